@@ -1,0 +1,108 @@
+//! Reflection models (BxDFs) built from the NDF and Fresnel layers.
+//!
+//! Frame: local shading frame, z = geometric normal; `wo` (toward the viewer) and `wi` (toward the light)
+//! are unit vectors pointing away from the surface. Reflection needs both strictly above the horizon.
+
+use glam::{Vec2, Vec3};
+
+/// Which kinds of lobe a sample came from (a small bit set).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct LobeFlags(u8);
+
+impl LobeFlags {
+    /// No lobe.
+    pub const NONE: LobeFlags = LobeFlags(0);
+    /// Reflection (the only transport this crate models today).
+    pub const REFLECTION: LobeFlags = LobeFlags(1);
+    /// A diffuse lobe (Lambert and the diffuse part of Phong).
+    pub const DIFFUSE: LobeFlags = LobeFlags(2);
+    /// A glossy lobe (Phong specular, rough microfacets, glint patches).
+    pub const GLOSSY: LobeFlags = LobeFlags(4);
+    /// A delta lobe (perfect mirror). Not produced yet; reserved so that renderers can match on it.
+    pub const SPECULAR: LobeFlags = LobeFlags(8);
+
+    /// Whether every flag of `other` is set in `self`.
+    #[inline]
+    pub const fn contains(self, other: LobeFlags) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// The raw bits.
+    #[inline]
+    pub const fn bits(self) -> u8 {
+        self.0
+    }
+}
+
+impl std::ops::BitOr for LobeFlags {
+    type Output = LobeFlags;
+    #[inline]
+    fn bitor(self, rhs: LobeFlags) -> LobeFlags {
+        LobeFlags(self.0 | rhs.0)
+    }
+}
+
+impl std::ops::BitOrAssign for LobeFlags {
+    #[inline]
+    fn bitor_assign(&mut self, rhs: LobeFlags) {
+        self.0 |= rhs.0;
+    }
+}
+
+/// One sampled direction with its BRDF value and density.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BxdfSample {
+    /// The sampled direction (unit, away from the surface, local frame).
+    pub wi: Vec3,
+    /// f(wo, wi), without the cosine; agrees with [`Bxdf::eval`].
+    pub f: Vec3,
+    /// Density of `wi` per unit solid angle; finite, > 0, agrees with [`Bxdf::pdf`].
+    pub pdf: f32,
+    /// The lobe the sample came from.
+    pub flags: LobeFlags,
+}
+
+impl BxdfSample {
+    /// The Monte Carlo weight f · cos θ_i / pdf.
+    #[inline]
+    pub fn weight(&self) -> Vec3 {
+        self.f * (self.wi.z.max(0.0) / self.pdf)
+    }
+}
+
+/// A BRDF in the local shading frame.
+///
+/// `eval` returns f (RGB, no cosine); `pdf` is per unit solid angle of `wi`. Below-horizon, degenerate
+/// or non-finite directions give 0 and pdf 0, and `sample` returns `None` instead of a zero-weight sample.
+pub trait Bxdf {
+    /// f(wo, wi), without the cosine factor.
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3;
+
+    /// Density (per unit solid angle of `wi`) with which [`Bxdf::sample`] draws `wi`.
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+
+    /// Draws `wi` given `wo`, using `uc` for the lobe choice and `u` for the direction.
+    /// `Some` guarantees a finite positive pdf that agrees with [`Bxdf::pdf`] and an `f` that agrees
+    /// with [`Bxdf::eval`].
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BxdfSample>;
+
+    /// Both [`Bxdf::eval`] and [`Bxdf::pdf`], sharing work where a model can.
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        (self.eval(wo, wi), self.pdf(wo, wi))
+    }
+}
+
+impl<T: Bxdf + ?Sized> Bxdf for &T {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        (**self).eval(wo, wi)
+    }
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        (**self).pdf(wo, wi)
+    }
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BxdfSample> {
+        (**self).sample(wo, uc, u)
+    }
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        (**self).eval_pdf(wo, wi)
+    }
+}

@@ -1,0 +1,130 @@
+//! The crate's one error type. Errors happen only at construction and I/O; evaluation never fails.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong when building a model or loading data.
+///
+/// Evaluation (`d`, `eval`, `pdf`, `sample`, …) never returns an error: degenerate input gives 0 / `None`.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A scalar parameter is outside its valid range (non-finite, non-positive, …).
+    #[error("invalid parameter `{name}` = {value}: {reason}")]
+    InvalidParameter {
+        /// The parameter's name as it appears in the constructor's signature.
+        name: &'static str,
+        /// The offending value (as `f64` so that integer parameters fit too).
+        value: f64,
+        /// What the valid range is.
+        reason: &'static str,
+    },
+    /// A matrix parameter (covariance, …) is invalid: not finite, not symmetric positive definite, ….
+    #[error("invalid matrix `{name}` {value:?}: {reason}")]
+    InvalidMatrix {
+        /// The parameter's name.
+        name: &'static str,
+        /// The entries, row major.
+        value: [f64; 4],
+        /// Why it is rejected.
+        reason: &'static str,
+    },
+    /// Map dimensions are unusable (zero-sized, or not matching the data length).
+    #[error("invalid map size {width}×{height}: {reason}")]
+    InvalidSize {
+        /// Width in texels.
+        width: usize,
+        /// Height in texels.
+        height: usize,
+        /// Why it is rejected.
+        reason: &'static str,
+    },
+    /// One texel of a normal map / height field holds unusable data.
+    #[error("{source_name}: texel ({x}, {y}): {reason}")]
+    InvalidTexel {
+        /// Where the data came from (a file path, or a description such as "normals").
+        source_name: String,
+        /// Texel column.
+        x: usize,
+        /// Texel row.
+        y: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A file was read but could not be decoded as a usable image.
+    #[error("cannot decode image {path}: {reason}")]
+    Image {
+        /// The file (or a description for in-memory bytes).
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
+}
+
+/// `Result` with this crate's [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Checks that a scalar parameter is finite and strictly positive.
+pub(crate) fn positive(name: &'static str, value: f32) -> Result<f32> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name,
+            value: value as f64,
+            reason: "must be finite and > 0",
+        })
+    }
+}
+
+/// Checks that a scalar parameter is finite and ≥ 0.
+pub(crate) fn non_negative(name: &'static str, value: f32) -> Result<f32> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name,
+            value: value as f64,
+            reason: "must be finite and >= 0",
+        })
+    }
+}
+
+/// Checks that a scalar parameter is finite.
+pub(crate) fn finite(name: &'static str, value: f32) -> Result<f32> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name,
+            value: value as f64,
+            reason: "must be finite",
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_name_the_parameter() {
+        let e = positive("alpha_x", -1.0).unwrap_err();
+        assert!(e.to_string().contains("alpha_x"), "{e}");
+        assert!(positive("a", f32::NAN).is_err());
+        assert!(positive("a", f32::INFINITY).is_err());
+        assert!(positive("a", 0.0).is_err());
+        assert_eq!(positive("a", 0.5).unwrap(), 0.5);
+        assert!(non_negative("a", 0.0).is_ok());
+        assert!(non_negative("a", -0.0).is_ok());
+        assert!(non_negative("a", -1e-9).is_err());
+        assert!(finite("a", f32::NEG_INFINITY).is_err());
+    }
+}

@@ -1,0 +1,200 @@
+//! Shading-frame one-liners.
+//!
+//! Every direction is expressed in the local shading frame: z is the geometric normal ω_g = (0, 0, 1),
+//! x is the tangent along which `alpha_x` acts. Directions point *away* from the surface and are unit
+//! length unless a function says otherwise. Functions here are total: they never panic, and the ones that
+//! can meet a degenerate configuration return an `Option` or a documented 0.
+
+use glam::{Vec2, Vec3};
+
+/// The geometric normal ω_g of the local frame.
+pub const NORMAL: Vec3 = Vec3::Z;
+
+/// cos θ of a unit direction: its z component.
+#[inline]
+pub fn cos_theta(w: Vec3) -> f32 {
+    w.z
+}
+
+/// cos² θ of a unit direction.
+#[inline]
+pub fn cos2_theta(w: Vec3) -> f32 {
+    w.z * w.z
+}
+
+/// sin² θ of a unit direction, clamped at 0 (computed as x² + y², exact near the pole).
+#[inline]
+pub fn sin2_theta(w: Vec3) -> f32 {
+    (w.x * w.x + w.y * w.y).max(0.0)
+}
+
+/// sin θ of a unit direction.
+#[inline]
+pub fn sin_theta(w: Vec3) -> f32 {
+    sin2_theta(w).sqrt()
+}
+
+/// tan² θ of a unit direction; `+∞` for directions in the tangent plane (z = 0).
+#[inline]
+pub fn tan2_theta(w: Vec3) -> f32 {
+    sin2_theta(w) / cos2_theta(w)
+}
+
+/// (cos φ, sin φ) of a direction; (1, 0) at the pole where φ is undefined.
+#[inline]
+pub fn cos_sin_phi(w: Vec3) -> Vec2 {
+    let s2 = sin2_theta(w);
+    if s2 > 0.0 {
+        Vec2::new(w.x, w.y) / s2.sqrt()
+    } else {
+        Vec2::X
+    }
+}
+
+/// Whether two directions lie strictly on the same side of the tangent plane.
+#[inline]
+pub fn same_hemisphere(a: Vec3, b: Vec3) -> bool {
+    a.z * b.z > 0.0
+}
+
+/// Whether `w` is usable as a reflection direction: finite, of non-zero length, strictly above the
+/// tangent plane.
+#[inline]
+pub fn is_upper(w: Vec3) -> bool {
+    w.is_finite() && w.z > 0.0
+}
+
+/// Mirror reflection of `w` about the unit normal `n`: 2 (w·n) n − w. Both point away from the surface.
+#[inline]
+pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
+    2.0 * w.dot(n) * n - w
+}
+
+/// The half vector ω_h = (ω_o + ω_i) / ‖ω_o + ω_i‖ of two unit directions.
+///
+/// `None` when the sum vanishes (ω_o = −ω_i) or is not finite. Not restricted to the upper hemisphere:
+/// callers check the hemisphere themselves.
+#[inline]
+pub fn half_vector(wo: Vec3, wi: Vec3) -> Option<Vec3> {
+    (wo + wi).try_normalize()
+}
+
+/// The slope ñ = (−x/z, −y/z) of a normal ω_n = (x, y, z) (Chermain 2019, §3).
+///
+/// Returns `None` for normals with z ≤ 0 or non-finite components (slopes are undefined there).
+#[inline]
+pub fn normal_to_slope(n: Vec3) -> Option<Vec2> {
+    if n.z > 0.0 && n.is_finite() {
+        let s = Vec2::new(-n.x / n.z, -n.y / n.z);
+        s.is_finite().then_some(s)
+    } else {
+        None
+    }
+}
+
+/// The unit normal normalize(−x̃, −ỹ, 1) of a slope ñ = (x̃, ỹ) (Chermain 2019, §3).
+///
+/// A non-finite slope returns the geometric normal `Vec3::Z`, so that callers never see NaN.
+#[inline]
+pub fn slope_to_normal(s: Vec2) -> Vec3 {
+    Vec3::new(-s.x, -s.y, 1.0).try_normalize().unwrap_or(Vec3::Z)
+}
+
+/// A right-handed orthonormal frame (tangent, bitangent, normal) for moving directions between world
+/// space and the local shading frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// Local x axis (tangent) in world space.
+    pub x: Vec3,
+    /// Local y axis (bitangent) in world space.
+    pub y: Vec3,
+    /// Local z axis (shading normal) in world space.
+    pub z: Vec3,
+}
+
+impl Frame {
+    /// A frame around the unit normal `n` with an arbitrary but continuous tangent
+    /// (Duff et al. 2017, "Building an orthonormal basis, revisited", listing 3).
+    pub fn from_normal(n: Vec3) -> Frame {
+        let (x, y) = n.any_orthonormal_pair();
+        Frame { x, y, z: n }
+    }
+
+    /// A frame around the unit normal `n` whose x axis is `tangent` made orthogonal to `n`
+    /// (Gram-Schmidt). Falls back to [`Frame::from_normal`] when the tangent is parallel to `n`.
+    pub fn from_normal_tangent(n: Vec3, tangent: Vec3) -> Frame {
+        match (tangent - n * n.dot(tangent)).try_normalize() {
+            Some(x) => Frame {
+                x,
+                y: n.cross(x),
+                z: n,
+            },
+            None => Frame::from_normal(n),
+        }
+    }
+
+    /// World → local.
+    #[inline]
+    pub fn to_local(&self, w: Vec3) -> Vec3 {
+        Vec3::new(w.dot(self.x), w.dot(self.y), w.dot(self.z))
+    }
+
+    /// Local → world.
+    #[inline]
+    pub fn to_world(&self, w: Vec3) -> Vec3 {
+        self.x * w.x + self.y * w.y + self.z * w.z
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn slope_round_trip() {
+        let n = Vec3::new(0.3, -0.2, 0.9).normalize();
+        let s = normal_to_slope(n).unwrap();
+        assert_relative_eq!(s.x, -n.x / n.z);
+        let back = slope_to_normal(s);
+        assert_relative_eq!(back.x, n.x, epsilon = 1e-6);
+        assert_relative_eq!(back.y, n.y, epsilon = 1e-6);
+        assert_relative_eq!(back.z, n.z, epsilon = 1e-6);
+        assert_eq!(normal_to_slope(Vec3::new(1.0, 0.0, 0.0)), None);
+        assert_eq!(normal_to_slope(Vec3::new(f32::NAN, 0.0, 1.0)), None);
+        assert_eq!(slope_to_normal(Vec2::new(f32::NAN, 0.0)), Vec3::Z);
+    }
+
+    #[test]
+    fn reflect_and_half_vector() {
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let wi = reflect(wo, Vec3::Z);
+        assert_relative_eq!(wi.x, -0.6);
+        assert_relative_eq!(wi.z, 0.8);
+        let h = half_vector(wo, wi).unwrap();
+        assert_relative_eq!(h.z, 1.0);
+        assert_eq!(half_vector(wo, -wo), None);
+    }
+
+    #[test]
+    fn trig_at_pole_and_horizon() {
+        assert_eq!(cos_sin_phi(Vec3::Z), Vec2::X);
+        assert_eq!(tan2_theta(Vec3::X), f32::INFINITY);
+        assert_eq!(sin2_theta(Vec3::Z), 0.0);
+        assert!(same_hemisphere(Vec3::Z, Vec3::new(0.0, 1.0, 1e-7)));
+        assert!(!same_hemisphere(Vec3::Z, Vec3::X));
+    }
+
+    #[test]
+    fn frame_round_trip() {
+        for n in [Vec3::Z, -Vec3::Z, Vec3::new(0.2, 0.5, -0.3).normalize()] {
+            let f = Frame::from_normal(n);
+            let w = Vec3::new(0.1, -0.7, 0.4).normalize();
+            let back = f.to_world(f.to_local(w));
+            assert!((back - w).length() < 1e-6);
+            assert!((f.to_local(n) - Vec3::Z).length() < 1e-6);
+        }
+        let f = Frame::from_normal_tangent(Vec3::Z, Vec3::new(1.0, 0.0, 0.5));
+        assert!((f.x - Vec3::X).length() < 1e-6);
+    }
+}

@@ -1,0 +1,31 @@
+//! # brdf
+//!
+//! BRDF math and glint normal distribution functions for renderers.
+//!
+//! ## Conventions
+//!
+//! - **Frame.** Everything is evaluated in the local shading frame: z is the geometric normal
+//!   ω_g = (0, 0, 1), x is the tangent along which `alpha_x` acts. `wo` (toward the viewer) and `wi`
+//!   (toward the light, or sampled) are unit vectors pointing *away* from the surface. Reflection needs
+//!   both strictly above the horizon; otherwise values and pdfs are 0. Use [`frame::Frame`] to move
+//!   directions between world space and the local frame.
+//! - **Slopes.** A normal ω_n = (x, y, z) has slope ñ = (−x/z, −y/z); the inverse is
+//!   normalize(−x̃, −ỹ, 1).
+//! - **NDF normalisation.** ∫ D(m) (m·ω_g) dm = 1 over the hemisphere, for every NDF.
+//! - **Projected area.** `projected_area(w)` = A(w), the microsurface's projected area toward `w` per
+//!   unit geometric area (cos θ for centred NDFs). Smith: ∫ ⟨w, m⟩ D(m) dm = A(w) (1 + Λ(w)).
+//! - **Microfacet BRDF.** f = F · G2 · D(h) / (4 A(wo) A(wi)).
+//! - **Values.** `Bxdf::eval` returns f (RGB, no cosine); `pdf` is per unit solid angle of `wi`.
+//! - **Randomness.** Samplers take their random numbers as arguments (`uc: f32`, `u: Vec2`).
+//! - **Roughness.** α is exposed directly. Beckmann α = √2·σ (σ = RMS slope per axis).
+//! - **Precision.** Public API in `f32`; builders and reference integrators accumulate in `f64`.
+//! - **Errors.** Constructors validate and return [`Result`]; evaluation never fails, never panics and
+//!   never returns NaN or infinity.
+
+pub mod bxdf;
+mod error;
+pub mod frame;
+pub mod ndf;
+
+pub use error::{Error, Result};
+pub use glam::{Vec2, Vec3};

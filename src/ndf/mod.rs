@@ -1,0 +1,133 @@
+//! Normal distribution functions (NDFs) and their Smith masking terms.
+//!
+//! Frame: local shading frame, z = geometric normal; `w`, `wo`, `m` are unit vectors pointing away from
+//! the surface. Every NDF is normalised so that ∫ D(m) (m·ω_g) dm = 1 over the hemisphere.
+
+use glam::{Vec2, Vec3};
+
+/// A microfacet normal distribution with its Smith masking function and samplers.
+///
+/// Conventions (see the crate docs): `d(m)` is a density per unit solid angle of micronormals with
+/// ∫ D(m) cos θ_m dm = 1; `projected_area(w)` is A(w), the microsurface's projected area toward `w` per
+/// unit geometric area; Smith's identity ∫ ⟨w, m⟩ D(m) dm = A(w) (1 + Λ(w)) defines Λ.
+///
+/// Every method is total: below-horizon, zero-length or non-finite arguments give 0 (or, for the
+/// samplers, a valid upper-hemisphere normal), never NaN, never a panic.
+pub trait Ndf {
+    /// D(m): micronormal density per unit solid angle. 0 for m below the horizon.
+    fn d(&self, m: Vec3) -> f32;
+
+    /// Smith Λ(w). 0 at normal incidence for centred NDFs; large but finite when `w` sees nothing.
+    fn lambda(&self, w: Vec3) -> f32;
+
+    /// A(w): projected area of the microsurface toward `w` per unit geometric area.
+    /// cos θ_w for a centred NDF (the default), 0 below the horizon.
+    fn projected_area(&self, w: Vec3) -> f32 {
+        w.z.max(0.0)
+    }
+
+    /// ∫ ⟨w, m⟩ D(m) dm = A(w) (1 + Λ(w)): the projected area of the micronormals that face `w`.
+    ///
+    /// Masking, visible-normal densities and the microfacet BRDF are written with this quantity so
+    /// that no term divides by a vanishing A(w). Override it where it has a form more robust than the
+    /// product (non-centred lobes, patches).
+    fn visible_area(&self, w: Vec3) -> f32 {
+        let a = self.projected_area(w);
+        if a > 0.0 {
+            a * (1.0 + self.lambda(w))
+        } else {
+            0.0
+        }
+    }
+
+    /// Smith masking G1(w, m) = χ⁺(w·m) / (1 + Λ(w)) = χ⁺(w·m) A(w) / ∫⟨w, m'⟩ D dm'.
+    fn g1(&self, w: Vec3, m: Vec3) -> f32 {
+        if !(w.z > 0.0 && w.dot(m) > 0.0) {
+            return 0.0;
+        }
+        let v = self.visible_area(w);
+        if v > 0.0 {
+            (self.projected_area(w) / v).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Separable (uncorrelated) masking-shadowing G2 = G1(wo, m) · G1(wi, m).
+    fn g2(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
+        self.g1(wo, m) * self.g1(wi, m)
+    }
+
+    /// Height-correlated masking-shadowing G2 = χ⁺(wo·m) χ⁺(wi·m) / (1 + Λ(wo) + Λ(wi))
+    /// (Heitz 2014, eq. 99).
+    fn g2_height_correlated(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
+        if !(wo.z > 0.0 && wi.z > 0.0 && wo.dot(m) > 0.0 && wi.dot(m) > 0.0) {
+            return 0.0;
+        }
+        let g = 1.0 / (1.0 + self.lambda(wo) + self.lambda(wi));
+        if g.is_finite() { g.clamp(0.0, 1.0) } else { 0.0 }
+    }
+
+    /// Draws a micronormal m with density D(m) cos θ_m (per unit solid angle), from `u` ∈ [0, 1)².
+    fn sample_normal(&self, u: Vec2) -> Vec3;
+
+    /// Density of [`Ndf::sample_normal`]: D(m) cos θ_m.
+    fn pdf_normal(&self, m: Vec3) -> f32 {
+        self.d(m) * m.z.max(0.0)
+    }
+
+    /// Draws a micronormal visible from `wo`, with density D_wo(m) = G1(wo, m) ⟨wo, m⟩ D(m) / A(wo).
+    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3;
+
+    /// Density of [`Ndf::sample_visible`]: D_wo(m) = χ⁺(wo·m) ⟨wo, m⟩ D(m) / ∫⟨wo, m'⟩ D dm'.
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        let c = wo.dot(m);
+        if !(wo.z > 0.0 && c > 0.0) {
+            return 0.0;
+        }
+        let v = self.visible_area(wo);
+        if v > 0.0 {
+            let p = c * self.d(m) / v;
+            if p.is_finite() { p } else { 0.0 }
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A reference to an NDF is an NDF (so a BRDF can borrow a patch or a shared lobe).
+impl<T: Ndf + ?Sized> Ndf for &T {
+    fn d(&self, m: Vec3) -> f32 {
+        (**self).d(m)
+    }
+    fn lambda(&self, w: Vec3) -> f32 {
+        (**self).lambda(w)
+    }
+    fn projected_area(&self, w: Vec3) -> f32 {
+        (**self).projected_area(w)
+    }
+    fn visible_area(&self, w: Vec3) -> f32 {
+        (**self).visible_area(w)
+    }
+    fn g1(&self, w: Vec3, m: Vec3) -> f32 {
+        (**self).g1(w, m)
+    }
+    fn g2(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
+        (**self).g2(wo, wi, m)
+    }
+    fn g2_height_correlated(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
+        (**self).g2_height_correlated(wo, wi, m)
+    }
+    fn sample_normal(&self, u: Vec2) -> Vec3 {
+        (**self).sample_normal(u)
+    }
+    fn pdf_normal(&self, m: Vec3) -> f32 {
+        (**self).pdf_normal(m)
+    }
+    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        (**self).sample_visible(wo, u)
+    }
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        (**self).pdf_visible(wo, m)
+    }
+}
