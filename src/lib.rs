@@ -27,5 +27,9 @@ mod error;
 pub mod frame;
 pub mod ndf;
 
+pub use bxdf::{
+    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, MicrofacetBrdf, OriginalPhong, Phong,
+    PhongNormalization,
+};
 pub use error::{Error, Result};
 pub use glam::{Vec2, Vec3};
