@@ -153,7 +153,10 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
             return None;
         }
         let h = half_vector(wo, wi)?;
-        let c = wo.dot(h);
+        // wo·h = wi·h in exact arithmetic; their mean is symmetric in (wo, wi) to the last bit, which
+        // keeps F(wo·h) and the Jacobian exactly reciprocal even where wo + wi is small and rounding
+        // makes the two dot products differ.
+        let c = 0.5 * (wo.dot(h) + wi.dot(h));
         (c > 0.0).then_some((h, c))
     }
 
