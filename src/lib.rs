@@ -26,6 +26,7 @@ pub mod bxdf;
 mod error;
 pub mod frame;
 pub mod ndf;
+pub mod warp;
 
 pub use error::{Error, Result};
 pub use glam::{Vec2, Vec3};
