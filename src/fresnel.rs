@@ -167,7 +167,8 @@ pub fn f0_from_conductor(eta: Vec3, k: Vec3) -> Vec3 {
             return 0.0;
         }
         let d = (eta + 1.0) * (eta + 1.0) + k * k;
-        (1.0 - 4.0 * eta / d).clamp(0.0, 1.0)
+        // η / d first: 4η alone may overflow (d = ∞ then gives η/d = 0, the limit).
+        (1.0 - 4.0 * (eta / d)).clamp(0.0, 1.0)
     };
     Vec3::new(
         channel(eta.x, k.x),
