@@ -108,7 +108,10 @@ fn reference_is_consistent() {
             let t = deg.to_radians();
             let (rs, rp) = trig_rs_rp(t, eta);
             let (crs, crp) = reference_rs_rp(t.cos(), C::real(eta));
-            assert!((rs - crs).abs() < 1e-13 && (rp - crp).abs() < 1e-13, "{eta} {deg}");
+            assert!(
+                (rs - crs).abs() < 1e-13 && (rp - crp).abs() < 1e-13,
+                "{eta} {deg}"
+            );
         }
         let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
         assert!((reference(1.0, eta, 0.0) - f0).abs() < 1e-15);
@@ -122,7 +125,10 @@ fn normal_incidence_is_f0() {
         // A handful of f32 operations on values ≤ 1: ≤ 8 ulp(1) absolute.
         let tol = 8.0 * EPS32;
         assert!((dielectric(1.0, eta) as f64 - f0).abs() < tol, "{eta}");
-        assert!((dielectric(-1.0, eta) as f64 - f0).abs() < tol, "{eta} from inside");
+        assert!(
+            (dielectric(-1.0, eta) as f64 - f0).abs() < tol,
+            "{eta} from inside"
+        );
         assert!((f0_from_ior(eta) as f64 - f0).abs() < tol, "{eta}");
     }
     for (eta, k) in [(0.2f32, 3.0f32), (1.5, 0.0), (1.0, 1.0), (2.8, 8.4)] {
@@ -131,7 +137,10 @@ fn normal_incidence_is_f0() {
         let tol = 8.0 * EPS32;
         let c = conductor(1.0, Vec3::splat(eta), Vec3::splat(k));
         let f = f0_from_conductor(Vec3::splat(eta), Vec3::splat(k));
-        assert!((c.x as f64 - f0).abs() < tol && (f.x as f64 - f0).abs() < tol, "{eta} {k}");
+        assert!(
+            (c.x as f64 - f0).abs() < tol && (f.x as f64 - f0).abs() < tol,
+            "{eta} {k}"
+        );
     }
 }
 
@@ -149,7 +158,11 @@ fn brewster_angle_is_half_the_s_reflectance() {
             // f32 evaluation (≤ 8 ulp(1)) plus the rounding of cos θ_B to f32 times |dR/dcos| (≤ 2
             // here, the slope of R_s/2 near Brewster for these η): 8 ulp(1) + 2 ulp(1).
             let tol = 10.0 * EPS32;
-            assert!((got - 0.5 * rs).abs() < tol, "η = {eta}, side {sign}: {got} vs {}", 0.5 * rs);
+            assert!(
+                (got - 0.5 * rs).abs() < tol,
+                "η = {eta}, side {sign}: {got} vs {}",
+                0.5 * rs
+            );
         }
     }
 }
@@ -160,7 +173,13 @@ fn grazing_incidence_gives_one() {
         assert_eq!(dielectric(0.0, eta), 1.0, "{eta}");
         assert_eq!(dielectric(-0.0, eta), 1.0, "{eta}");
     }
-    for (eta, k) in [(0.2f32, 3.0f32), (1.5, 0.0), (1.0, 0.0), (2.8, 8.4), (1e3, 100.0)] {
+    for (eta, k) in [
+        (0.2f32, 3.0f32),
+        (1.5, 0.0),
+        (1.0, 0.0),
+        (2.8, 8.4),
+        (1e3, 100.0),
+    ] {
         assert_eq!(
             conductor(0.0, Vec3::splat(eta), Vec3::splat(k)),
             Vec3::ONE,
@@ -176,7 +195,10 @@ fn grazing_incidence_gives_one() {
         let g = ConductorFresnel::GOLD;
         let got = conductor(c, g.eta, g.k).x as f64;
         let want = reference(c as f64, g.eta.x as f64, g.k.x as f64);
-        assert!((got - want).abs() < 16.0 * EPS32, "gold {c}: {got} vs {want}");
+        assert!(
+            (got - want).abs() < 16.0 * EPS32,
+            "gold {c}: {got} vs {want}"
+        );
     }
 }
 
@@ -191,7 +213,11 @@ fn total_internal_reflection_is_exactly_one() {
             let c = cos_c * (1.0 - 1e-5) * (1.0 - i as f64 / 200.0);
             assert_eq!(dielectric(-(c as f32), eta), 1.0, "η = {eta}, cos = {c}");
             // The same interface seen from outside of a medium with η < 1.
-            assert_eq!(dielectric(c as f32, 1.0 / eta), 1.0, "η = 1/{eta}, cos = {c}");
+            assert_eq!(
+                dielectric(c as f32, 1.0 / eta),
+                1.0,
+                "η = 1/{eta}, cos = {c}"
+            );
         }
     }
 }
@@ -219,7 +245,10 @@ fn continuous_at_the_critical_angle() {
             let delta = 4.0 * EPS32;
             let f32_term = slope * delta.sqrt().min(delta / (2.0 * eps)) + 8.0 * EPS32;
             let want = reference(ci, eta_r, 0.0);
-            assert!((got - want).abs() <= f32_term, "η {eta} ε {eps}: {got} vs {want}");
+            assert!(
+                (got - want).abs() <= f32_term,
+                "η {eta} ε {eps}: {got} vs {want}"
+            );
             let gap = 1.0 - got;
             assert!(
                 gap >= -f32_term && gap <= slope * eps + f32_term,
@@ -271,7 +300,10 @@ fn conductor_with_zero_k_is_a_dielectric() {
             let k0 = conductor(c, Vec3::splat(eta), Vec3::ZERO).x as f64;
             // Away from the critical angle: two f32 evaluations of ≤ 20 operations each, on values of
             // like magnitude; measured maximum difference 1.8e-7 (1.5 ulp(1)), bound 16 ulp(1).
-            assert!((d - k0).abs() < 16.0 * EPS32, "η {eta} cos {c}: {d} vs {k0}");
+            assert!(
+                (d - k0).abs() < 16.0 * EPS32,
+                "η {eta} cos {c}: {d} vs {k0}"
+            );
         }
     }
 }
@@ -290,7 +322,13 @@ fn conductor_matches_the_complex_reference() {
             metals.push((c.eta[i], c.k[i]));
         }
     }
-    metals.extend([(1e-3, 0.5), (0.05, 100.0), (1e3, 100.0), (3.0, 1e-3), (1.2, 0.3)]);
+    metals.extend([
+        (1e-3, 0.5),
+        (0.05, 100.0),
+        (1e3, 100.0),
+        (3.0, 1e-3),
+        (1.2, 0.3),
+    ]);
     let mut worst = 0.0f64;
     for &(eta, k) in &metals {
         for i in 0..=200 {
@@ -322,7 +360,11 @@ fn dielectric_matches_the_complex_reference() {
                 continue;
             }
             let want = reference_dielectric(c as f64, eta as f64);
-            let eta_r = if c < 0.0 { 1.0 / eta as f64 } else { eta as f64 };
+            let eta_r = if c < 0.0 {
+                1.0 / eta as f64
+            } else {
+                eta as f64
+            };
             let ci = (c as f64).abs();
             let sin2 = 1.0 - ci * ci;
             let cos_t = (1.0 - sin2 / (eta_r * eta_r)).max(0.0).sqrt();
@@ -398,7 +440,10 @@ fn presets_match_their_sources() {
         (0.65225, 1.5724, 7.7354),
     ];
     let interp = |rows: &[(f64, f64, f64)], w: f64| {
-        let i = rows.windows(2).position(|p| p[0].0 <= w && w <= p[1].0).unwrap();
+        let i = rows
+            .windows(2)
+            .position(|p| p[0].0 <= w && w <= p[1].0)
+            .unwrap();
         let ((w0, n0, k0), (w1, n1, k1)) = (rows[i], rows[i + 1]);
         let t = (w - w0) / (w1 - w0);
         (n0 + t * (n1 - n0), k0 + t * (k1 - k0))
@@ -412,8 +457,14 @@ fn presets_match_their_sources() {
         for (ch, w) in [0.650, 0.550, 0.450].into_iter().enumerate() {
             let (n, k) = interp(rows, w);
             // Rounded to 3 decimals: |Δ| ≤ 5e-4 (+ f32 representation).
-            assert!((preset.eta[ch] as f64 - n).abs() <= 5.1e-4, "{preset:?} {w}: n {n}");
-            assert!((preset.k[ch] as f64 - k).abs() <= 5.1e-4, "{preset:?} {w}: k {k}");
+            assert!(
+                (preset.eta[ch] as f64 - n).abs() <= 5.1e-4,
+                "{preset:?} {w}: n {n}"
+            );
+            assert!(
+                (preset.k[ch] as f64 - k).abs() <= 5.1e-4,
+                "{preset:?} {w}: k {k}"
+            );
         }
     }
     // Physical sanity of the colours at normal incidence: gold and copper reflect red more than blue,
@@ -428,7 +479,10 @@ fn presets_match_their_sources() {
     assert!(au.x > au.y && au.y > au.z, "{au}");
     assert!(cu.x > cu.y && cu.y > cu.z, "{cu}");
     assert!(ag.min_element() > 0.95, "{ag}");
-    assert!(al.min_element() > 0.9 && al.max_element() - al.min_element() < 0.03, "{al}");
+    assert!(
+        al.min_element() > 0.9 && al.max_element() - al.min_element() < 0.03,
+        "{al}"
+    );
 }
 
 #[test]
