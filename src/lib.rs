@@ -29,3 +29,4 @@ pub mod ndf;
 
 pub use error::{Error, Result};
 pub use glam::{Vec2, Vec3};
+pub use ndf::SlopeGaussian;
