@@ -32,3 +32,4 @@ pub mod warp;
 pub use error::{Error, Result};
 pub use fresnel::Fresnel;
 pub use glam::{Vec2, Vec3};
+pub use ndf::SlopeGaussian;
