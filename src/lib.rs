@@ -25,11 +25,15 @@
 pub mod bxdf;
 mod error;
 pub mod frame;
+pub mod fresnel;
 pub mod ndf;
+pub mod warp;
 
 pub use bxdf::{
     BlinnPhongLobe, Bxdf, BxdfSample, Lambert, MicrofacetBrdf, OriginalPhong, Phong,
     PhongNormalization,
 };
 pub use error::{Error, Result};
+pub use fresnel::Fresnel;
 pub use glam::{Vec2, Vec3};
+pub use ndf::SlopeGaussian;
