@@ -11,10 +11,11 @@
 mod support;
 
 use brdf::bxdf::{
-    BlinnPhongLobe, BlinnPhongNormalization, Bxdf, Lambert, Masking, MicrofacetBrdf, NoFresnel,
-    OriginalPhong, OriginalPhongNormalization, Phong, PhongNormalization, Sampling, SchlickFresnel,
+    BlinnPhongLobe, BlinnPhongNormalization, Bxdf, Lambert, Masking, MicrofacetBrdf, OriginalPhong,
+    OriginalPhongNormalization, Phong, PhongNormalization, Sampling,
 };
 use brdf::frame::Frame;
+use brdf::fresnel::{NoFresnel, SchlickFresnel};
 use brdf::ndf::Ndf;
 use glam::{Vec2, Vec3};
 use proptest::prelude::*;

@@ -6,12 +6,11 @@
 //! empirical form without masking or the 1/(4 cos cos) factor.
 
 use super::lambert::unit_rgb;
-use super::lobe::{
-    cosine_power, pdf_cosine_hemisphere, sample_cosine_hemisphere, sample_cosine_power,
-};
+use super::lobe::{cosine_power, sample_cosine_power};
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::{Error, Result, non_negative};
 use crate::frame::{half_vector, is_upper, reflect};
+use crate::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
 
@@ -163,7 +162,7 @@ impl Bxdf for BlinnPhongLobe {
             0.0
         };
         let p = self.p_spec();
-        let v = (1.0 - p) * pdf_cosine_hemisphere(wi.z) + p * spec;
+        let v = (1.0 - p) * pdf_cosine_hemisphere(wi) + p * spec;
         if v.is_finite() { v } else { 0.0 }
     }
 
@@ -178,7 +177,7 @@ impl Bxdf for BlinnPhongLobe {
             }
             (reflect(wo, h), LobeFlags::GLOSSY)
         } else {
-            (sample_cosine_hemisphere(u), LobeFlags::DIFFUSE)
+            (square_to_cosine_hemisphere(u), LobeFlags::DIFFUSE)
         };
         if !is_upper(wi) {
             return None;

@@ -3,10 +3,10 @@
 //! It is reciprocal, and its directional albedo ∫ f cos θ_i dω_i is exactly ρ for every `wo`, so it
 //! conserves energy whenever 0 ≤ ρ ≤ 1 (which the constructor enforces per channel).
 
-use super::lobe::{pdf_cosine_hemisphere, sample_cosine_hemisphere};
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::{Error, Result};
 use crate::frame::is_upper;
+use crate::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
@@ -30,7 +30,8 @@ pub(crate) fn unit_rgb(name: &'static str, v: Vec3) -> Result<Vec3> {
 /// cos θ_i / π (perfect importance sampling: the weight f cos θ_i / pdf is ρ).
 ///
 /// # Reference
-/// [Lambert1760]; the cosine-weighted hemisphere sampler is Malley's method ([Pharr2023], §A.5.3).
+/// [Lambert1760]; the cosine-weighted hemisphere sampler is [`crate::warp::square_to_cosine_hemisphere`]
+/// (Malley's method).
 ///
 /// # Degenerate cases
 /// `wo` or `wi` not strictly above the horizon, zero-length or non-finite: f = 0, pdf = 0, `sample`
@@ -66,7 +67,7 @@ impl Bxdf for Lambert {
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if is_upper(wo) && is_upper(wi) {
-            pdf_cosine_hemisphere(wi.z)
+            pdf_cosine_hemisphere(wi)
         } else {
             0.0
         }
@@ -76,7 +77,7 @@ impl Bxdf for Lambert {
         if !is_upper(wo) || !u.is_finite() {
             return None;
         }
-        let wi = sample_cosine_hemisphere(u);
+        let wi = square_to_cosine_hemisphere(u);
         let pdf = self.pdf(wo, wi);
         (pdf > 0.0).then(|| BxdfSample {
             wi,

@@ -1,28 +1,13 @@
-//! Private sampling helpers shared by the BxDFs: the cosine-weighted hemisphere and the cosine-power
-//! lobe about an arbitrary axis, each as a sample / pdf pair.
+//! Private sampling helper shared by the Phong-type BxDFs: the cosine-power lobe (γ+1)/(2π) cos^γ θ
+//! about an arbitrary axis, as a sample / pdf pair (the cosine-weighted hemisphere is in
+//! [`crate::warp`]).
 //!
-//! Both are written in the lobe's own frame (axis = z) and are exact inverses of their densities;
-//! the BxDFs rotate the result with [`crate::frame::Frame`].
+//! The sampler is written in the lobe's own frame (axis = z) and inverts its CDF exactly; the rotated
+//! variant uses [`crate::frame::Frame`].
 
 use crate::frame::Frame;
 use glam::{Vec2, Vec3};
-use std::f32::consts::{FRAC_1_PI, TAU};
-
-/// cos θ-distributed direction about z (Malley's method: uniform disk point lifted to the hemisphere).
-///
-/// Density cos θ / π. Returns z ≥ 0; z = 0 only on the boundary u.x → 1.
-#[inline]
-pub(crate) fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let r = u.x.clamp(0.0, 1.0).sqrt();
-    let (s, c) = (TAU * u.y).sin_cos();
-    Vec3::new(r * c, r * s, (1.0 - u.x).clamp(0.0, 1.0).sqrt())
-}
-
-/// Density of [`sample_cosine_hemisphere`] at a direction with cos θ = `cos_theta`: max(cos θ, 0)/π.
-#[inline]
-pub(crate) fn pdf_cosine_hemisphere(cos_theta: f32) -> f32 {
-    cos_theta.max(0.0) * FRAC_1_PI
-}
+use std::f32::consts::TAU;
 
 /// The lobe value max(0, c)^γ, with 0^0 = 0 so that the lobe's support is exactly c > 0.
 #[inline]

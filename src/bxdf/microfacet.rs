@@ -12,9 +12,9 @@
 //! The denominator of the second form equals A_o A_i (1 + Λ_o + Λ_i) ≥ 0 and stays positive when one
 //! of A_o, A_i vanishes while the corresponding V does not.
 
-use super::shim::Fresnel;
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::frame::{half_vector, is_upper, reflect};
+use crate::fresnel::Fresnel;
 use crate::ndf::Ndf;
 use glam::{Vec2, Vec3};
 

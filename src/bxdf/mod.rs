@@ -18,8 +18,6 @@ pub use microfacet::{Masking, MicrofacetBrdf, Sampling};
 pub use phong::{
     ARVO_MAX_GAMMA, OriginalPhong, OriginalPhongNormalization, Phong, PhongNormalization,
 };
-// TEMPORARY: the Fresnel stand-ins until `brdf::fresnel` lands on main (then these lines go).
-pub use shim::{Fresnel, NoFresnel, SchlickFresnel};
 
 /// Which kinds of lobe a sample came from (a small bit set).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

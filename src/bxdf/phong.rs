@@ -12,14 +12,13 @@
 //! integrates to less than 1 when part of the specular lobe is below the horizon).
 
 use super::lambert::unit_rgb;
-use super::lobe::{
-    cosine_power, pdf_cosine_hemisphere, pdf_cosine_power, sample_cosine_hemisphere,
-    sample_cosine_power_about,
-};
-use super::shim::{phong_lobe_integral, phong_lobe_integral_arvo, schlick};
+use super::lobe::{cosine_power, pdf_cosine_power, sample_cosine_power_about};
+use super::shim::{phong_lobe_integral, phong_lobe_integral_arvo};
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::{Error, Result, non_negative};
 use crate::frame::is_upper;
+use crate::fresnel::schlick;
+use crate::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, TAU};
 
@@ -61,7 +60,7 @@ fn specular_probability(kd: Vec3, ks_weight: Vec3) -> f32 {
 /// Density of the diffuse + cosine-power mixture used by both Phong types.
 #[inline]
 fn mixture_pdf(wo: Vec3, wi: Vec3, p_spec: f32, gamma: f32) -> f32 {
-    (1.0 - p_spec) * pdf_cosine_hemisphere(wi.z)
+    (1.0 - p_spec) * pdf_cosine_hemisphere(wi)
         + p_spec * pdf_cosine_power(wi.dot(mirror(wo)), gamma)
 }
 
@@ -83,7 +82,7 @@ fn sample_mixture(
             LobeFlags::GLOSSY,
         )
     } else {
-        (sample_cosine_hemisphere(u), LobeFlags::DIFFUSE)
+        (square_to_cosine_hemisphere(u), LobeFlags::DIFFUSE)
     };
     is_upper(wi).then_some((wi, LobeFlags::REFLECTION | lobe))
 }

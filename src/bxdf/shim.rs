@@ -1,8 +1,7 @@
 //! TEMPORARY stand-ins for items other branches are adding to `main` (`brdf::ndf::phong_lobe_integral*`,
-//! `brdf::fresnel`). Same names and signatures; this file is deleted when those land.
+//! `brdf::fresnel`, now merged). Same names and signatures; this file is deleted when those land.
 #![allow(dead_code)]
 
-use glam::Vec3;
 use std::f64::consts::PI;
 
 /// I(γ, c) = ∫_{H²} max(0, ω·r)^γ cos θ dω with r at cos θ_r = c (Mallett & Yuksel 2020).
@@ -37,39 +36,4 @@ pub fn phong_lobe_integral_arvo(n: u32, cos_theta: f32) -> f32 {
         tk *= s * s * (k as f64 - 1.0) / k as f64;
     }
     (2.0 * (tk + a * c + c * c * t) / (n as f64 + 2.0)) as f32
-}
-
-/// Fresnel reflectance as a function of the cosine between the incident direction and the normal.
-pub trait Fresnel {
-    /// F(cos θ).
-    fn eval(&self, cos_theta: f32) -> Vec3;
-}
-
-/// F = 1.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct NoFresnel;
-
-impl Fresnel for NoFresnel {
-    fn eval(&self, _cos_theta: f32) -> Vec3 {
-        Vec3::ONE
-    }
-}
-
-/// Schlick's approximation F = f0 + (1 − f0)(1 − cos θ)^5.
-pub fn schlick(f0: Vec3, cos_theta: f32) -> Vec3 {
-    let m = (1.0 - cos_theta.clamp(0.0, 1.0)).powi(5);
-    f0 + (Vec3::ONE - f0) * m
-}
-
-/// Schlick Fresnel with reflectance `f0` at normal incidence.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SchlickFresnel {
-    /// Reflectance at normal incidence.
-    pub f0: Vec3,
-}
-
-impl Fresnel for SchlickFresnel {
-    fn eval(&self, cos_theta: f32) -> Vec3 {
-        schlick(self.f0, cos_theta)
-    }
 }
