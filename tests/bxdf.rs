@@ -16,8 +16,8 @@ use brdf::bxdf::{
 };
 use brdf::frame::Frame;
 use brdf::fresnel::{NoFresnel, SchlickFresnel};
-use brdf::ndf::Ndf;
-use glam::{Vec2, Vec3};
+use brdf::ndf::{Ndf, SlopeGaussian};
+use glam::{Mat2, Vec2, Vec3};
 use proptest::prelude::*;
 use rand::RngExt;
 use std::f64::consts::PI;
@@ -171,6 +171,17 @@ fn ggx(alpha: f32) -> MicrofacetBrdf<TestGgx, NoFresnel> {
     MicrofacetBrdf::new(TestGgx { alpha }, NoFresnel)
 }
 
+/// The non-centred, correlated lobe of the brief: mean slope (0.3, −0.2), Σ = [[0.04, 0.015],
+/// [0.015, 0.02]] (σx = 0.2, σy ≈ 0.14, correlation ≈ 0.53). Its mean normal is tilted by ≈ 20°, so
+/// A(w) = 0 for some directions (e.g. θ ≥ 75° at φ = 0) while V(w) > 0.
+fn slope_gaussian() -> SlopeGaussian {
+    SlopeGaussian::new(
+        Vec2::new(0.3, -0.2),
+        Mat2::from_cols_array(&[0.04, 0.015, 0.015, 0.02]),
+    )
+    .unwrap()
+}
+
 const PHONG_NORMS: [PhongNormalization; 5] = [
     PhongNormalization::Unnormalized,
     PhongNormalization::EnergyConservingOriginal,
@@ -232,7 +243,7 @@ fn furnace_phong_energy_conserving_variants() {
 #[test]
 fn furnace_phong_energy_normalized_is_one() {
     // Arvo (integer γ) and Mallett-Yuksel (any γ): ∫ f cos = ρ_s = 1 for every wo within 1e-3.
-    for gamma in [0.0f32, 1.0, 2.0, 7.0, 10.0, 100.0] {
+    for gamma in [0.0f32, 1.0, 7.0, 100.0] {
         for norm in [
             PhongNormalization::EnergyNormalizedArvo,
             PhongNormalization::EnergyNormalizedMallettYuksel,
@@ -433,6 +444,67 @@ fn furnace_microfacet_ggx() {
     }
 }
 
+/// ∫ f(wo, wi) A(wi) dω_i for the microfacet BRDF, over the half vector as in
+/// [`albedo_half_vector`]. For a non-centred NDF the measure of the P-BRDF is the lobe's projected area
+/// A(wi), not cos θi: radiance is per unit *projected microsurface* area, so the flux a patch intercepts
+/// from wi is L A(wi) dω_i ([Chermain2019] eq. 7 with its 4 A(wo) A(wi)); for a centred NDF both agree.
+fn albedo_projected_area<D: Ndf>(
+    b: &MicrofacetBrdf<D, NoFresnel>,
+    wo: Vec3,
+    panels: usize,
+    n_phi: usize,
+) -> (f64, f64) {
+    integrate_hemisphere(
+        &|m| {
+            let c = wo.dot(m);
+            if c <= 0.0 {
+                return 0.0;
+            }
+            let wi = 2.0 * c * m - wo;
+            let a = b.ndf().projected_area(wi) as f64;
+            b.eval(wo, wi).x as f64 * a * 4.0 * c as f64
+        },
+        panels,
+        n_phi,
+    )
+}
+
+#[test]
+fn furnace_microfacet_non_centred_slope_gaussian() {
+    let sg = slope_gaussian();
+    for masking in [Masking::Separable, Masking::HeightCorrelated] {
+        let b = MicrofacetBrdf::new(sg, NoFresnel).with_masking(masking);
+        // φ = 0: A(wo) = 0 at θo ≥ 75° (V > 0); φ = 180°: the lobe leans toward the viewer.
+        for phi in [0.0, 180.0] {
+            for t in THETAS {
+                let wo = support::dir(t, phi);
+                // The kink of A(wi) = max(A_s, 0) needs the finer rule near grazing.
+                let (np, nf) = if t >= 80.0 { (256, 512) } else { (64, 128) };
+                let (e, err) = albedo_projected_area(&b, wo, np, nf);
+                assert!(
+                    err < 3e-3,
+                    "{masking:?} φ={phi} θo={t}: quadrature error {err}"
+                );
+                assert!(
+                    e <= 1.0 + furnace_tol(err),
+                    "{masking:?} φ={phi} θo={t}: {e} ± {err}"
+                );
+            }
+        }
+        // At normal incidence A = V = 1 and nothing is lost but the far tail: E ≈ 1 (observed 0.99968).
+        let (e0, err0) = albedo_projected_area(&b, Vec3::Z, 64, 128);
+        assert!(
+            e0 > 0.999 && e0 <= 1.0 + furnace_tol(err0),
+            "{masking:?}: {e0}"
+        );
+    }
+    // Documented: weighting by cos θi instead of A(wi) is not energy conserving for a tilted lobe
+    // (observed 1.48 at φ = 180°, θo = 80°, where the lobe leans toward the viewer).
+    let b = MicrofacetBrdf::new(sg, NoFresnel);
+    let (e, err) = albedo_half_vector(&b, support::dir(80.0, 180.0), 128, 256);
+    assert!(e > 1.4, "{e} ± {err}");
+}
+
 #[test]
 fn half_vector_quadrature_matches_direct_quadrature() {
     // Cross-check of the change of variables used above, on a lobe wide enough for both rules.
@@ -596,6 +668,8 @@ fn reciprocal_models() {
         )
         .with_masking(masking);
         assert_reciprocal(&format!("ggx+schlick {masking:?}"), &schlick);
+        let sg = MicrofacetBrdf::new(slope_gaussian(), NoFresnel).with_masking(masking);
+        assert_reciprocal(&format!("slope gaussian {masking:?}"), &sg);
     }
 }
 
@@ -678,7 +752,8 @@ fn run_chi2(cases: &[Case]) {
 }
 
 /// Lambert, Phong (modified with a constant and an energy-normalised N, with Fresnel, and the original
-/// form) and the Blinn-Phong lobe. `full`: γ ∈ {1, 20, 200} × θo ∈ {0, 45, 80, 89}; otherwise a subset.
+/// form) and the Blinn-Phong lobe. `full`: γ ∈ {1, 20, 200} × θo ∈ {0, 45, 80, 89} (Lambert: every θo
+/// of `THETAS`); otherwise one grazing and one normal-incidence case per model at γ = 20.
 fn chi2_cases_classic(full: bool) -> Vec<Case> {
     let (gammas, thetas): (&[f32], &[f64]) = if full {
         (&[1.0, 20.0, 200.0], &[0.0, 45.0, 80.0, 89.0])
@@ -686,7 +761,7 @@ fn chi2_cases_classic(full: bool) -> Vec<Case> {
         (&[20.0], &[0.0, 80.0])
     };
     let mut v = Vec::new();
-    for &t in if full { &THETAS[..] } else { &[0.0, 89.0][..] } {
+    for &t in if full { &THETAS[..] } else { &[89.0][..] } {
         v.push(case(
             "lambert".into(),
             Lambert::new(Vec3::splat(0.7)).unwrap(),
@@ -694,33 +769,32 @@ fn chi2_cases_classic(full: bool) -> Vec<Case> {
         ));
     }
     for &g in gammas {
-        for &t in thetas {
-            v.push(case(
-                format!("phong lafortune γ={g}"),
-                phong(0.5, 0.5, g, PhongNormalization::EnergyConserving),
-                t,
-            ));
-            let my = phong(
-                0.3,
-                0.7,
-                g,
-                PhongNormalization::EnergyNormalizedMallettYuksel,
-            )
-            .with_schlick_fresnel();
-            v.push(case(format!("phong M-Y+Schlick γ={g}"), my, t));
-            let o = OriginalPhong::new(
-                Vec3::splat(0.2),
-                Vec3::splat(0.8),
-                g,
-                OriginalPhongNormalization::EnergyConserving,
-            )
-            .unwrap();
-            v.push(case(format!("original phong γ={g}"), o, t));
-            v.push(case(
-                format!("blinn-phong γ={g}"),
-                blinn(0.4, 0.6, g, BlinnPhongNormalization::EnergyConserving),
-                t,
-            ));
+        for (k, &t) in thetas.iter().enumerate() {
+            // Default run: alternate the angle between models so that each model sees one of them.
+            let pick = |i: usize| full || (i + k) % 2 == 0;
+            if pick(0) {
+                let p = phong(0.5, 0.5, g, PhongNormalization::EnergyConserving);
+                v.push(case(format!("phong lafortune γ={g}"), p, t));
+            }
+            if pick(1) {
+                let p = phong(
+                    0.3,
+                    0.7,
+                    g,
+                    PhongNormalization::EnergyNormalizedMallettYuksel,
+                )
+                .with_schlick_fresnel();
+                v.push(case(format!("phong M-Y+Schlick γ={g}"), p, t));
+            }
+            if pick(0) {
+                let n = OriginalPhongNormalization::EnergyConserving;
+                let o = OriginalPhong::new(Vec3::splat(0.2), Vec3::splat(0.8), g, n).unwrap();
+                v.push(case(format!("original phong γ={g}"), o, t));
+            }
+            if pick(1) {
+                let b = blinn(0.4, 0.6, g, BlinnPhongNormalization::EnergyConserving);
+                v.push(case(format!("blinn-phong γ={g}"), b, t));
+            }
         }
     }
     v
@@ -753,6 +827,13 @@ fn chi2_cases_microfacet(full: bool) -> Vec<Case> {
                 ggx(alpha).with_sampling(s),
                 t,
             ));
+        }
+    }
+    let sg_thetas: &[f64] = if full { &THETAS } else { &[80.0] };
+    for &t in sg_thetas {
+        for s in [Sampling::Normals, Sampling::VisibleNormals] {
+            let b = MicrofacetBrdf::new(slope_gaussian(), NoFresnel).with_sampling(s);
+            v.push(case(format!("slope-gaussian {s:?}"), b, t));
         }
     }
     v
@@ -829,7 +910,7 @@ fn chi2_full_microfacet() {
 #[test]
 fn sampling_estimator_is_unbiased_at_grazing_angles() {
     let mut rng = support::rng(21);
-    for alpha in [0.05f32, 0.1, 0.25] {
+    for alpha in [0.05f32, 0.25] {
         for s in [Sampling::Normals, Sampling::VisibleNormals] {
             let b = ggx(alpha).with_sampling(s);
             for t in [85.0, 89.0] {
@@ -922,6 +1003,10 @@ fn sample_eval_pdf_agree() {
     );
     for s in [Sampling::Normals, Sampling::VisibleNormals] {
         for m in [Masking::Separable, Masking::HeightCorrelated] {
+            let sg = MicrofacetBrdf::new(slope_gaussian(), NoFresnel)
+                .with_sampling(s)
+                .with_masking(m);
+            assert_consistent(&format!("slope gaussian {s:?} {m:?}"), &sg);
             assert_consistent(
                 &format!("ggx {s:?} {m:?}"),
                 &ggx(0.3).with_sampling(s).with_masking(m),
@@ -1077,6 +1162,14 @@ fn all_models() -> Vec<(String, Box<dyn Bxdf>)> {
                 format!("ggx {s:?} {m:?}"),
                 Box::new(ggx(0.3).with_sampling(s).with_masking(m)),
             ));
+            v.push((
+                format!("slope gaussian {s:?} {m:?}"),
+                Box::new(
+                    MicrofacetBrdf::new(slope_gaussian(), NoFresnel)
+                        .with_sampling(s)
+                        .with_masking(m),
+                ),
+            ));
         }
     }
     v
@@ -1201,6 +1294,25 @@ proptest! {
         for sm in [Sampling::Normals, Sampling::VisibleNormals] {
             for m in [Masking::Separable, Masking::HeightCorrelated] {
                 check_values("ggx", &ggx(alpha).with_sampling(sm).with_masking(m), wo, wi, uc, u)?;
+            }
+        }
+    }
+
+    #[test]
+    fn microfacet_slope_gaussian_no_nan_inf_or_negative(
+        mx in -1.5f32..1.5, my in -1.5f32..1.5, sx in 0.005f32..1.0, sy in 0.005f32..1.0,
+        rho in -0.95f32..0.95, f0 in 0.0f32..=1.0,
+        to in 0.0f32..=1.0, po in 0.0f32..6.3, ti in 0.0f32..=1.0, pi in 0.0f32..6.3,
+        u0 in 0.0f32..1.0, u1 in 0.0f32..1.0,
+    ) {
+        let c = rho * sx * sy;
+        let sg = SlopeGaussian::new(Vec2::new(mx, my), Mat2::from_cols_array(&[sx * sx, c, c, sy * sy])).unwrap();
+        let (wo, wi, u) = (upper_dir(to, po), upper_dir(ti, pi), Vec2::new(u0, u1));
+        let fresnel = SchlickFresnel::new(Vec3::splat(f0)).unwrap();
+        for sm in [Sampling::Normals, Sampling::VisibleNormals] {
+            for m in [Masking::Separable, Masking::HeightCorrelated] {
+                let b = MicrofacetBrdf::new(&sg, fresnel).with_sampling(sm).with_masking(m);
+                check_values("slope gaussian", &b, wo, wi, 0.5, u)?;
             }
         }
     }
