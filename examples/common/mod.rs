@@ -5,6 +5,8 @@
 //! `examples/<name>.rs` mains and the `gallery` run the same code.
 #![allow(dead_code)]
 
+pub mod lobes;
+
 use plotters::prelude::*;
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -83,7 +85,11 @@ pub fn colormap(t: f32) -> [u8; 3] {
         [0.369, 0.789, 0.383],
         [0.993, 0.906, 0.144],
     ];
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 } * 4.0;
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    } * 4.0;
     let i = (t as usize).min(3);
     let f = t - i as f32;
     let mut out = [0u8; 3];
@@ -235,12 +241,9 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
                         .filter(|p| keep(p.0, chart.x_scale) && keep(p.1, chart.y_scale))
                         .collect();
                     if chart.scatter {
-                        ctx.draw_series(
-                            pts.iter()
-                                .map(|&p| Circle::new(p, 4, color.filled())),
-                        )?
-                        .label(s.label.clone())
-                        .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
+                        ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))?
+                            .label(s.label.clone())
+                            .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
                     } else {
                         ctx.draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?
                             .label(s.label.clone())
@@ -274,9 +277,9 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
             (Scale::Linear, Scale::Log) => {
                 draw!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?)
             }
-            (Scale::Log, Scale::Log) => draw!(
-                builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?
-            ),
+            (Scale::Log, Scale::Log) => {
+                draw!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?)
+            }
         }
         root.present()?;
     }
