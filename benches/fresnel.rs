@@ -55,7 +55,8 @@ fn warps(c: &mut Criterion) {
     let (_, u, w) = inputs();
     let mut g = c.benchmark_group("warp");
     g.throughput(Throughput::Elements(N as u64));
-    let forward: [(&str, fn(Vec2) -> Vec3); 3] = [
+    type Forward = (&'static str, fn(Vec2) -> Vec3);
+    let forward: [Forward; 3] = [
         ("cosine", square_to_cosine_hemisphere),
         ("uniform", square_to_uniform_hemisphere),
         ("equal_area", square_to_hemisphere_equal_area),
@@ -65,7 +66,8 @@ fn warps(c: &mut Criterion) {
             b.iter(|| u.iter().map(|&u| f(black_box(u))).sum::<Vec3>())
         });
     }
-    let inverse: [(&str, fn(Vec3) -> Vec2); 3] = [
+    type Inverse = (&'static str, fn(Vec3) -> Vec2);
+    let inverse: [Inverse; 3] = [
         ("cosine", cosine_hemisphere_to_square),
         ("uniform", uniform_hemisphere_to_square),
         ("equal_area", hemisphere_to_square_equal_area),
