@@ -25,6 +25,7 @@
 pub mod bxdf;
 mod error;
 pub mod frame;
+mod math;
 pub mod ndf;
 
 pub use error::{Error, Result};

@@ -3,6 +3,12 @@
 //! Frame: local shading frame, z = geometric normal; `w`, `wo`, `m` are unit vectors pointing away from
 //! the surface. Every NDF is normalised so that ∫ D(m) (m·ω_g) dm = 1 over the hemisphere.
 
+mod beckmann;
+mod ggx;
+
+pub use beckmann::{Beckmann, MIN_ALPHA};
+pub use ggx::Ggx;
+
 use glam::{Vec2, Vec3};
 
 /// A microfacet normal distribution with its Smith masking function and samplers.
@@ -65,7 +71,11 @@ pub trait Ndf {
             return 0.0;
         }
         let g = 1.0 / (1.0 + self.lambda(wo) + self.lambda(wi));
-        if g.is_finite() { g.clamp(0.0, 1.0) } else { 0.0 }
+        if g.is_finite() {
+            g.clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
     }
 
     /// Draws a micronormal m with density D(m) cos θ_m (per unit solid angle), from `u` ∈ [0, 1)².
