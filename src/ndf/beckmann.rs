@@ -27,7 +27,7 @@ pub const MIN_ALPHA: f32 = 1e-4;
 /// α_x acts along the tangent x; α = √2 σ with σ the RMS slope per axis.
 ///
 /// # Reference
-/// [Walter2007] eq. 25 (isotropic D and Λ), [Heitz2014] §5.3 (anisotropic form, α(φ)),
+/// [Walter2007] §5.1 (isotropic D and Λ), [Heitz2014] (anisotropic form through α(φ)),
 /// [Heitz2014b] and [Jakob2014] (visible-normal sampling).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Beckmann {
@@ -92,7 +92,7 @@ impl Beckmann {
 /// Returns a finite value for every a > 0 (Λ ≈ 1/(2a√π) → capped at `f32::MAX` as a → 0).
 ///
 /// # Reference
-/// [Walter2007] eq. 27 (Λ), [Heitz2014] eq. 85; the continued fraction is [Abramowitz1964] 7.1.14.
+/// [Walter2007] §5.1 (Beckmann G1), [Heitz2014] (Λ of the Beckmann distribution); the continued fraction is [Abramowitz1964] 7.1.14.
 #[inline]
 fn lambda_of_a(a: f32) -> f32 {
     if !(a > 0.0) {

@@ -20,7 +20,7 @@ use std::f32::consts::PI;
 /// stays ≤ 3.2·10⁷).
 ///
 /// # Reference
-/// [Walter2007] eq. 33–34 (isotropic), [Heitz2014] §5.2 (anisotropic D, Λ), [Heitz2018] (visible
+/// [Walter2007] §5.2 (isotropic D, Λ), [Heitz2014] (anisotropic D and Λ), [Heitz2018] (visible
 /// normals).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ggx {

@@ -5,9 +5,15 @@
 
 mod beckmann;
 mod ggx;
+mod masking;
+mod phong_integral;
 
 pub use beckmann::{Beckmann, MIN_ALPHA};
 pub use ggx::Ggx;
+pub use masking::{
+    g1_vcavity, g2_height_correlated_from_lambda, g2_separable_from_lambda, g2_vcavity,
+};
+pub use phong_integral::{phong_lobe_integral, phong_lobe_integral_arvo};
 
 use glam::{Vec2, Vec3};
 
