@@ -30,3 +30,4 @@ pub mod ndf;
 
 pub use error::{Error, Result};
 pub use glam::{Vec2, Vec3};
+pub use ndf::{Beckmann, BlinnPhong, Ggx, Ndf};

@@ -6,8 +6,6 @@
 //! functions over a dense grid. No `mul_add`: without `target-cpu` flags it becomes a slow software
 //! call, so every polynomial is a plain Horner scheme.
 
-/// √π.
-pub(crate) const SQRT_PI: f32 = 1.772_453_9;
 /// 1/√π.
 pub(crate) const INV_SQRT_PI: f32 = 0.564_189_6;
 

@@ -9,7 +9,7 @@ use super::Ndf;
 use crate::Result;
 use crate::error::positive;
 use crate::frame::slope_to_normal;
-use crate::math::{INV_SQRT_PI, SQRT_PI, erf, erfc, erfinv, exp_neg_sq};
+use crate::math::{INV_SQRT_PI, erf, erfc, erfinv, exp_neg_sq};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -20,6 +20,45 @@ use std::f32::consts::PI;
 /// while a lobe of width 10⁻⁴ rad is already narrower than anything a renderer resolves (use a mirror
 /// below that). The accuracy tests cover α ∈ [10⁻⁴, 10].
 pub const MIN_ALPHA: f32 = 1e-4;
+
+/// α = r²: the perceptual roughness r ∈ [0, 1] of Burley's parameterisation mapped to α.
+///
+/// Squaring makes equal steps of r look roughly equally spaced. Non-finite r gives 0 (which the
+/// NDF constructors then reject, naming `alpha`).
+///
+/// # Reference
+/// [Burley2012] §5.4 (α = roughness²).
+pub fn alpha_from_roughness(r: f32) -> f32 {
+    if r.is_finite() { r * r } else { 0.0 }
+}
+
+/// Beckmann α equivalent to a Phong / Blinn-Phong exponent γ: α = √(2/(γ + 2)).
+///
+/// The two NDFs then have the same second moment of the slope near the peak (Walter's mapping
+/// γ = 2/α² − 2, inverted). γ = 0 gives α = 1. Negative or NaN γ is treated as 0; γ = +∞ gives 0.
+///
+/// # Reference
+/// [Walter2007] §5.2.
+pub fn beckmann_alpha_from_shininess(gamma: f32) -> f32 {
+    let g = if gamma > 0.0 { gamma } else { 0.0 };
+    (2.0 / (g + 2.0)).sqrt()
+}
+
+/// Phong / Blinn-Phong exponent equivalent to a Beckmann α: γ = 2/α² − 2, the inverse of
+/// [`beckmann_alpha_from_shininess`].
+///
+/// Clamped to [0, `f32::MAX`]: |α| ≥ 1 gives 0 (Blinn-Phong cannot be rougher than uniform),
+/// α = 0 gives `f32::MAX`, NaN gives 0.
+///
+/// # Reference
+/// [Walter2007] §5.2.
+pub fn shininess_from_beckmann_alpha(alpha: f32) -> f32 {
+    if alpha.is_nan() {
+        return 0.0;
+    }
+    let g = 2.0 / (alpha * alpha) - 2.0;
+    if g.is_finite() { g.max(0.0) } else { f32::MAX }
+}
 
 /// The anisotropic Beckmann distribution.
 ///
@@ -207,6 +246,18 @@ fn sample_visible_slope_std(cot_theta: f32, tan_theta: f32, theta: f32, u: Vec2)
     Vec2::new(x, erfinv(2.0 * u.y.clamp(0.0, 1.0) - 1.0))
 }
 
+/// Nudges a sampled normal that rounding left exactly on (or behind) the visibility boundary
+/// m·wo = 0 toward wo by 10⁻⁶ rad, so that its pdf is positive. Affects only draws whose u lies
+/// within ~10⁻⁶ of the end of the CDF.
+#[inline]
+pub(super) fn keep_visible(m: Vec3, wo: Vec3) -> Vec3 {
+    if m.dot(wo) > 0.0 {
+        m
+    } else {
+        (m + 1e-6 * wo).try_normalize().unwrap_or(Vec3::Z)
+    }
+}
+
 impl Ndf for Beckmann {
     /// D(m) = exp(−((x/α_x)² + (y/α_y)²)/z²) / (π α_x α_y z⁴); 0 for z ≤ 0 or non-finite m
     /// (and where the numerator underflows, within ~10⁻¹¹ of the horizon).
@@ -249,13 +300,18 @@ impl Ndf for Beckmann {
     /// G1(w, m) = χ⁺(w·m) / (1 + Λ(w)).
     #[inline]
     fn g1(&self, w: Vec3, m: Vec3) -> f32 {
-        if !(w.dot(m) > 0.0) {
+        if !(w.dot(m) > 0.0 && m.is_finite()) {
             return 0.0;
         }
         match self.a_of(w) {
             Some(a) => 1.0 / (1.0 + lambda_of_a(a)),
             None => 0.0,
         }
+    }
+
+    /// Height-correlated G2 = χ⁺(wo·m) χ⁺(wi·m) / (1 + Λ(wo) + Λ(wi)); 0 for degenerate input.
+    fn g2_height_correlated(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
+        super::masking::g2_height_correlated_checked(self, wo, wi, m)
     }
 
     /// m ~ D(m) cos θ_m by exact inversion: the slopes are Gaussian, drawn by Box–Muller
@@ -288,7 +344,7 @@ impl Ndf for Beckmann {
             self.alpha_x * rotated.x,
             self.alpha_y * rotated.y,
         ));
-        m
+        keep_visible(m, wo)
     }
 }
 

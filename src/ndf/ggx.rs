@@ -105,7 +105,7 @@ impl Ndf for Ggx {
     /// G1(w, m) = χ⁺(w·m) / (1 + Λ(w)) = χ⁺(w·m) 2z / (z + √(z² + n²)).
     #[inline]
     fn g1(&self, w: Vec3, m: Vec3) -> f32 {
-        if !(w.dot(m) > 0.0) {
+        if !(w.dot(m) > 0.0 && m.is_finite()) {
             return 0.0;
         }
         match self.stretched_sin(w) {
@@ -115,6 +115,11 @@ impl Ndf for Ggx {
             }
             None => 0.0,
         }
+    }
+
+    /// Height-correlated G2 = χ⁺(wo·m) χ⁺(wi·m) / (1 + Λ(wo) + Λ(wi)); 0 for degenerate input.
+    fn g2_height_correlated(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
+        super::masking::g2_height_correlated_checked(self, wo, wi, m)
     }
 
     /// m ~ D(m) cos θ_m by exact inversion: the standard radial slope has CDF r²/(1 + r²), so
@@ -168,8 +173,9 @@ impl Ndf for Ggx {
         let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * (r * sp);
         let lift = (1.0 - p1 * p1 - p2 * p2).max(1e-14).sqrt();
         let nh = p1 * t1 + p2 * t2 + lift * vh;
-        Vec3::new(self.alpha_x * nh.x, self.alpha_y * nh.y, nh.z.max(1e-30))
+        let m = Vec3::new(self.alpha_x * nh.x, self.alpha_y * nh.y, nh.z.max(1e-30))
             .try_normalize()
-            .unwrap_or(Vec3::Z)
+            .unwrap_or(Vec3::Z);
+        super::beckmann::keep_visible(m, wo)
     }
 }

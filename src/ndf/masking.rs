@@ -56,6 +56,22 @@ pub fn g2_height_correlated_from_lambda(lambda_o: f32, lambda_i: f32) -> f32 {
     1.0 / (1.0 + lo + li)
 }
 
+/// [`Ndf::g2_height_correlated`](super::Ndf::g2_height_correlated) with the finiteness checks the
+/// trait default lacks: χ⁺(wo·m) χ⁺(wi·m) / (1 + Λ(wo) + Λ(wi)), 0 for degenerate input.
+#[inline]
+pub(super) fn g2_height_correlated_checked<N: super::Ndf + ?Sized>(
+    ndf: &N,
+    wo: Vec3,
+    wi: Vec3,
+    m: Vec3,
+) -> f32 {
+    let ok = wo.is_finite() && wi.is_finite() && m.is_finite();
+    if !(ok && wo.z > 0.0 && wi.z > 0.0 && wo.dot(m) > 0.0 && wi.dot(m) > 0.0) {
+        return 0.0;
+    }
+    g2_height_correlated_from_lambda(ndf.lambda(wo), ndf.lambda(wi))
+}
+
 /// Separable (uncorrelated) Smith masking-shadowing from the two Λ values:
 /// 1 / ((1 + Λ(wo)) (1 + Λ(wi))). Same conventions as [`g2_height_correlated_from_lambda`].
 ///
