@@ -29,10 +29,11 @@ pub mod bxdf;
 mod error;
 pub mod frame;
 pub mod fresnel;
+mod math;
 pub mod ndf;
 pub mod warp;
 
 pub use error::{Error, Result};
 pub use fresnel::Fresnel;
 pub use glam::{Vec2, Vec3};
-pub use ndf::SlopeGaussian;
+pub use ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
