@@ -16,7 +16,7 @@ use brdf::bxdf::{
 };
 use brdf::frame::Frame;
 use brdf::fresnel::{NoFresnel, SchlickFresnel};
-use brdf::ndf::{Ndf, SlopeGaussian};
+use brdf::ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
 use proptest::prelude::*;
 use rand::RngExt;
@@ -180,6 +180,43 @@ fn slope_gaussian() -> SlopeGaussian {
         Mat2::from_cols_array(&[0.04, 0.015, 0.015, 0.02]),
     )
     .unwrap()
+}
+
+/// A boxed microfacet BRDF (F = 1) with the given options.
+fn mf<D: Ndf + 'static>(ndf: D, masking: Masking, sampling: Sampling) -> Box<dyn Bxdf> {
+    Box::new(
+        MicrofacetBrdf::new(ndf, NoFresnel)
+            .with_masking(masking)
+            .with_sampling(sampling),
+    )
+}
+
+/// The crate's centred NDFs through [`MicrofacetBrdf`]: Beckmann (Cook-Torrance) and GGX, isotropic α
+/// and anisotropic (αx, αy) = (α, 2.5α).
+fn crate_microfacets(
+    alpha: f32,
+    masking: Masking,
+    sampling: Sampling,
+) -> Vec<(String, Box<dyn Bxdf>)> {
+    let a2 = 2.5 * alpha;
+    vec![
+        (
+            format!("beckmann α={alpha}"),
+            mf(Beckmann::isotropic(alpha).unwrap(), masking, sampling),
+        ),
+        (
+            format!("ggx α={alpha}"),
+            mf(Ggx::isotropic(alpha).unwrap(), masking, sampling),
+        ),
+        (
+            format!("beckmann α=({alpha}, {a2})"),
+            mf(Beckmann::new(alpha, a2).unwrap(), masking, sampling),
+        ),
+        (
+            format!("ggx α=({alpha}, {a2})"),
+            mf(Ggx::new(alpha, a2).unwrap(), masking, sampling),
+        ),
+    ]
 }
 
 const PHONG_NORMS: [PhongNormalization; 5] = [
@@ -506,6 +543,133 @@ fn furnace_microfacet_non_centred_slope_gaussian() {
 }
 
 #[test]
+fn furnace_microfacet_crate_ndfs() {
+    for alpha in [0.1f32, 0.5, 1.0] {
+        for masking in [Masking::Separable, Masking::HeightCorrelated] {
+            for (name, b) in crate_microfacets(alpha, masking, Sampling::VisibleNormals) {
+                for t in THETAS {
+                    // Anisotropic lobes are checked across and along the stretched axis. The kink of
+                    // the horizon cut at 89° leaves an error estimate up to ~1e-4 (0.01 % of E).
+                    for phi in [0.0, 90.0] {
+                        let (e, err) = albedo_half_vector(
+                            b.as_ref(),
+                            support::dir(t, phi),
+                            res(t).0,
+                            res(t).1,
+                        );
+                        assert!(
+                            err < 5e-4,
+                            "{name} {masking:?} θo={t} φ={phi}: quadrature error {err}"
+                        );
+                        assert!(
+                            e <= 1.0 + furnace_tol(err),
+                            "{name} {masking:?} θo={t} φ={phi}: {e} ± {err}"
+                        );
+                        if !name.contains('(') {
+                            break; // isotropic: φ does not matter
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // The Blinn-Phong NDF D = (γ+2)/(2π) cos^γ θm through the same BRDF.
+    for gamma in [10.0f32, 100.0] {
+        let b = MicrofacetBrdf::new(BlinnPhong::new(gamma).unwrap(), NoFresnel);
+        for t in THETAS {
+            let (e, err) = albedo_half_vector(&b, support::dir(t, 0.0), res(t).0, res(t).1);
+            assert!(
+                err < 1e-4 && e <= 1.0 + furnace_tol(err),
+                "blinn-phong ndf γ={gamma} θo={t}: {e} ± {err}"
+            );
+        }
+    }
+}
+
+#[test]
+fn crate_ndfs_agree_with_independent_implementations() {
+    // Ggx vs the textbook TestGgx above; Beckmann vs SlopeGaussian::beckmann (a different
+    // implementation of the same lobe, through its slope density). Both sides are f32 evaluations of
+    // steep functions of h (D varies by a factor ~e per α of tilt): 2e-4 relative covers the rounding
+    // of h (a few 1e-8) amplified by d ln D/dθ ≲ 2 tan θ / α² (observed ≤ 1.2e-4 for TestGgx at α = 0.1).
+    let mut rng = support::rng(31);
+    for alpha in [0.1f32, 0.4, 1.0] {
+        for masking in [Masking::Separable, Masking::HeightCorrelated] {
+            let pairs: [(&str, Box<dyn Bxdf>, Box<dyn Bxdf>); 2] = [
+                (
+                    "ggx",
+                    mf(
+                        Ggx::isotropic(alpha).unwrap(),
+                        masking,
+                        Sampling::VisibleNormals,
+                    ),
+                    mf(TestGgx { alpha }, masking, Sampling::VisibleNormals),
+                ),
+                (
+                    "beckmann",
+                    mf(
+                        Beckmann::isotropic(alpha).unwrap(),
+                        masking,
+                        Sampling::VisibleNormals,
+                    ),
+                    mf(
+                        SlopeGaussian::beckmann(alpha, alpha).unwrap(),
+                        masking,
+                        Sampling::VisibleNormals,
+                    ),
+                ),
+            ];
+            for (name, a, b) in &pairs {
+                for _ in 0..2000 {
+                    let (wo, wi) = (random_upper(&mut rng), random_upper(&mut rng));
+                    let (fa, fb) = (a.eval(wo, wi).x, b.eval(wo, wi).x);
+                    assert!(
+                        (fa - fb).abs() <= 2e-4 * fa.max(fb) + 1e-30,
+                        "{name} α={alpha} {masking:?} {wo} {wi}: {fa} vs {fb}"
+                    );
+                    let (pa, pb) = (a.pdf(wo, wi), b.pdf(wo, wi));
+                    assert!(
+                        (pa - pb).abs() <= 2e-4 * pa.max(pb) + 1e-30,
+                        "{name} α={alpha} pdf {wo} {wi}: {pa} vs {pb}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The lobe's peak in the plane of incidence: Phong peaks exactly at the mirror direction; the
+/// microfacet BRDF f (without cosine) peaks beyond it, toward grazing, at grazing incidence
+/// (the off-specular peak of Torrance-Sparrow, from D(h) G2 / cos θi), and f·cos θi peaks before it.
+#[test]
+fn off_specular_peaks() {
+    let argmax = |g: &dyn Fn(Vec3) -> f32| -> f64 {
+        // θi ∈ [0°, 90°) on the mirror side (φ = 180°) in steps of 0.01°.
+        (0..9000)
+            .map(|k| k as f64 * 0.01)
+            .max_by(|&a, &b| g(support::dir(a, 180.0)).total_cmp(&g(support::dir(b, 180.0))))
+            .unwrap()
+    };
+    let wo = support::dir(75.0, 0.0);
+    let p = phong(0.0, 1.0, 50.0, PhongNormalization::EnergyConserving);
+    // f32 plateau of cos^50 near its maximum: ties within ±0.05° of the exact peak.
+    let peak = argmax(&|wi| p.eval(wo, wi).x);
+    assert!((peak - 75.0).abs() <= 0.05, "phong peaks at {peak}°");
+    for alpha in [0.2f32, 0.4] {
+        for (name, b) in
+            crate_microfacets(alpha, Masking::HeightCorrelated, Sampling::VisibleNormals)
+                .into_iter()
+                .take(2)
+        {
+            let peak_f = argmax(&|wi| b.eval(wo, wi).x);
+            let peak_fcos = argmax(&|wi| b.eval(wo, wi).x * wi.z);
+            assert!(peak_f > 76.0, "{name}: f peaks at {peak_f}°");
+            assert!(peak_fcos < 75.0, "{name}: f cos peaks at {peak_fcos}°");
+        }
+    }
+}
+
+#[test]
 fn half_vector_quadrature_matches_direct_quadrature() {
     // Cross-check of the change of variables used above, on a lobe wide enough for both rules.
     let b = ggx(0.5);
@@ -670,6 +834,12 @@ fn reciprocal_models() {
         assert_reciprocal(&format!("ggx+schlick {masking:?}"), &schlick);
         let sg = MicrofacetBrdf::new(slope_gaussian(), NoFresnel).with_masking(masking);
         assert_reciprocal(&format!("slope gaussian {masking:?}"), &sg);
+        for (name, b) in crate_microfacets(0.3, masking, Sampling::VisibleNormals) {
+            assert_reciprocal(&format!("{name} {masking:?}"), b.as_ref());
+        }
+        let bp =
+            MicrofacetBrdf::new(BlinnPhong::new(30.0).unwrap(), NoFresnel).with_masking(masking);
+        assert_reciprocal(&format!("blinn-phong ndf {masking:?}"), &bp);
     }
 }
 
@@ -813,29 +983,64 @@ fn chi2_cases_classic(full: bool) -> Vec<Case> {
 /// `lost_mass_matches_the_pdf_deficit` and `sampling_estimator_is_unbiased_at_grazing_angles`
 /// ([`grazing_cases`]). The non-centred lobe (slope σ ≈ 0.2) is excluded at 89° for the same reason.
 fn chi2_cases_microfacet(full: bool) -> Vec<Case> {
-    let configs: Vec<(f32, f64)> = if full {
-        [0.1f32, 0.25, 0.5, 1.0]
-            .iter()
-            .flat_map(|&a| THETAS.iter().map(move |&t| (a, t)))
-            .filter(|&(a, t)| !(a < 0.5 && t > 85.0))
-            .collect()
-    } else {
-        vec![(0.5, 0.0), (0.5, 89.0), (0.1, 60.0)]
-    };
     let mut v = Vec::new();
-    for (alpha, t) in configs {
-        for s in [Sampling::Normals, Sampling::VisibleNormals] {
+    let samplings = [Sampling::Normals, Sampling::VisibleNormals];
+    if full {
+        for alpha in [0.1f32, 0.25, 0.5, 1.0] {
+            for &t in THETAS.iter().filter(|&&t| alpha >= 0.5 || t < 85.0) {
+                for s in samplings {
+                    v.push(case(
+                        format!("test-ggx α={alpha} {s:?}"),
+                        ggx(alpha).with_sampling(s),
+                        t,
+                    ));
+                    for (name, b) in crate_microfacets(alpha, Masking::HeightCorrelated, s) {
+                        // Anisotropic (α, 2.5α): the narrow axis is α, same exclusion rule.
+                        v.push(Case {
+                            name: format!("{name} {s:?} θo={t}"),
+                            bxdf: b,
+                            wo: support::dir(t, 30.0),
+                        });
+                    }
+                }
+            }
+        }
+        for gamma in [10.0f32, 100.0] {
+            for &t in THETAS.iter().filter(|&&t| gamma <= 10.0 || t < 85.0) {
+                for s in samplings {
+                    let b = MicrofacetBrdf::new(BlinnPhong::new(gamma).unwrap(), NoFresnel)
+                        .with_sampling(s);
+                    v.push(case(format!("blinn-phong ndf γ={gamma} {s:?}"), b, t));
+                }
+            }
+        }
+    } else {
+        for s in samplings {
             v.push(case(
-                format!("test-ggx α={alpha} {s:?}"),
-                ggx(alpha).with_sampling(s),
-                t,
+                format!("test-ggx α=0.5 {s:?}"),
+                ggx(0.5).with_sampling(s),
+                89.0,
+            ));
+            let beckmann = Beckmann::isotropic(0.1).unwrap();
+            v.push(case(
+                format!("beckmann α=0.1 {s:?}"),
+                MicrofacetBrdf::new(beckmann, NoFresnel).with_sampling(s),
+                60.0,
             ));
         }
+        let aniso = Ggx::new(0.2, 0.5).unwrap();
+        v.push(case(
+            "ggx α=(0.2, 0.5) VisibleNormals".into(),
+            MicrofacetBrdf::new(aniso, NoFresnel),
+            30.0,
+        ));
+        let bp = MicrofacetBrdf::new(BlinnPhong::new(20.0).unwrap(), NoFresnel);
+        v.push(case("blinn-phong ndf γ=20 VisibleNormals".into(), bp, 0.0));
     }
     // θo = 89° excluded for the same reason as narrow GGX (σ ≈ 0.2 ≈ α 0.28), see `grazing_cases`.
     let sg_thetas: &[f64] = if full { &THETAS[..4] } else { &[80.0] };
     for &t in sg_thetas {
-        for s in [Sampling::Normals, Sampling::VisibleNormals] {
+        for s in samplings {
             let b = MicrofacetBrdf::new(slope_gaussian(), NoFresnel).with_sampling(s);
             v.push(case(format!("slope-gaussian {s:?}"), b, t));
         }
@@ -1036,6 +1241,11 @@ fn sample_eval_pdf_agree() {
                 .with_sampling(s)
                 .with_masking(m);
             assert_consistent(&format!("slope gaussian {s:?} {m:?}"), &sg);
+            for (name, b) in crate_microfacets(0.3, m, s) {
+                assert_consistent(&format!("{name} {s:?} {m:?}"), b.as_ref());
+            }
+            let bp = mf(BlinnPhong::new(40.0).unwrap(), m, s);
+            assert_consistent(&format!("blinn-phong ndf {s:?} {m:?}"), bp.as_ref());
             assert_consistent(
                 &format!("ggx {s:?} {m:?}"),
                 &ggx(0.3).with_sampling(s).with_masking(m),
@@ -1201,6 +1411,17 @@ fn all_models() -> Vec<(String, Box<dyn Bxdf>)> {
             ));
         }
     }
+    for (name, b) in crate_microfacets(0.3, Masking::HeightCorrelated, Sampling::VisibleNormals) {
+        v.push((name, b));
+    }
+    v.push((
+        "blinn-phong ndf".into(),
+        mf(
+            BlinnPhong::new(40.0).unwrap(),
+            Masking::HeightCorrelated,
+            Sampling::VisibleNormals,
+        ),
+    ));
     v
 }
 
@@ -1342,6 +1563,22 @@ proptest! {
             for m in [Masking::Separable, Masking::HeightCorrelated] {
                 let b = MicrofacetBrdf::new(&sg, fresnel).with_sampling(sm).with_masking(m);
                 check_values("slope gaussian", &b, wo, wi, 0.5, u)?;
+            }
+        }
+    }
+
+    #[test]
+    fn microfacet_crate_ndfs_no_nan_inf_or_negative(
+        ax in 1e-3f32..2.0, ay in 1e-3f32..2.0, gamma in 0.0f32..1e4,
+        to in 0.0f32..=1.0, po in 0.0f32..6.3, ti in 0.0f32..=1.0, pi in 0.0f32..6.3,
+        u0 in 0.0f32..1.0, u1 in 0.0f32..1.0,
+    ) {
+        let (wo, wi, u) = (upper_dir(to, po), upper_dir(ti, pi), Vec2::new(u0, u1));
+        for sm in [Sampling::Normals, Sampling::VisibleNormals] {
+            for m in [Masking::Separable, Masking::HeightCorrelated] {
+                check_values("beckmann", mf(Beckmann::new(ax, ay).unwrap(), m, sm).as_ref(), wo, wi, 0.5, u)?;
+                check_values("ggx", mf(Ggx::new(ax, ay).unwrap(), m, sm).as_ref(), wo, wi, 0.5, u)?;
+                check_values("blinn-phong ndf", mf(BlinnPhong::new(gamma).unwrap(), m, sm).as_ref(), wo, wi, 0.5, u)?;
             }
         }
     }

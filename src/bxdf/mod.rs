@@ -10,7 +10,6 @@ mod lambert;
 mod lobe;
 mod microfacet;
 mod phong;
-mod shim;
 
 pub use blinn_phong::{BlinnPhongLobe, BlinnPhongNormalization};
 pub use lambert::Lambert;

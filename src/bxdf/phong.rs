@@ -13,11 +13,11 @@
 
 use super::lambert::unit_rgb;
 use super::lobe::{cosine_power, pdf_cosine_power, sample_cosine_power_about};
-use super::shim::{phong_lobe_integral, phong_lobe_integral_arvo};
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::{Error, Result, non_negative};
 use crate::frame::is_upper;
 use crate::fresnel::schlick;
+use crate::ndf::{phong_lobe_integral, phong_lobe_integral_arvo};
 use crate::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, TAU};

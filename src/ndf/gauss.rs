@@ -345,7 +345,11 @@ const STEP_TOL: f64 = 1e-9;
 fn halley_step(f: f64, df: f64, ddf: f64) -> f64 {
     let newton = f / df;
     let q = newton * ddf / (2.0 * df);
-    if q.abs() < 0.5 { newton / (1.0 - q) } else { newton }
+    if q.abs() < 0.5 {
+        newton / (1.0 - q)
+    } else {
+        newton
+    }
 }
 
 /// 2π, for the Box–Muller angle.
