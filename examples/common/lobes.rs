@@ -4,7 +4,7 @@
 //! Polar plots: wo = (sin θo, 0, cos θo) for θo ∈ {0, 30, 60, 80}°; wi = (sin t, 0, cos t) for
 //! t ∈ (−90°, 90°), drawn as the points r (sin t, cos t) with r = f(wo, wi)·cos θi (channel 0). Each
 //! series starts with a line from the origin toward wo (same colour) so the mirror direction can be
-//! read off; the x and z axes have the same scale (chart 900 × 500 for a range [−R, R] × [0, R]).
+//! read off; the x and z axes have (nearly) the same scale (chart 900 × 480 for a range [−R, R] × [0, R]).
 //!
 //! Hemisphere images: four panels (θo = 0, 30, 60, 80°, left to right); pixel (x, y) of the unit
 //! disk ↔ wi = (x, y, √(1 − x² − y²)), +x to the right (toward wo), +y up; linear colour scale from 0
@@ -17,7 +17,7 @@ use brdf::bxdf::{
     OriginalPhongNormalization, Phong, PhongNormalization,
 };
 use brdf::fresnel::NoFresnel;
-use brdf::ndf::SlopeGaussian;
+use brdf::ndf::{Beckmann, BlinnPhong, Ggx, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
 use std::path::Path;
 
@@ -42,7 +42,6 @@ fn model(stem: &'static str, title: impl Into<String>, bxdf: impl Bxdf + 'static
 /// The models and parameters shown (ρ_d = 0, ρ_s = 1 where the model has both, F = 1).
 fn models() -> Res<Vec<Model>> {
     let (z, one) = (Vec3::ZERO, Vec3::ONE);
-    let beckmann = |a: f32| SlopeGaussian::beckmann(a, a);
     let tilted = SlopeGaussian::new(
         Vec2::new(0.3, -0.2),
         Mat2::from_cols_array(&[0.04, 0.015, 0.015, 0.02]),
@@ -82,12 +81,27 @@ fn models() -> Res<Vec<Model>> {
         model(
             "cook_torrance_beckmann_a0.2",
             "Cook-Torrance (Beckmann α = 0.2, F = 1)",
-            MicrofacetBrdf::new(beckmann(0.2)?, NoFresnel),
+            MicrofacetBrdf::new(Beckmann::isotropic(0.2)?, NoFresnel),
         ),
         model(
             "cook_torrance_beckmann_a0.5",
             "Cook-Torrance (Beckmann α = 0.5, F = 1)",
-            MicrofacetBrdf::new(beckmann(0.5)?, NoFresnel),
+            MicrofacetBrdf::new(Beckmann::isotropic(0.5)?, NoFresnel),
+        ),
+        model(
+            "microfacet_ggx_a0.2",
+            "Torrance-Sparrow with GGX α = 0.2, F = 1",
+            MicrofacetBrdf::new(Ggx::isotropic(0.2)?, NoFresnel),
+        ),
+        model(
+            "microfacet_ggx_a0.5",
+            "Torrance-Sparrow with GGX α = 0.5, F = 1",
+            MicrofacetBrdf::new(Ggx::isotropic(0.5)?, NoFresnel),
+        ),
+        model(
+            "microfacet_blinn_phong_g48",
+            "Microfacet with the Blinn-Phong NDF, γ = 48 (≈ Beckmann α = 0.2)",
+            MicrofacetBrdf::new(BlinnPhong::new(48.0)?, NoFresnel),
         ),
         model(
             "microfacet_slope_gaussian",
@@ -150,7 +164,7 @@ fn polar_plot(out: &Path, m: &Model, quick: bool) -> Res<Artifact> {
     let path = out.join(format!("lobe_polar_{}.png", m.stem));
     let title = format!("{}: f·cos θi in the plane of incidence", m.title);
     let mut chart = Chart::new(&title, "x = r sin θi", "z = r cos θi");
-    chart.size = (900, 500);
+    chart.size = (900, 480);
     line_chart(&path, &chart, &series)?;
     Ok(Artifact::new(
         path,
