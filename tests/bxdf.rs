@@ -39,7 +39,7 @@ struct TestGgx {
 
 impl Ndf for TestGgx {
     fn d(&self, m: Vec3) -> f32 {
-        if !(m.z > 0.0) {
+        if m.z.is_nan() || m.z <= 0.0 {
             return 0.0;
         }
         let a2 = self.alpha * self.alpha;
@@ -48,7 +48,7 @@ impl Ndf for TestGgx {
     }
 
     fn lambda(&self, w: Vec3) -> f32 {
-        if !(w.z > 0.0) {
+        if w.z.is_nan() || w.z <= 0.0 {
             return 0.0;
         }
         let tan2 = (w.x * w.x + w.y * w.y) / (w.z * w.z);
@@ -586,6 +586,9 @@ fn furnace_microfacet_crate_ndfs() {
     }
 }
 
+/// A name and two implementations of the same BRDF.
+type Pair = (&'static str, Box<dyn Bxdf>, Box<dyn Bxdf>);
+
 #[test]
 fn crate_ndfs_agree_with_independent_implementations() {
     // Ggx vs the textbook TestGgx above; Beckmann vs SlopeGaussian::beckmann (a different
@@ -595,7 +598,7 @@ fn crate_ndfs_agree_with_independent_implementations() {
     let mut rng = support::rng(31);
     for alpha in [0.1f32, 0.4, 1.0] {
         for masking in [Masking::Separable, Masking::HeightCorrelated] {
-            let pairs: [(&str, Box<dyn Bxdf>, Box<dyn Bxdf>); 2] = [
+            let pairs: [Pair; 2] = [
                 (
                     "ggx",
                     mf(

@@ -172,7 +172,8 @@ impl Bxdf for BlinnPhongLobe {
         }
         let (wi, lobe) = if uc < self.p_spec() {
             let h = sample_cosine_power(u, self.gamma);
-            if !(wo.dot(h) > 0.0) {
+            // wo·h ≤ 0 (or NaN): the mirror image of wo is below the microfacet.
+            if wo.dot(h).is_nan() || wo.dot(h) <= 0.0 {
                 return None;
             }
             (reflect(wo, h), LobeFlags::GLOSSY)

@@ -163,7 +163,7 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
     #[inline]
     fn eval_at(&self, wo: Vec3, wi: Vec3, h: Vec3, c: f32) -> Vec3 {
         let d = self.ndf.d(h);
-        if !(d > 0.0) {
+        if d.is_nan() || d <= 0.0 {
             return Vec3::ZERO;
         }
         let v = self.fresnel.eval(c) * (0.25 * d * self.masking_factor(wo, wi));
