@@ -25,6 +25,7 @@
 pub mod bxdf;
 mod error;
 pub mod frame;
+pub mod glint;
 pub mod ndf;
 
 pub use error::{Error, Result};

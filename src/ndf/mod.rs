@@ -65,7 +65,11 @@ pub trait Ndf {
             return 0.0;
         }
         let g = 1.0 / (1.0 + self.lambda(wo) + self.lambda(wi));
-        if g.is_finite() { g.clamp(0.0, 1.0) } else { 0.0 }
+        if g.is_finite() {
+            g.clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
     }
 
     /// Draws a micronormal m with density D(m) cos θ_m (per unit solid angle), from `u` ∈ [0, 1)².

@@ -116,7 +116,8 @@ impl Chi2 {
                     let st = (1.0 - z * z).max(0.0).sqrt();
                     for &(xp, wp) in &gl {
                         let phi = p0 + 0.5 * dphi * (xp + 1.0);
-                        let w = Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, z as f32);
+                        let w =
+                            Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, z as f32);
                         s += wz * wp * pdf(w);
                     }
                 }
