@@ -25,8 +25,12 @@
 pub mod bxdf;
 mod error;
 pub mod frame;
+pub mod fresnel;
 pub mod glint;
 pub mod ndf;
+pub mod warp;
 
 pub use error::{Error, Result};
+pub use fresnel::Fresnel;
 pub use glam::{Vec2, Vec3};
+pub use ndf::SlopeGaussian;

@@ -5,6 +5,10 @@
 
 use glam::{Vec2, Vec3};
 
+mod gauss;
+mod slope_gaussian;
+pub use slope_gaussian::*;
+
 /// A microfacet normal distribution with its Smith masking function and samplers.
 ///
 /// Conventions (see the crate docs): `d(m)` is a density per unit solid angle of micronormals with

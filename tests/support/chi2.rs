@@ -82,7 +82,7 @@ impl Chi2 {
         let dphi = 2.0 * PI / np as f64;
         let cell_of = |w: Vec3| -> Option<usize> {
             let z = w.z as f64;
-            if !(z >= z_min) || !w.is_finite() {
+            if z.is_nan() || z < z_min || !w.is_finite() {
                 return None;
             }
             let iz = (((z - z_min) / dz) as usize).min(nz - 1);

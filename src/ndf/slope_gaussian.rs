@@ -1,0 +1,767 @@
+//! The non-centred anisotropic Beckmann lobe [`SlopeGaussian`]: a 2D Gaussian of slopes with mean μ
+//! and covariance Σ, the building block of the glint mixture of [Chermain2019] (§3.2, eq. 2-6).
+//!
+//! A micronormal m = normalize(−x̃, −ỹ, 1) has slope ñ = (x̃, ỹ); the lobe is the slope density
+//! P22(ñ) = exp(−½ (ñ − μ)ᵀ Σ⁻¹ (ñ − μ)) / (2π √|Σ|) and the NDF D(m) = P22(ñ(m)) / cos⁴θ_m.
+//! Its masking terms are exact for every view direction w: with the projected slope q = ñ·(cos φ_w,
+//! sin φ_w) ~ N(q̄, s²), the signed projected area is A_s = cos θ − sin θ q̄, the visible projected area
+//! V(w) = ∫⟨w, m⟩⁺ D dm = s_w G(A_s / s_w) with s_w = sin θ · s and G(z) = E[(z − Z)⁺] the normal ramp,
+//! and Λ = V/A − 1 ([Dupuy2013], [Heitz2014]). Visible normals are sampled exactly by inverting the
+//! 1D tilted density ∝ (a − z₁)⁺ φ(z₁) along the view direction in whitened slope space.
+//! Derivations: docs/slope_gaussian.md.
+//!
+//! Per-direction methods do their special-function work in `f64` (libm `erfc`, `exp`), see the
+//! costs in docs/results.md; everything else is `f32`.
+
+use super::Ndf;
+use super::gauss;
+use crate::error::{Error, Result, positive};
+use glam::{Mat2, Vec2, Vec3};
+use std::f64::consts::PI;
+
+/// Default floor on the slope standard deviation used by [`SlopeGaussian::from_moments`]:
+/// σ_ε = 0.01, the near-specular roughness of [Chermain2019] §5.2.2.
+pub const DEFAULT_SIGMA_MIN: f32 = 0.01;
+
+/// Smallest `sigma_min` that [`SlopeGaussian::from_moments`] honours (smaller positive values are
+/// raised to it): below ~1e-6 the peak density 1/(2π σ²) and L⁻¹ approach the limits of `f32`.
+pub const SIGMA_MIN_FLOOR: f32 = 1e-6;
+
+/// Random numbers are clamped into [2⁻²⁶, 1 − 2⁻²⁶] (in `f64`; NaN becomes ½) before they are
+/// transformed, so u = 0 and u = 1 − ε give finite normals (at most ~6 standard deviations from the
+/// mean). The clamp moves a probability of 2⁻²⁶ ≈ 1.5e-8 per end: far below any test's resolution.
+const U_EPS: f64 = 1.0 / (1u64 << 26) as f64;
+
+/// Where a sampled visible normal rounds to ⟨wo, m⟩ ≤ 0 in `f32`, it is moved along wo until
+/// ⟨wo, m⟩ = this value (see [`SlopeGaussian::sample_visible`]).
+const FACING_NUDGE: f64 = 1e-5;
+
+/// 1/(2π).
+const FRAC_1_2PI: f32 = 0.159_154_94;
+
+/// A non-centred, anisotropic, correlated Beckmann lobe: a 2D Gaussian of microfacet slopes.
+///
+/// P22(ñ) = exp(−½ (ñ − μ)ᵀ Σ⁻¹ (ñ − μ)) / (2π √|Σ|),  D(m) = P22(ñ(m)) / cos⁴θ_m,
+/// with μ = (μx, μy) the mean slope and Σ = [[σx², c], [c, σy²]] the slope covariance. A centred lobe
+/// with Σ = diag(αx²/2, αy²/2) is the anisotropic Beckmann NDF (α = √2 σ).
+///
+/// Stored: μ and the Cholesky factor L (Σ = L Lᵀ, lower triangular) and its inverse L⁻¹, as `f32`:
+/// **32 bytes**, 4-byte aligned. The normalisation 1/(2π √|Σ|) = L⁻¹₁₁ L⁻¹₂₂ / (2π) costs two
+/// multiplications per evaluation instead of four more bytes.
+///
+/// Every slope maps to an upper-hemisphere normal, so ∫_{H²} D(m) cos θ_m dm = ∫_{ℝ²} P22 = 1 for
+/// every lobe, however far its mean is tilted.
+///
+/// # Reference
+/// [Chermain2019] eq. 2 and 4 (lobe), eq. 5-6 (moments); [Dupuy2013] (Λ of this lobe);
+/// [Heitz2014] (Smith masking, visible normals).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlopeGaussian {
+    /// Mean slope μ.
+    mean: Vec2,
+    /// L = [[l11, 0], [l21, l22]] stored as [l11, l21, l22].
+    chol: [f32; 3],
+    /// L⁻¹ = [[i11, 0], [i21, i22]] stored as [i11, i21, i22].
+    inv_chol: [f32; 3],
+}
+
+const _: () = assert!(std::mem::size_of::<SlopeGaussian>() == 32);
+
+/// The per-view quantities every masking term needs, in `f64`.
+#[derive(Clone, Copy, Debug)]
+struct ViewTerms {
+    /// Signed projected area A_s = w_z − μ·w_xy = cos θ − sin θ q̄.
+    a_s: f64,
+    /// v = Lᵀ w_xy: the projected slope along w_xy is q̄ + v·z/… with z ~ N(0, I).
+    vx: f64,
+    vy: f64,
+    /// s_w = |v| = sin θ · s, the standard deviation of sin θ · q.
+    s_w: f64,
+}
+
+/// The projected areas of a lobe toward one direction, for mixtures that sum them over lobes.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct VisibleAreaParts {
+    /// Signed projected area A_s(w) = ∫ (w·m) D(m) dm = cos θ − sin θ q̄ (may be negative).
+    pub signed_area: f32,
+    /// Visible projected area V(w) = ∫ ⟨w, m⟩⁺ D(m) dm ≥ max(A_s, 0).
+    pub visible_area: f32,
+}
+
+impl SlopeGaussian {
+    /// A lobe with mean slope `mean` and slope covariance `cov`.
+    ///
+    /// # Errors
+    /// - [`Error::InvalidParameter`] naming `mean` if a component of `mean` is not finite;
+    /// - [`Error::InvalidMatrix`] naming `cov` if an entry is not finite, if `cov` is not symmetric
+    ///   (|c₀₁ − c₁₀| > 1e-6 √(c₀₀ c₁₁); the two are then averaged), if it is not positive definite,
+    ///   or if it is so small or so large that L⁻¹ or the normalisation 1/(2π √|Σ|) leaves the normal
+    ///   `f32` range.
+    ///
+    /// # Reference
+    /// [Chermain2019] eq. 4.
+    pub fn new(mean: Vec2, cov: Mat2) -> Result<Self> {
+        for v in [mean.x, mean.y] {
+            crate::error::finite("mean", v)?;
+        }
+        let c = cov.to_cols_array().map(f64::from);
+        let (c00, c10, c01, c11) = (c[0], c[1], c[2], c[3]);
+        let err = |reason| Error::InvalidMatrix {
+            name: "cov",
+            value: [c00, c01, c10, c11],
+            reason,
+        };
+        if !c.iter().all(|v| v.is_finite()) {
+            return Err(err("entries must be finite"));
+        }
+        if !(c00 > 0.0 && c11 > 0.0) {
+            return Err(err("must be positive definite (diagonal entries > 0)"));
+        }
+        if (c01 - c10).abs() > 1e-6 * (c00 * c11).sqrt() {
+            return Err(err("must be symmetric"));
+        }
+        let sxy = 0.5 * (c01 + c10);
+        if !(c00 * c11 - sxy * sxy > 0.0) {
+            return Err(err("must be positive definite (determinant > 0)"));
+        }
+        Self::from_cov_f64(mean, c00, sxy, c11)
+            .ok_or_else(|| err("too small or too large: L⁻¹ or 1/(2π√|Σ|) leaves the f32 range"))
+    }
+
+    /// The centred anisotropic Beckmann NDF of roughness (αx, αy): Σ = diag(αx²/2, αy²/2).
+    ///
+    /// D(m) = exp(−tan²θ (cos²φ/αx² + sin²φ/αy²)) / (π αx αy cos⁴θ).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `alpha_x` / `alpha_y` if not finite and > 0, or naming
+    /// `alpha_x * alpha_y` if the lobe leaves the `f32` range (α below ~1e-18 or above ~1e18).
+    ///
+    /// # Reference
+    /// [Walter2007] eq. 25; [Chermain2019] eq. 2 with μ = 0.
+    pub fn beckmann(alpha_x: f32, alpha_y: f32) -> Result<Self> {
+        let ax = positive("alpha_x", alpha_x)? as f64;
+        let ay = positive("alpha_y", alpha_y)? as f64;
+        Self::from_cov_f64(Vec2::ZERO, 0.5 * ax * ax, 0.0, 0.5 * ay * ay).ok_or(
+            Error::InvalidParameter {
+                name: "alpha_x * alpha_y",
+                value: ax * ay,
+                reason: "lobe too narrow or too wide for f32",
+            },
+        )
+    }
+
+    /// The lobe fitted to slope moments, as [Chermain2019] eq. 5-6 builds it (infallible, for hot
+    /// paths).
+    ///
+    /// `m` = [E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]. In `f64`:
+    /// - μ = (E[x̃], E[ỹ]);
+    /// - σx² = max(E[x̃²] − E[x̃]², σ_min²), σy² likewise (the floor: a flat region still reflects
+    ///   like a near-mirror of roughness σ_min, not a Dirac);
+    /// - c = E[x̃ỹ] − E[x̃] E[ỹ] (the paper's eq. 5 prints c², a typo), clamped to
+    ///   |c| ≤ √((σx² − σ_min²)(σy² − σ_min²)). This makes Σ − σ_min² I positive semi-definite, so
+    ///   **every** direction of Σ has variance ≥ σ_min² (not only the axes) and Σ is positive definite
+    ///   with |Σ| ≥ σ_min⁴. A perfectly correlated (one-dimensional) slope set thus keeps a minor axis
+    ///   of standard deviation exactly σ_min.
+    ///
+    /// `sigma_min`: non-finite or ≤ 0 → [`DEFAULT_SIGMA_MIN`]; positive values below
+    /// [`SIGMA_MIN_FLOOR`] are raised to it.
+    ///
+    /// Fallback: if a moment is not finite, or the result would leave the `f32` range (variances
+    /// above ~1e37), the centred isotropic lobe of σ = σ_min is returned.
+    ///
+    /// # Reference
+    /// [Chermain2019] eq. 4-6.
+    pub fn from_moments(m: [f32; 5], sigma_min: f32) -> Self {
+        let s = if sigma_min.is_finite() && sigma_min > 0.0 {
+            sigma_min.max(SIGMA_MIN_FLOOR)
+        } else {
+            DEFAULT_SIGMA_MIN
+        } as f64;
+        let fallback = || {
+            Self::from_cov_f64(Vec2::ZERO, s * s, 0.0, s * s)
+                .or_else(|| {
+                    let d = DEFAULT_SIGMA_MIN as f64;
+                    Self::from_cov_f64(Vec2::ZERO, d * d, 0.0, d * d)
+                })
+                .unwrap_or(Self::UNIT_FALLBACK)
+        };
+        if !m.iter().all(|v| v.is_finite()) {
+            return fallback();
+        }
+        let [ex, ey, exx, eyy, exy] = m.map(f64::from);
+        let s2 = s * s;
+        let var_x = (exx - ex * ex).max(s2);
+        let var_y = (eyy - ey * ey).max(s2);
+        let c_max = ((var_x - s2) * (var_y - s2)).sqrt();
+        let c = (exy - ex * ey).clamp(-c_max, c_max);
+        Self::from_cov_f64(Vec2::new(m[0], m[1]), var_x, c, var_y).unwrap_or_else(fallback)
+    }
+
+    /// Centred isotropic lobe with σ = 1/√2 (Beckmann α = 1): the last-resort fallback, written
+    /// out so that no code path can fail.
+    const UNIT_FALLBACK: Self = SlopeGaussian {
+        mean: Vec2::ZERO,
+        chol: [std::f32::consts::FRAC_1_SQRT_2, 0.0, std::f32::consts::FRAC_1_SQRT_2],
+        inv_chol: [std::f32::consts::SQRT_2, 0.0, std::f32::consts::SQRT_2],
+    };
+
+    /// Builds the lobe from an `f64` covariance; `None` unless Σ is positive definite and L, L⁻¹ and
+    /// the normalisation are finite normal `f32` numbers.
+    fn from_cov_f64(mean: Vec2, sxx: f64, sxy: f64, syy: f64) -> Option<Self> {
+        if !(sxx > 0.0 && sxx.is_finite() && syy.is_finite() && sxy.is_finite()) {
+            return None;
+        }
+        let l11 = sxx.sqrt();
+        let l21 = sxy / l11;
+        let l22_sq = syy - l21 * l21;
+        if !(l22_sq > 0.0) {
+            return None;
+        }
+        let l22 = l22_sq.sqrt();
+        let (i11, i22) = (1.0 / l11, 1.0 / l22);
+        let i21 = -l21 * i11 * i22;
+        let chol = [l11 as f32, l21 as f32, l22 as f32];
+        let inv_chol = [i11 as f32, i21 as f32, i22 as f32];
+        let norm = inv_chol[0] * inv_chol[2] * FRAC_1_2PI;
+        let normal = |v: f32| v.is_finite() && v.abs() >= f32::MIN_POSITIVE;
+        let ok = normal(chol[0])
+            && normal(chol[2])
+            && normal(inv_chol[0])
+            && normal(inv_chol[2])
+            && chol[1].is_finite()
+            && inv_chol[1].is_finite()
+            && normal(norm);
+        ok.then_some(SlopeGaussian {
+            mean,
+            chol,
+            inv_chol,
+        })
+    }
+
+    /// The mean slope μ.
+    #[inline]
+    pub fn mean(&self) -> Vec2 {
+        self.mean
+    }
+
+    /// The slope covariance Σ = L Lᵀ, rebuilt from the stored Cholesky factor (equal to the
+    /// constructor's input up to `f32` rounding, ~1e-7 relative).
+    pub fn covariance(&self) -> Mat2 {
+        let [l11, l21, l22] = self.chol.map(f64::from);
+        let (sxx, sxy, syy) = (l11 * l11, l11 * l21, l21 * l21 + l22 * l22);
+        Mat2::from_cols_array(&[sxx as f32, sxy as f32, sxy as f32, syy as f32])
+    }
+
+    /// The lower-triangular Cholesky factor L of Σ = L Lᵀ (slope = μ + L z with z ~ N(0, I)).
+    #[inline]
+    pub fn cholesky(&self) -> Mat2 {
+        let [l11, l21, l22] = self.chol;
+        Mat2::from_cols(Vec2::new(l11, l21), Vec2::new(0.0, l22))
+    }
+
+    /// The mean normal ω_n̄ = normalize(−μx, −μy, 1): the normal of the mean slope.
+    ///
+    /// # Reference
+    /// [Chermain2019] eq. 13 (ω_n̄ᵢ).
+    pub fn mean_normal(&self) -> Vec3 {
+        slope_to_normal_f64(self.mean.x as f64, self.mean.y as f64)
+    }
+
+    /// The slope density P22(ñ) = exp(−½ |L⁻¹(ñ − μ)|²) / (2π √|Σ|) (per unit slope area).
+    ///
+    /// `f32`: one 2×2 triangular product and one `exp`. Non-finite slopes give 0.
+    ///
+    /// # Reference
+    /// [Chermain2019] eq. 4.
+    #[inline]
+    pub fn p22(&self, slope: Vec2) -> f32 {
+        let [i11, i21, i22] = self.inv_chol;
+        let d = slope - self.mean;
+        let zx = i11 * d.x;
+        let zy = i21 * d.x + i22 * d.y;
+        let e = (-0.5 * (zx * zx + zy * zy)).exp();
+        if e >= 0.0 {
+            i11 * i22 * FRAC_1_2PI * e
+        } else {
+            0.0 // NaN from a non-finite slope
+        }
+    }
+
+    /// The signed projected area A_s(w) = ∫ (w·m) D(m) dm = w_z − μ·w_xy = cos θ − sin θ q̄.
+    ///
+    /// Equals ⟨ω_n̄, w⟩ / (ω_n̄·ω_g) before clamping; negative when the mean facet faces away from w.
+    /// 0 for w below the horizon or not finite.
+    ///
+    /// # Reference
+    /// [Chermain2019] eq. 17 (per lobe, unclamped).
+    #[inline]
+    pub fn signed_projected_area(&self, w: Vec3) -> f32 {
+        self.view_terms(w).map_or(0.0, |t| t.a_s as f32)
+    }
+
+    /// Both projected areas toward w at once: A_s(w) and V(w) (see [`VisibleAreaParts`]), for
+    /// mixtures that accumulate Σ Wᵢ A_s,i and Σ Wᵢ V_i. Zeros for invalid w.
+    ///
+    /// # Reference
+    /// [Chermain2019] eq. 13, 17; derivation in docs/slope_gaussian.md.
+    #[inline]
+    pub fn visible_area_parts(&self, w: Vec3) -> VisibleAreaParts {
+        match self.view_terms(w) {
+            Some(t) => VisibleAreaParts {
+                signed_area: t.a_s as f32,
+                visible_area: visible_area_f64(&t) as f32,
+            },
+            None => VisibleAreaParts::default(),
+        }
+    }
+
+    /// A_s, v = Lᵀ w_xy and s_w = |v| for a usable direction (finite, w_z > 0).
+    #[inline]
+    fn view_terms(&self, w: Vec3) -> Option<ViewTerms> {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return None;
+        }
+        let (wx, wy, wz) = (w.x as f64, w.y as f64, w.z as f64);
+        let a_s = wz - (self.mean.x as f64 * wx + self.mean.y as f64 * wy);
+        let [l11, l21, l22] = self.chol.map(f64::from);
+        let vx = l11 * wx + l21 * wy;
+        let vy = l22 * wy;
+        let s_w = (vx * vx + vy * vy).sqrt();
+        Some(ViewTerms { a_s, vx, vy, s_w })
+    }
+
+    /// The normal of the slope μ + L z.
+    #[inline]
+    fn normal_from_z(&self, zx: f64, zy: f64) -> Vec3 {
+        let [l11, l21, l22] = self.chol.map(f64::from);
+        let sx = self.mean.x as f64 + l11 * zx;
+        let sy = self.mean.y as f64 + l21 * zx + l22 * zy;
+        slope_to_normal_f64(sx, sy)
+    }
+
+    /// ln(⟨wo, m⟩ D(m) / V(wo)) in `f64`, or `None` outside the visible support.
+    fn ln_pdf_visible(&self, wo: Vec3, m: Vec3) -> Option<f64> {
+        let t = self.view_terms(wo)?;
+        if !(m.z > 0.0 && m.is_finite()) {
+            return None;
+        }
+        let c = facing(wo, m);
+        if !(c > 0.0) {
+            return None;
+        }
+        let ln_v = if t.s_w > 0.0 {
+            t.s_w.ln() + gauss::ln_ramp(t.a_s / t.s_w)
+        } else if t.a_s > 0.0 {
+            t.a_s.ln()
+        } else {
+            return None;
+        };
+        let (mx, my, mz) = (m.x as f64, m.y as f64, m.z as f64);
+        let (sx, sy) = (-mx / mz, -my / mz);
+        let [l11, l21, l22] = self.chol.map(f64::from);
+        let zx = (sx - self.mean.x as f64) / l11;
+        let zy = (sy - self.mean.y as f64 - l21 * zx) / l22;
+        let ln_p22 = -0.5 * (zx * zx + zy * zy) - (2.0 * PI * l11 * l22).ln();
+        let ln_inv_cos4 = 2.0 * (1.0 + sx * sx + sy * sy).ln();
+        let ln_pdf = c.ln() + ln_p22 + ln_inv_cos4 - ln_v;
+        (!ln_pdf.is_nan()).then_some(ln_pdf)
+    }
+}
+
+impl Ndf for SlopeGaussian {
+    /// D(m) = P22(ñ(m)) (1 + |ñ|²)² = P22(ñ) / cos⁴θ_m (`f32`).
+    ///
+    /// 0 for m.z ≤ 0 or non-finite m; values beyond `f32::MAX` are clamped to it.
+    ///
+    /// # Reference
+    /// [Chermain2019] eq. 2.
+    #[inline]
+    fn d(&self, m: Vec3) -> f32 {
+        let Some(s) = crate::frame::normal_to_slope(m) else {
+            return 0.0;
+        };
+        let p = self.p22(s);
+        if p == 0.0 {
+            return 0.0;
+        }
+        let c = 1.0 + s.length_squared();
+        let v = p * c * c;
+        if v.is_finite() { v } else { f32::MAX }
+    }
+
+    /// Smith Λ(w) = V/A − 1 = G(−z)/z with z = A_s / s_w = (μ_w − q̄)/s, μ_w = cot θ.
+    ///
+    /// G(−z) = φ(z) − z Q(z) is computed without cancellation (Mills' continued fraction for
+    /// z > 5). 0 at normal incidence and below the horizon / for invalid w; `f32::MAX` when
+    /// A_s ≤ 0 (the mean facet faces away from w: everything is masked) or when Λ overflows.
+    ///
+    /// # Reference
+    /// [Dupuy2013] (non-centred anisotropic Beckmann Λ); [Heitz2014] eq. 72 (centred case).
+    fn lambda(&self, w: Vec3) -> f32 {
+        let Some(t) = self.view_terms(w) else {
+            return 0.0;
+        };
+        if !(t.a_s > 0.0) {
+            return f32::MAX;
+        }
+        if t.s_w == 0.0 {
+            return 0.0;
+        }
+        let z = t.a_s / t.s_w;
+        ((gauss::ramp_neg(z) / z) as f32).min(f32::MAX)
+    }
+
+    /// A(w) = max(A_s(w), 0) = max(cos θ − sin θ q̄, 0) = ⟨ω_n̄, w⟩ / (ω_n̄·ω_g).
+    ///
+    /// # Reference
+    /// [Chermain2019] eq. 17 (one lobe).
+    #[inline]
+    fn projected_area(&self, w: Vec3) -> f32 {
+        self.view_terms(w).map_or(0.0, |t| t.a_s.max(0.0) as f32)
+    }
+
+    /// V(w) = ∫ ⟨w, m⟩⁺ D(m) dm = s_w G(A_s / s_w) = A_s Φ(z) + s_w φ(z), exact for every w.
+    ///
+    /// Stable forms: A_s + s_w G(−z) for z > 0 (two non-negative terms; the second is dropped for
+    /// z > 8 where it is < 1e-17 A_s), s_w G(−|z|) for z ≤ 0 (Mills' ratio, no overflow or 0/0), A_s at
+    /// normal incidence. Never divides by sin θ. 0 for invalid w.
+    ///
+    /// # Reference
+    /// docs/slope_gaussian.md; [Chermain2019] eq. 12-13 (the integral per lobe).
+    #[inline]
+    fn visible_area(&self, w: Vec3) -> f32 {
+        self.view_terms(w)
+            .map_or(0.0, |t| visible_area_f64(&t) as f32)
+    }
+
+    /// Exact sampling of D(m) cos θ_m: slope = μ + L z, z = Box–Muller(u).
+    ///
+    /// z = √(−2 ln u₁) (cos 2πu₂, sin 2πu₂) with u clamped into [2⁻²⁶, 1 − 2⁻²⁶] (NaN → ½), so every
+    /// u gives a finite unit upper-hemisphere normal.
+    fn sample_normal(&self, u: Vec2) -> Vec3 {
+        let (u1, u2) = (clamp_u(u.x), clamp_u(u.y));
+        let r = (-2.0 * u1.ln()).sqrt();
+        let (s, c) = (gauss::TWO_PI * u2).sin_cos();
+        self.normal_from_z(r * c, r * s)
+    }
+
+    /// Exact sampling of the visible normals D_wo(m) ∝ ⟨wo, m⟩⁺ D(m).
+    ///
+    /// In slope space the density is ∝ (A_s − w_xy·ñ)⁺ P22(ñ). With ñ = μ + L z and v = Lᵀ w_xy
+    /// the weight is |v| (a − z₁)⁺, a = A_s/|v|, z₁ = v̂·z; z₂ = v̂⊥·z stays N(0, 1) and independent.
+    /// z₁ is drawn by inverting its cdf (a Φ(x) + φ(x)) / (a Φ(a) + φ(a)) with u.x (Newton in `f64`,
+    /// any real a), z₂ = Φ⁻¹(u.y). u is clamped as in [`Ndf::sample_normal`].
+    ///
+    /// Degenerate cases: wo invalid or at normal incidence → [`Ndf::sample_normal`] (exact at normal
+    /// incidence). If `f32` rounding puts the normal at ⟨wo, m⟩ ≤ 0 (possible only where the
+    /// visible set is thinner than `f32` resolution), m is moved along wo to ⟨wo, m⟩ = 1e-5, so the
+    /// returned normal always has a positive [`Ndf::pdf_visible`].
+    ///
+    /// # Reference
+    /// [Heitz2014] §5 (visible normals); derivation in docs/slope_gaussian.md.
+    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        let Some(t) = self.view_terms(wo) else {
+            return self.sample_normal(u);
+        };
+        if t.s_w == 0.0 {
+            return self.sample_normal(u);
+        }
+        let a = t.a_s / t.s_w;
+        let z1 = gauss::sample_ramp(a, clamp_u(u.x));
+        let z2 = gauss::inv_std_cdf(clamp_u(u.y));
+        let (ex, ey) = (t.vx / t.s_w, t.vy / t.s_w);
+        let m = self.normal_from_z(z1 * ex - z2 * ey, z1 * ey + z2 * ex);
+        ensure_facing(wo, m)
+    }
+
+    /// D_wo(m) = ⟨wo, m⟩⁺ D(m) / V(wo), formed in `f64` logarithms so that it stays finite and
+    /// positive where D and V both underflow (grazing views of lobes tilted away).
+    ///
+    /// 0 outside the visible set (m below the horizon or ⟨wo, m⟩ ≤ 0) and for invalid wo. Inside it,
+    /// values below `f32::MIN_POSITIVE` are returned as `f32::MIN_POSITIVE` (the density is positive
+    /// there; a caller testing pdf > 0 for "in the support" stays right) and values above `f32::MAX`
+    /// as `f32::MAX`.
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        match self.ln_pdf_visible(wo, m) {
+            Some(l) => (l.exp() as f32).clamp(f32::MIN_POSITIVE, f32::MAX),
+            None => 0.0,
+        }
+    }
+}
+
+/// V(w) from the view terms (see [`Ndf::visible_area`] for the branches).
+#[inline]
+fn visible_area_f64(t: &ViewTerms) -> f64 {
+    if t.s_w == 0.0 {
+        return t.a_s.max(0.0);
+    }
+    let z = t.a_s / t.s_w;
+    if z > 8.0 {
+        // s_w G(−z) / A_s = G(−z)/z < 1e-17 here: below f64 resolution of A_s.
+        t.a_s
+    } else if z > 0.0 {
+        t.a_s + t.s_w * gauss::ramp_neg(z)
+    } else {
+        t.s_w * gauss::ramp_neg(-z)
+    }
+}
+
+/// ⟨wo, m⟩ in `f64` from the `f32` vectors (the same arithmetic in the sampler and in the pdf).
+#[inline]
+fn facing(wo: Vec3, m: Vec3) -> f64 {
+    wo.x as f64 * m.x as f64 + wo.y as f64 * m.y as f64 + wo.z as f64 * m.z as f64
+}
+
+/// m if it faces wo after rounding, else m moved along wo to ⟨wo, m⟩ = [`FACING_NUDGE`].
+fn ensure_facing(wo: Vec3, m: Vec3) -> Vec3 {
+    let c = facing(wo, m);
+    if c > 0.0 {
+        return m;
+    }
+    let k = FACING_NUDGE - c;
+    let n = [
+        m.x as f64 + k * wo.x as f64,
+        m.y as f64 + k * wo.y as f64,
+        m.z as f64 + k * wo.z as f64,
+    ];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let n = Vec3::new((n[0] / len) as f32, (n[1] / len) as f32, (n[2] / len) as f32);
+    if n.is_finite() && n.z > 0.0 && facing(wo, n) > 0.0 {
+        n
+    } else {
+        wo
+    }
+}
+
+/// normalize(−sx, −sy, 1) in `f64`, rounded to `f32`; the geometric normal if that fails.
+#[inline]
+fn slope_to_normal_f64(sx: f64, sy: f64) -> Vec3 {
+    let inv = 1.0 / (1.0 + sx * sx + sy * sy).sqrt();
+    let m = Vec3::new((-sx * inv) as f32, (-sy * inv) as f32, inv as f32);
+    if m.is_finite() && m.z > 0.0 {
+        m
+    } else {
+        Vec3::Z
+    }
+}
+
+/// u into [2⁻²⁶, 1 − 2⁻²⁶] in `f64`; NaN → ½.
+#[inline]
+fn clamp_u(u: f32) -> f64 {
+    let u = u as f64;
+    if u.is_nan() {
+        0.5
+    } else {
+        u.clamp(U_EPS, 1.0 - U_EPS)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lobe(mx: f32, my: f32, sx: f32, sy: f32, rho: f32) -> SlopeGaussian {
+        let c = rho * sx * sy;
+        SlopeGaussian::new(
+            Vec2::new(mx, my),
+            Mat2::from_cols_array(&[sx * sx, c, c, sy * sy]),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn size_is_32_bytes() {
+        assert_eq!(std::mem::size_of::<SlopeGaussian>(), 32);
+    }
+
+    #[test]
+    fn accessors_round_trip() {
+        let g = lobe(0.3, -0.2, 0.2, 0.05, 0.7);
+        let cov = g.covariance();
+        // f32 storage of L: entries agree to a few ulp of the largest (~1e-7 relative).
+        assert!((cov.x_axis.x - 0.04).abs() < 1e-8);
+        assert!((cov.y_axis.y - 0.0025).abs() < 1e-9);
+        assert!((cov.x_axis.y - 0.7 * 0.2 * 0.05).abs() < 1e-8);
+        assert_eq!(cov.x_axis.y, cov.y_axis.x);
+        let l = g.cholesky();
+        let back = l * l.transpose();
+        assert!((back - cov).abs_diff_eq(Mat2::ZERO, 1e-8));
+        assert_eq!(g.mean(), Vec2::new(0.3, -0.2));
+        let n = g.mean_normal();
+        let expected = Vec3::new(-0.3, 0.2, 1.0).normalize();
+        assert!((n - expected).length() < 1e-7);
+    }
+
+    #[test]
+    fn p22_is_the_bivariate_normal() {
+        // Independent f64 formula with Σ⁻¹ from the adjugate.
+        let (mx, my, sx, sy, rho) = (0.3f64, -0.2, 0.2, 0.05, -0.6);
+        let g = lobe(mx as f32, my as f32, sx as f32, sy as f32, rho as f32);
+        for &(x, y) in &[(0.3, -0.2), (0.5, -0.1), (0.1, -0.3), (0.0, 0.0)] {
+            let (dx, dy) = (x - mx, y - my);
+            let q = (dx * dx / (sx * sx) - 2.0 * rho * dx * dy / (sx * sy) + dy * dy / (sy * sy))
+                / (1.0 - rho * rho);
+            let p = (-0.5 * q).exp() / (2.0 * PI * sx * sy * (1.0 - rho * rho).sqrt());
+            let got = g.p22(Vec2::new(x as f32, y as f32)) as f64;
+            // f32 exp of an argument up to ~30: relative error ≤ ~30 × 2⁻²³ ≈ 4e-6, plus storage.
+            assert!((got - p).abs() <= 1e-5 * p + 1e-30, "({x}, {y}): {got} vs {p}");
+        }
+        assert_eq!(g.p22(Vec2::new(f32::NAN, 0.0)), 0.0);
+        assert_eq!(g.p22(Vec2::new(f32::INFINITY, 0.0)), 0.0);
+    }
+
+    #[test]
+    fn masking_identities_hold() {
+        let g = lobe(0.4, 0.1, 0.3, 0.2, 0.5);
+        for &(x, y, z) in &[(0.0f32, 0.0f32, 1.0f32), (0.5, 0.1, 0.8), (-0.9, 0.2, 0.3), (0.9, 0.3, 0.1)] {
+            let w = Vec3::new(x, y, z).normalize();
+            let parts = g.visible_area_parts(w);
+            let a = g.projected_area(w);
+            let v = g.visible_area(w);
+            assert_eq!(parts.visible_area, v);
+            assert_eq!(parts.signed_area.max(0.0), a);
+            assert!(v >= a && v > 0.0);
+            let l = g.lambda(w);
+            if a > 0.0 {
+                // V = A (1 + Λ) to f32 rounding of the three values.
+                assert!((a * (1.0 + l) - v).abs() <= 4e-7 * v, "{a} {l} {v}");
+            } else {
+                assert_eq!(l, f32::MAX);
+            }
+        }
+        assert_eq!(g.lambda(Vec3::Z), 0.0);
+        assert_eq!(g.visible_area(Vec3::Z), 1.0);
+    }
+
+    #[test]
+    fn invalid_directions_give_zero() {
+        let g = lobe(0.4, 0.1, 0.3, 0.2, 0.5);
+        for w in [
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::ZERO,
+            Vec3::new(f32::NAN, 0.0, 1.0),
+            Vec3::new(0.0, f32::INFINITY, 1.0),
+        ] {
+            assert_eq!(g.d(w), 0.0);
+            assert_eq!(g.lambda(w), 0.0);
+            assert_eq!(g.projected_area(w), 0.0);
+            assert_eq!(g.visible_area(w), 0.0);
+            assert_eq!(g.signed_projected_area(w), 0.0);
+            assert_eq!(g.pdf_visible(w, Vec3::Z), 0.0);
+            assert_eq!(g.pdf_visible(Vec3::Z, w), 0.0);
+            assert_eq!(g.g1(w, Vec3::Z), 0.0);
+            let m = g.sample_visible(w, Vec2::new(0.3, 0.6));
+            assert!(m.z > 0.0 && (m.length() - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn from_moments_floors_and_clamps() {
+        // A constant slope (0.2, −0.1): variances 0, so σ = σ_min on both axes, c = 0.
+        let (x, y) = (0.2f32, -0.1f32);
+        let g = SlopeGaussian::from_moments([x, y, x * x, y * y, x * y], 0.01);
+        let cov = g.covariance();
+        assert_eq!(g.mean(), Vec2::new(x, y));
+        // f32 rounding of E[x̃]² vs E[x̃²] leaves |var| ≲ 1e-8 < σ_min² = 1e-4: the floor wins.
+        assert!((cov.x_axis.x - 1e-4).abs() < 1e-10 && (cov.y_axis.y - 1e-4).abs() < 1e-10);
+        assert!(cov.x_axis.y.abs() < 1e-10);
+
+        // Perfect correlation along the diagonal: var = 0.05 on both axes, c = 0.05 (ρ = 1).
+        let g = SlopeGaussian::from_moments([0.0, 0.0, 0.05, 0.05, 0.05], 0.01);
+        let cov = g.covariance();
+        let (sxx, sxy, syy) = (cov.x_axis.x as f64, cov.x_axis.y as f64, cov.y_axis.y as f64);
+        // c clamped to √((σx² − σ²)(σy² − σ²)) = 0.05 − 1e-4: minor eigenvalue exactly σ_min².
+        assert!((sxy - (0.05 - 1e-4)).abs() < 1e-8, "{sxy}");
+        let mean_eig = 0.5 * (sxx + syy);
+        let minor = mean_eig - (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt();
+        assert!((minor - 1e-4).abs() < 1e-8, "{minor}");
+
+        // Anti-correlated with distinct variances: clamp to −√((0.09 − σ²)(0.01 − σ²)).
+        let g = SlopeGaussian::from_moments([0.0, 0.0, 0.09, 0.01, -0.5], 0.01);
+        let c = g.covariance().x_axis.y as f64;
+        assert!((c + ((0.09f64 - 1e-4) * (0.01 - 1e-4)).sqrt()).abs() < 1e-8, "{c}");
+
+        // A valid moment set is reproduced: σx = 0.3, σy = 0.1, ρ = 0.4, mean (0.5, 0.2).
+        let (mx, my, sx, sy, r) = (0.5f64, 0.2f64, 0.3f64, 0.1f64, 0.4f64);
+        let m = [
+            mx as f32,
+            my as f32,
+            (sx * sx + mx * mx) as f32,
+            (sy * sy + my * my) as f32,
+            (r * sx * sy + mx * my) as f32,
+        ];
+        let cov = SlopeGaussian::from_moments(m, 0.01).covariance();
+        // Moments rounded to f32 (relative 6e-8 of E[x̃²] ≈ 0.34): variances good to ~5e-8.
+        assert!((cov.x_axis.x as f64 - sx * sx).abs() < 1e-7);
+        assert!((cov.y_axis.y as f64 - sy * sy).abs() < 1e-7);
+        assert!((cov.x_axis.y as f64 - r * sx * sy).abs() < 1e-7);
+    }
+
+    #[test]
+    fn from_moments_fallbacks() {
+        let centred = |g: SlopeGaussian, s: f32| {
+            let cov = g.covariance();
+            g.mean() == Vec2::ZERO
+                && (cov.x_axis.x - s * s).abs() < 1e-6 * s * s
+                && (cov.y_axis.y - s * s).abs() < 1e-6 * s * s
+                && cov.x_axis.y == 0.0
+        };
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            for i in 0..5 {
+                let mut m = [0.1, 0.2, 0.3, 0.3, 0.0];
+                m[i] = bad;
+                assert!(centred(SlopeGaussian::from_moments(m, 0.02), 0.02));
+            }
+        }
+        // Bad sigma_min → DEFAULT_SIGMA_MIN; tiny sigma_min → SIGMA_MIN_FLOOR.
+        let flat = [0.0, 0.0, 0.0, 0.0, 0.0];
+        assert!(centred(SlopeGaussian::from_moments(flat, f32::NAN), DEFAULT_SIGMA_MIN));
+        assert!(centred(SlopeGaussian::from_moments(flat, -1.0), DEFAULT_SIGMA_MIN));
+        assert!(centred(SlopeGaussian::from_moments(flat, 1e-20), SIGMA_MIN_FLOOR));
+        // Huge second moments beyond f32-representable lobes: fallback, not a panic.
+        let g = SlopeGaussian::from_moments([0.0, 0.0, f32::MAX, f32::MAX, 0.0], 0.01);
+        assert!(g.d(Vec3::Z).is_finite());
+    }
+
+    #[test]
+    fn bad_constructor_input_names_the_parameter() {
+        let id = Mat2::IDENTITY;
+        let e = SlopeGaussian::new(Vec2::new(f32::NAN, 0.0), id).unwrap_err();
+        assert!(matches!(e, Error::InvalidParameter { name: "mean", .. }), "{e}");
+        let cases = [
+            Mat2::from_cols_array(&[f32::NAN, 0.0, 0.0, 1.0]),
+            Mat2::from_cols_array(&[1.0, 0.5, 0.0, 1.0]),
+            Mat2::from_cols_array(&[1.0, 2.0, 2.0, 1.0]),
+            Mat2::from_cols_array(&[-1.0, 0.0, 0.0, 1.0]),
+            Mat2::from_cols_array(&[0.0, 0.0, 0.0, 1.0]),
+            Mat2::from_cols_array(&[1e-45, 0.0, 0.0, 1e-45]),
+        ];
+        for cov in cases {
+            let e = SlopeGaussian::new(Vec2::ZERO, cov).unwrap_err();
+            assert!(matches!(e, Error::InvalidMatrix { name: "cov", .. }), "{e}");
+            assert!(e.to_string().contains("cov"));
+        }
+        for (ax, ay, name) in [(0.0, 0.1, "alpha_x"), (0.1, f32::NAN, "alpha_y")] {
+            let e = SlopeGaussian::beckmann(ax, ay).unwrap_err();
+            assert!(e.to_string().contains(name), "{e}");
+        }
+    }
+
+    #[test]
+    fn pdf_visible_is_positive_where_v_underflows() {
+        // σ = 0.05, mean slope (1, 0), view from the side the lobe is tilted away from, 80°:
+        // a = (cot 80° − 1)/0.05 ≈ −16.5, V ≈ 0.05 φ(16.5)/16.5² ≈ 1e-63: below f32.
+        let g = lobe(1.0, 0.0, 0.05, 0.05, 0.0);
+        let wo = Vec3::new(80f32.to_radians().sin(), 0.0, 80f32.to_radians().cos());
+        assert_eq!(g.visible_area(wo), 0.0);
+        assert_eq!(g.lambda(wo), f32::MAX);
+        for i in 0..50 {
+            let u = Vec2::new((i as f32 + 0.5) / 50.0, ((i * 7) % 50) as f32 / 50.0 + 0.01);
+            let m = g.sample_visible(wo, u);
+            assert!(m.z > 0.0 && wo.dot(m) > 0.0);
+            let p = g.pdf_visible(wo, m);
+            assert!(p > 0.0 && p.is_finite(), "{m} {p}");
+        }
+    }
+}
