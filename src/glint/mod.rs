@@ -15,10 +15,14 @@ mod footprint;
 mod image_io;
 mod moments;
 mod normal_map;
+mod procedural;
 
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
+};
+pub use procedural::{
+    BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
 };
 
 use crate::ndf::Ndf;
