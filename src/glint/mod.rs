@@ -10,13 +10,16 @@
 //! uv = texel coordinate / size, maps tile, texel row 0 is the bottom row of an image file) are
 //! documented on [`NormalMap`] and in `docs/glint.md`.
 
+mod bins;
 mod footprint;
 #[cfg(feature = "image")]
 mod image_io;
 mod moments;
 mod normal_map;
 mod procedural;
+mod reference;
 
+pub use bins::HemisphereBins;
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
@@ -24,6 +27,7 @@ pub use normal_map::{
 pub use procedural::{
     BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
 };
+pub use reference::{BinnedPndf, Kernel, REFERENCE_BATCHES, binned_pndf, naive_brdf, tv_distance};
 
 use crate::ndf::Ndf;
 
