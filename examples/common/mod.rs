@@ -6,6 +6,7 @@
 #![allow(dead_code)]
 
 pub mod curves;
+pub mod pndf_images;
 
 use plotters::prelude::*;
 use std::error::Error;

@@ -10,13 +10,18 @@
 //!
 //! # Reference
 //! [ShirleyChiu1997] (concentric map); [Snyder1987] (Lambert azimuthal equal-area projection);
-//! [Atanasov2020] §4 (binned directions).
+//! [Atanasov2020] §2 (equal-solid-angle direction bins, Fig. 2).
 
 use crate::warp::{hemisphere_to_square_equal_area, square_to_hemisphere_equal_area};
 use crate::{Error, Result};
 use glam::{Vec2, Vec3};
 
-/// An equal-area n × n binning of the upper hemisphere (see the [module docs](self)).
+/// An equal-area n × n binning of the upper hemisphere.
+///
+/// Bins are the cells of an n × n grid on the unit square mapped onto the hemisphere by
+/// [`square_to_hemisphere_equal_area`] (solid angle = 2π × square area): bin `j * n + i` is the image
+/// of the cell [i/n, (i+1)/n) × [j/n, (j+1)/n), of solid angle 2π/n². For even n the pole is the
+/// corner shared by the four central bins, for odd n the centre of the middle bin.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct HemisphereBins {
     n: usize,
