@@ -55,7 +55,8 @@ pub const MAX_EXTENT_PERIODS: f32 = 2.0;
 /// Build one per shading point with [`Footprint::from_differentials`]; read it in texel units of a map
 /// with [`Footprint::gaussian_texels`] or [`Footprint::parallelogram_texels`]. See the
 /// [`glint` module docs](crate::glint) and the constants for the two views and the clamps; the
-/// source file's module comment has the full discussion.
+/// source file's module comment has the full discussion. Map sizes of 0 given to the views are
+/// treated as 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Footprint {
     uv: Vec2,

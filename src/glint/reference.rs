@@ -30,8 +30,11 @@ use rayon::prelude::*;
 /// about 1/√30 ≈ 18 %), enough for test tolerances of a few standard errors.
 pub const REFERENCE_BATCHES: usize = 16;
 
-/// Rows of strata per parallel task (fixed, so that results do not depend on the thread count).
-const STRATA_ROWS_PER_TASK: usize = 32;
+/// Smallest number of stratum rows per parallel task, and the largest number of tasks per batch. Both
+/// are fixed (results do not depend on the thread count); the cap bounds the memory of the per-task
+/// histograms to 16 × bins × 16 bytes.
+const MIN_ROWS_PER_TASK: usize = 32;
+const MAX_TASKS_PER_BATCH: usize = 16;
 
 /// Which footprint kernel weights the positions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -161,7 +164,8 @@ fn cholesky(cov: Mat2) -> [f64; 3] {
 /// Deterministic: random numbers come from one PCG stream per (seed, batch, stratum row); rows are
 /// split into fixed tasks run in parallel and reduced in order.
 ///
-/// Cost: O(samples) normal lookups (~4 normalisations each) plus O(batches · bins).
+/// Cost: O(samples) normal lookups (~4 normalisations each) plus O(batches · bins); memory
+/// O(16 · bins) for the per-task histograms.
 ///
 /// # Reference
 /// [Chermain2019] eq. 8, §5.1.1.
@@ -208,7 +212,8 @@ pub fn binned_pndf(
         }
     };
     let nb = bins.len();
-    let tasks = m.div_ceil(STRATA_ROWS_PER_TASK);
+    let rows_per_task = MIN_ROWS_PER_TASK.max(m.div_ceil(MAX_TASKS_PER_BATCH));
+    let tasks = m.div_ceil(rows_per_task);
     let mut batch_counts: Vec<Vec<u64>> = Vec::with_capacity(batches);
     let mut batch_inv: Vec<Vec<f64>> = Vec::with_capacity(batches);
     for batch in 0..batches {
@@ -216,7 +221,7 @@ pub fn binned_pndf(
             .into_par_iter()
             .map(|task| {
                 let mut hist: Hist = vec![(0, 0.0); nb];
-                let rows = task * STRATA_ROWS_PER_TASK..((task + 1) * STRATA_ROWS_PER_TASK).min(m);
+                let rows = task * rows_per_task..((task + 1) * rows_per_task).min(m);
                 for row in rows {
                     let mut rng = Pcg64Mcg::seed_from_u64(
                         seed ^ (batch as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
