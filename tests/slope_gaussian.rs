@@ -195,8 +195,9 @@ fn projected_areas_match_quadrature() {
                 }
             }
 
-            // ∫ pdf_visible = 1 wherever V is resolvable by the f32 D used in the quadrature.
-            if v > 1e-20 {
+            // ∫ pdf_visible = 1 wherever V is resolvable by the f32 D used in the quadrature; at one
+            // azimuth per θ (each pdf evaluation costs ~10 D evaluations: the file stays fast).
+            if v > 1e-20 && (phi == 135.0 || theta == 0.0) {
                 let (p_q, p_err) =
                     integrate_around(c, w, &|m: Vec3| c.g.pdf_visible(w, m) as f64);
                 let tol = 4.0 * p_err + float_bound(c, 1.0) + 1e-6;
