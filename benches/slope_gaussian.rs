@@ -31,7 +31,10 @@ fn inputs(sigma: f32) -> Inputs {
     let mut us = Vec::new();
     for _ in 0..BATCH {
         let mean = Vec2::new(rng.random_range(-0.7..0.7), rng.random_range(-0.7..0.7));
-        let (sx, sy) = (sigma * rng.random_range(0.5..1.5f32), sigma * rng.random_range(0.5..1.5f32));
+        let (sx, sy) = (
+            sigma * rng.random_range(0.5..1.5f32),
+            sigma * rng.random_range(0.5..1.5f32),
+        );
         let rho: f32 = rng.random_range(-0.7..0.7);
         let c = rho * sx * sy;
         lobes.push(
@@ -44,7 +47,11 @@ fn inputs(sigma: f32) -> Inputs {
         us.push(Vec2::new(rng.random(), rng.random()));
     }
     // Normals near each lobe (drawn from it), so that `d` does real work.
-    let normals = lobes.iter().zip(&us).map(|(g, &u)| g.sample_normal(u)).collect();
+    let normals = lobes
+        .iter()
+        .zip(&us)
+        .map(|(g, &u)| g.sample_normal(u))
+        .collect();
     Inputs {
         lobes,
         dirs,

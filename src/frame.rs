@@ -97,7 +97,9 @@ pub fn normal_to_slope(n: Vec3) -> Option<Vec2> {
 /// A non-finite slope returns the geometric normal `Vec3::Z`, so that callers never see NaN.
 #[inline]
 pub fn slope_to_normal(s: Vec2) -> Vec3 {
-    Vec3::new(-s.x, -s.y, 1.0).try_normalize().unwrap_or(Vec3::Z)
+    Vec3::new(-s.x, -s.y, 1.0)
+        .try_normalize()
+        .unwrap_or(Vec3::Z)
 }
 
 /// A right-handed orthonormal frame (tangent, bitangent, normal) for moving directions between world

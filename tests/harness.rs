@@ -40,7 +40,10 @@ fn chi2_accepts_a_correct_sampler() {
         ..Chi2::new("cosine/correct", 1)
     };
     let p = t
-        .run(|_, u| Some(cosine_sample(u)), |w| (w.z.max(0.0) as f64) / PI)
+        .run(
+            |_, u| Some(cosine_sample(u)),
+            |w| (w.z.max(0.0) as f64) / PI,
+        )
         .unwrap();
     assert!(p > 0.01);
 }

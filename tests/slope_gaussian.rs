@@ -46,11 +46,7 @@ struct Case {
 }
 
 fn case(mean: (f32, f32), sx: f32, sy: f32, rho: f32) -> Case {
-    let (a, b, c) = (
-        (sx * sx) as f64,
-        (sy * sy) as f64,
-        (rho * sx * sy) as f64,
-    );
+    let (a, b, c) = ((sx * sx) as f64, (sy * sy) as f64, (rho * sx * sy) as f64);
     let m = 0.5 * (a + b);
     let d = (0.25 * (a - b).powi(2) + c * c).sqrt();
     Case {
@@ -143,7 +139,8 @@ fn d_cos_integrates_to_one() {
         .filter_map(|c| {
             let (v, err) = integrate_lobe(c, &|m: Vec3| c.g.d(m) as f64 * m.z as f64);
             let tol = 4.0 * err + float_bound(c, 1.0);
-            ((v - 1.0).abs() > tol).then(|| format!("{}: ∫ D cos = {v} ± {err:e} (tol {tol:e})", c.name))
+            ((v - 1.0).abs() > tol)
+                .then(|| format!("{}: ∫ D cos = {v} ± {err:e} (tol {tol:e})", c.name))
         })
         .collect();
     assert!(failures.is_empty(), "{failures:#?}");
@@ -163,13 +160,15 @@ fn projected_areas_match_quadrature() {
             let mut out = Vec::new();
 
             // Signed projected area ∫ (w·m) D dm = cos θ − sin θ q̄ (smooth integrand).
-            let (a_q, a_err) =
-                integrate_lobe(c, &|m: Vec3| w.dot(m) as f64 * c.g.d(m) as f64);
+            let (a_q, a_err) = integrate_lobe(c, &|m: Vec3| w.dot(m) as f64 * c.g.d(m) as f64);
             let a = c.g.signed_projected_area(w) as f64;
             // Scale: ∫ |w·m| D ≤ ∫ D = E[√(1 + |ñ|²)] ≤ 2 for these lobes.
             let tol = 4.0 * a_err + float_bound(c, 2.0) + 1e-7;
             if (a_q - a).abs() > tol {
-                out.push(format!("{} w({theta},{phi}): A_s = {a}, quadrature {a_q} ± {a_err:e}", c.name));
+                out.push(format!(
+                    "{} w({theta},{phi}): A_s = {a}, quadrature {a_q} ± {a_err:e}",
+                    c.name
+                ));
             }
 
             // Visible area ∫ ⟨w,m⟩⁺ D dm (kink moved to the horizon of the w-frame).
@@ -191,15 +190,17 @@ fn projected_areas_match_quadrature() {
                 let l = c.g.lambda(w) as f64;
                 let tol = (tol / a) * 2.0 + 1e-6 * (1.0 + l);
                 if (l_q - l).abs() > tol {
-                    out.push(format!("{} w({theta},{phi}): Λ = {l:e}, quadrature {l_q:e}", c.name));
+                    out.push(format!(
+                        "{} w({theta},{phi}): Λ = {l:e}, quadrature {l_q:e}",
+                        c.name
+                    ));
                 }
             }
 
             // ∫ pdf_visible = 1 wherever V is resolvable by the f32 D used in the quadrature; at one
             // azimuth per θ (each pdf evaluation costs ~10 D evaluations: the file stays fast).
             if v > 1e-20 && (phi == 135.0 || theta == 0.0) {
-                let (p_q, p_err) =
-                    integrate_around(c, w, &|m: Vec3| c.g.pdf_visible(w, m) as f64);
+                let (p_q, p_err) = integrate_around(c, w, &|m: Vec3| c.g.pdf_visible(w, m) as f64);
                 let tol = 4.0 * p_err + float_bound(c, 1.0) + 1e-6;
                 if (p_q - 1.0).abs() > tol {
                     out.push(format!(
@@ -261,7 +262,10 @@ fn centred_lobe_is_anisotropic_beckmann() {
                 // rounded to f32 (6e-8). Below the f32 normal range (1.2e-38) only "tiny" is checked.
                 let tol = (1e-6 + 4e-7 * a * a) * l_ref;
                 if l_ref < 1e-37 {
-                    assert!(l < 1e-36, "α ({ax},{ay}) w({theta},{phi}): Λ = {l:e}, ref {l_ref:e}");
+                    assert!(
+                        l < 1e-36,
+                        "α ({ax},{ay}) w({theta},{phi}): Λ = {l:e}, ref {l_ref:e}"
+                    );
                     continue;
                 }
                 assert!(
@@ -285,7 +289,11 @@ fn lambda_matches_dupuy_closed_form_for_tilted_lobes() {
             let (t, p) = (theta.to_radians(), phi.to_radians());
             let (cp, sp) = (p.cos(), p.sin());
             let q = mu.x as f64 * cp + mu.y as f64 * sp;
-            let (sxx, sxy, syy) = (cov.x_axis.x as f64, cov.x_axis.y as f64, cov.y_axis.y as f64);
+            let (sxx, sxy, syy) = (
+                cov.x_axis.x as f64,
+                cov.x_axis.y as f64,
+                cov.y_axis.y as f64,
+            );
             let s = (cp * cp * sxx + 2.0 * cp * sp * sxy + sp * sp * syy).sqrt();
             let nu = (1.0 / t.tan() - q) / (std::f64::consts::SQRT_2 * s);
             let l = c.g.lambda(w) as f64;
@@ -304,9 +312,17 @@ fn lambda_matches_dupuy_closed_form_for_tilted_lobes() {
             let rel_nu = 1.2e-7 * (1.0 + mu_norm) / a_s.abs() + 2e-7;
             let tol = (1e-6 + 2.0 * nu * nu * rel_nu) * l_ref;
             if l_ref < 1e-37 {
-                assert!(l < 1e-36, "{} w({theta},{phi}): Λ = {l:e}, ref {l_ref:e}", c.name);
+                assert!(
+                    l < 1e-36,
+                    "{} w({theta},{phi}): Λ = {l:e}, ref {l_ref:e}",
+                    c.name
+                );
             } else {
-                assert!((l - l_ref).abs() <= tol, "{} w({theta},{phi}): Λ = {l:e}, ref {l_ref:e}", c.name);
+                assert!(
+                    (l - l_ref).abs() <= tol,
+                    "{} w({theta},{phi}): Λ = {l:e}, ref {l_ref:e}",
+                    c.name
+                );
             }
         }
     }
@@ -326,7 +342,13 @@ fn chi2_params() -> Vec<LobeParams> {
             ("iso0.3", 0.3, 0.3, 0.0),
             ("aniso", 0.1, 0.4, 0.7),
         ] {
-            v.push((format!("mean({},{}) {label}", mean.0, mean.1), mean, sx, sy, rho));
+            v.push((
+                format!("mean({},{}) {label}", mean.0, mean.1),
+                mean,
+                sx,
+                sy,
+                rho,
+            ));
         }
     }
     v
@@ -366,7 +388,10 @@ fn chi2_sample_normal() {
             let g = &lobe(*mean, *sx, *sy, *rho);
             let sample = |u: Vec2| g.sample_normal(u);
             let center = pilot_center(&sample);
-            chi2_centred(format!("sg normal {name}"), center, sample, |m| g.pdf_normal(m)).err()
+            chi2_centred(format!("sg normal {name}"), center, sample, |m| {
+                g.pdf_normal(m)
+            })
+            .err()
         })
         .collect();
     assert!(failures.is_empty(), "{failures:#?}");
@@ -486,7 +511,10 @@ impl Whitened {
         }
         let z1 = self.z1_of_zeta(zeta);
         let z2 = std_normal().inverse_cdf(xi);
-        let (zx, zy) = (self.e[0] * z1 - self.e[1] * z2, self.e[1] * z1 + self.e[0] * z2);
+        let (zx, zy) = (
+            self.e[0] * z1 - self.e[1] * z2,
+            self.e[1] * z1 + self.e[0] * z2,
+        );
         let [l11, l21, l22] = self.l;
         let sx = self.mu[0] + l11 * zx;
         let sy = self.mu[1] + l21 * zx + l22 * zy;
@@ -509,7 +537,11 @@ fn chi2_sample_visible() {
         } else {
             (-mean.1 as f64).atan2(-mean.0 as f64).to_degrees()
         };
-        let away = if mean == (0.0, 0.0) { 90.0 } else { toward + 180.0 };
+        let away = if mean == (0.0, 0.0) {
+            90.0
+        } else {
+            toward + 180.0
+        };
         jobs.push((name.clone(), mean, sx, sy, rho, 0.0, 0.0));
         for theta in [30.0, 60.0, 80.0, 89.0] {
             jobs.push((name.clone(), mean, sx, sy, rho, theta, toward));
@@ -627,7 +659,8 @@ fn degenerate_directions_and_inputs() {
     // Constructors name the parameter.
     let e = SlopeGaussian::new(Vec2::new(0.0, f32::INFINITY), Mat2::IDENTITY).unwrap_err();
     assert!(e.to_string().contains("`mean`"), "{e}");
-    let e = SlopeGaussian::new(Vec2::ZERO, Mat2::from_cols_array(&[1.0, 0.3, 0.0, 1.0])).unwrap_err();
+    let e =
+        SlopeGaussian::new(Vec2::ZERO, Mat2::from_cols_array(&[1.0, 0.3, 0.0, 1.0])).unwrap_err();
     assert!(e.to_string().contains("`cov`"), "{e}");
     let e = SlopeGaussian::beckmann(-0.1, 0.1).unwrap_err();
     assert!(e.to_string().contains("`alpha_x`"), "{e}");
@@ -650,5 +683,8 @@ fn from_moments_flat_region_is_sigma_min() {
         sigma_major: 0.01,
     };
     let (v, err) = integrate_lobe(&c, &|m: Vec3| g.d(m) as f64 * m.z as f64);
-    assert!((v - 1.0).abs() <= 4.0 * err + float_bound(&c, 1.0), "{v} ± {err}");
+    assert!(
+        (v - 1.0).abs() <= 4.0 * err + float_bound(&c, 1.0),
+        "{v} ± {err}"
+    );
 }

@@ -82,7 +82,7 @@ impl Chi2 {
         let dphi = 2.0 * PI / np as f64;
         let cell_of = |w: Vec3| -> Option<usize> {
             let z = w.z as f64;
-            if !(z >= z_min) || !w.is_finite() {
+            if z.is_nan() || z < z_min || !w.is_finite() {
                 return None;
             }
             let iz = (((z - z_min) / dz) as usize).min(nz - 1);
@@ -116,7 +116,8 @@ impl Chi2 {
                     let st = (1.0 - z * z).max(0.0).sqrt();
                     for &(xp, wp) in &gl {
                         let phi = p0 + 0.5 * dphi * (xp + 1.0);
-                        let w = Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, z as f32);
+                        let w =
+                            Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, z as f32);
                         s += wz * wp * pdf(w);
                     }
                 }

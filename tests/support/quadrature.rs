@@ -62,11 +62,7 @@ pub fn integrate_band(
             let mut ring = 0.0;
             for j in 0..n_phi {
                 let phi = (j as f64 + 0.5) * dphi;
-                let w = Vec3::new(
-                    (st * phi.cos()) as f32,
-                    (st * phi.sin()) as f32,
-                    ct as f32,
-                );
+                let w = Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, ct as f32);
                 ring += g(w);
             }
             total += ring * dphi * st * wx * 0.5 * width;
