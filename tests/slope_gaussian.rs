@@ -555,10 +555,14 @@ fn chi2_sample_visible() {
             let g = lobe(*mean, *sx, *sy, *rho);
             let wo = dir(*theta, *phi);
             let wh = Whitened::new(*mean, *sx, *sy, *rho, wo);
-            Chi2::new(
-                format!("sg visible {name} wo({theta:.0},{phi:.0}) a={:.2}", wh.a),
-                CHI2_FAMILY,
-            )
+            // ζ covers [0, 1] by construction: grid the whole range (no pilot run needed).
+            Chi2 {
+                z_min: Some(0.0),
+                ..Chi2::new(
+                    format!("sg visible {name} wo({theta:.0},{phi:.0}) a={:.2}", wh.a),
+                    CHI2_FAMILY,
+                )
+            }
             .run(
                 |_, u| Some(wh.to_omega(g.sample_visible(wo, u))),
                 |w| wh.pdf_omega(w, |m| g.pdf_visible(wo, m)),

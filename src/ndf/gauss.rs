@@ -37,6 +37,9 @@ pub(crate) fn std_cdf(x: f64) -> f64 {
 /// arithmetic: depth 20 at t = 5 → 2.8e-14; 14 at 7 → 1.3e-14; 10 at 10 → 1.2e-14; 6 at 20 → 2.1e-14).
 /// ε(t) = 1/(t + 2/(t + 3/(t + …))) is the part after the first partial denominator, so that
 /// 1 − t R(t) = ε(t) R(t) exactly (no cancellation).
+///
+/// # Reference
+/// \[AbramowitzStegun1964\] 26.2.14.
 #[inline]
 pub(crate) fn mills_cf(t: f64) -> (f64, f64) {
     let depth = if t < 7.0 {

@@ -443,6 +443,9 @@ impl Ndf for SlopeGaussian {
     ///
     /// z = √(−2 ln u₁) (cos 2πu₂, sin 2πu₂) with u clamped into [2⁻²⁶, 1 − 2⁻²⁶] (NaN → ½), so every
     /// u gives a finite unit upper-hemisphere normal.
+    ///
+    /// # Reference
+    /// \[BoxMuller1958\]; \[Chermain2019\] eq. 2 (the slope density being sampled).
     fn sample_normal(&self, u: Vec2) -> Vec3 {
         let (u1, u2) = (clamp_u(u.x), clamp_u(u.y));
         let r = (-2.0 * u1.ln()).sqrt();
