@@ -154,11 +154,11 @@ impl SlopeGaussian {
     /// The lobe fitted to slope moments, as \[Chermain2019\] eq. 5-6 builds it (infallible, for hot
     /// paths).
     ///
-    /// `m` = [E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]. In `f64`:
-    /// - μ = (E[x̃], E[ỹ]);
-    /// - σx² = max(E[x̃²] − E[x̃]², σ_min²), σy² likewise (the floor: a flat region still reflects
+    /// `m` = `[E(x̃), E(ỹ), E(x̃²), E(ỹ²), E(x̃ỹ)]` (expectations over the footprint). In `f64`:
+    /// - μ = (E(x̃), E(ỹ));
+    /// - σx² = max(E(x̃²) − E(x̃)², σ_min²), σy² likewise (the floor: a flat region still reflects
     ///   like a near-mirror of roughness σ_min, not a Dirac);
-    /// - c = E[x̃ỹ] − E[x̃] E[ỹ] (the paper's eq. 5 prints c², a typo), clamped to
+    /// - c = E(x̃ỹ) − E(x̃) E(ỹ) (the paper's eq. 5 prints c², a typo), clamped to
     ///   |c| ≤ √((σx² − σ_min²)(σy² − σ_min²)). This makes Σ − σ_min² I positive semi-definite, so
     ///   **every** direction of Σ has variance ≥ σ_min² (not only the axes) and Σ is positive definite
     ///   with |Σ| ≥ σ_min⁴. A perfectly correlated (one-dimensional) slope set thus keeps a minor axis
