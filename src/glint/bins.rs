@@ -9,8 +9,8 @@
 //! odd n).
 //!
 //! # Reference
-//! [ShirleyChiu1997] (concentric map); [Snyder1987] (Lambert azimuthal equal-area projection);
-//! [Atanasov2020] §2 (equal-solid-angle direction bins, Fig. 2).
+//! \[ShirleyChiu1997\] (concentric map); \[Snyder1987\] (Lambert azimuthal equal-area projection);
+//! \[Atanasov2020\] §2 (equal-solid-angle direction bins, Fig. 2).
 
 use crate::warp::{hemisphere_to_square_equal_area, square_to_hemisphere_equal_area};
 use crate::{Error, Result};

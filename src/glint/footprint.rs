@@ -17,7 +17,7 @@
 //! (s, s).
 //!
 //! # Reference
-//! [Chermain2019] §4.1 (Gaussian footprint k_P); [Igehy1999] (ray differentials); [Atanasov2020] §2
+//! \[Chermain2019\] §4.1 (Gaussian footprint k_P); \[Igehy1999\] (ray differentials); \[Atanasov2020\] §2
 //! (the pixel footprint A of the bin map, from ray differentials).
 
 use glam::{Mat2, Vec2};
@@ -239,7 +239,7 @@ impl Footprint {
     /// kernel is k_P(p) = exp(−½ (p − c)ᵀ Σ⁻¹ (p − c)) / (2π √det Σ), normalised over the plane.
     ///
     /// # Reference
-    /// [Chermain2019], §4.1.
+    /// \[Chermain2019\], §4.1.
     pub fn gaussian_texels(&self, width: usize, height: usize) -> (Vec2, Mat2) {
         let v = self.texel_view(width, height);
         (to_vec2(v.center), to_mat2(v.cov))

@@ -110,7 +110,7 @@ use crate::ndf::Ndf;
 /// ```
 ///
 /// # Reference
-/// [Chermain2019] §4 (P-NDF, P-Smith term and patch projected area A_P).
+/// \[Chermain2019\] §4 (P-NDF, P-Smith term and patch projected area A_P).
 pub trait GlintNdf {
     /// The P-NDF of one footprint; may borrow the representation.
     type Patch<'a>: Ndf
@@ -118,6 +118,6 @@ pub trait GlintNdf {
         Self: 'a;
 
     /// The P-NDF of the surface seen through one ray footprint:
-    /// D_P(ω_h) = ∫ δ(ω_n(u) − ω_h) k_P(u) du ([Chermain2019] eq. 8), as approximated by the model.
+    /// D_P(ω_h) = ∫ δ(ω_n(u) − ω_h) k_P(u) du (\[Chermain2019\] eq. 8), as approximated by the model.
     fn patch(&self, footprint: &Footprint) -> Self::Patch<'_>;
 }

@@ -4,7 +4,7 @@
 //! docs of [`crate::glint`]; read them there.
 //!
 //! # Reference
-//! [Chermain2019] §3 (slope representation, interpolated normals); [Dupuy2013] (slope moments, mipmaps).
+//! \[Chermain2019\] §3 (slope representation, interpolated normals); \[Dupuy2013\] (slope moments, mipmaps).
 
 use super::moments::MomentPyramid;
 use crate::frame::{normal_to_slope, slope_to_normal};
@@ -349,7 +349,7 @@ impl NormalMap {
     /// Non-finite coordinates are replaced by 0.
     ///
     /// # Reference
-    /// [Chermain2019] §3 (the microsurface is the interpolated normal map).
+    /// \[Chermain2019\] §3 (the microsurface is the interpolated normal map).
     #[inline]
     pub fn normal_at_texel(&self, p: Vec2) -> Vec3 {
         self.blended_normal(p).try_normalize().unwrap_or(Vec3::Z)
@@ -410,19 +410,19 @@ impl NormalMap {
     }
 
     /// The slope moments of every texel of mip level `level` (row major), `None` beyond the last level:
-    /// `[E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]`.
+    /// `[E\[x̃\], E\[ỹ\], E\[x̃²\], E\[ỹ²\], E\[x̃ỹ\]]`.
     ///
     /// Level 0 holds each texel's own slope and its products (x̃, ỹ, x̃², ỹ², x̃ỹ): the texel's slope is
     /// taken as constant over the texel. Level l + 1 has size (max(1, ⌊w/2⌋), max(1, ⌊h/2⌋)) and each of
     /// its texels is the area-weighted average of the level-l texels its rectangle of the uv square
     /// overlaps: for even sizes exactly the 2 × 2 box; an odd size spreads 3 texels over the new texels
-    /// with fractional weights (still a convex combination, so E[x̃²] ≥ E[x̃]² is preserved).
+    /// with fractional weights (still a convex combination, so E\[x̃²\] ≥ E\[x̃\]² is preserved).
     /// Averages are accumulated in f64 and stored in f32.
     ///
     /// The first call builds the whole pyramid (O(texels), parallel); later calls are free.
     ///
     /// # Reference
-    /// [Dupuy2013] (LEAN/LEADR-style moment mipmaps); [Chermain2019] §4.2.2 (mipmapped moments for the
+    /// \[Dupuy2013\] (LEAN/LEADR-style moment mipmaps); \[Chermain2019\] §4.2.2 (mipmapped moments for the
     /// approximate masking).
     pub fn moments(&self, level: usize) -> Option<&[[f32; 5]]> {
         self.pyramid().level(level).map(|l| l.data.as_slice())
@@ -438,13 +438,13 @@ impl NormalMap {
     /// (i, j) has its centre at (i + ½, j + ½) level texels); between the levels ⌊λ⌋ and ⌈λ⌉ linearly.
     ///
     /// The result is a convex combination of level-0 texel moments, so it is a valid set of moments
-    /// (variances E[x̃²] − E[x̃]² ≥ 0 up to rounding). NaN or non-positive radii select level 0, +∞ the
+    /// (variances E\[x̃²\] − E\[x̃\]² ≥ 0 up to rounding). NaN or non-positive radii select level 0, +∞ the
     /// 1 × 1 level;
     /// a non-finite centre is replaced by 0. See [`moments_mean_covariance`] to turn the result into a
     /// mean slope and a covariance.
     ///
     /// # Reference
-    /// [Chermain2019] §4.2.2; [Dupuy2013] §4.
+    /// \[Chermain2019\] §4.2.2; \[Dupuy2013\] §4.
     pub fn filtered_moments(&self, center_texel: Vec2, radius_texels: f32) -> [f32; 5] {
         self.pyramid()
             .filtered(self.width, self.height, center_texel, radius_texels)
@@ -452,15 +452,15 @@ impl NormalMap {
 }
 
 /// The mean slope and the 2 × 2 slope covariance of a set of moments
-/// `[E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]`.
+/// `[E\[x̃\], E\[ỹ\], E\[x̃²\], E\[ỹ²\], E\[x̃ỹ\]]`.
 ///
-/// σx² = E[x̃²] − E[x̃]², σy² = E[ỹ²] − E[ỹ]², c = E[x̃ỹ] − E[x̃]E[ỹ], computed in f64. Rounding can make a
+/// σx² = E\[x̃²\] − E\[x̃\]², σy² = E\[ỹ²\] − E\[ỹ\]², c = E\[x̃ỹ\] − E\[x̃\]E\[ỹ\], computed in f64. Rounding can make a
 /// variance slightly negative: variances are clamped at 0 and the correlation is clamped so that the
 /// matrix stays positive semi-definite (|c| ≤ σx σy). Adding a minimum roughness (e.g. σ_ε² on the
 /// diagonal) is the caller's choice.
 ///
 /// # Reference
-/// [Chermain2019] eq. 5.
+/// \[Chermain2019\] eq. 5.
 pub fn moments_mean_covariance(m: &[f32; 5]) -> (Vec2, glam::Mat2) {
     let [ex, ey, exx, eyy, exy] = m.map(|v| v as f64);
     let vx = (exx - ex * ex).max(0.0);

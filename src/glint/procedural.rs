@@ -1,4 +1,4 @@
-//! Procedural normal maps: stand-ins for the measured maps of [Chermain2019] Fig. 7 (scratched,
+//! Procedural normal maps: stand-ins for the measured maps of \[Chermain2019\] Fig. 7 (scratched,
 //! brushed, bumpy, metallic flakes).
 //!
 //! Every generator is seeded (`u64`) and deterministic whatever the number of rayon threads: random
@@ -129,7 +129,7 @@ fn height_slopes(h: &[f32], width: usize, height: usize) -> Vec<Vec2> {
     out
 }
 
-/// (E[x̃²], E[ỹ²]) of a slope field: per-row f64 sums, then a sequential sum (thread-independent).
+/// (E\[x̃²\], E\[ỹ²\]) of a slope field: per-row f64 sums, then a sequential sum (thread-independent).
 fn mean_square(slopes: &[Vec2], width: usize) -> (f64, f64) {
     let rows: Vec<(f64, f64)> = slopes
         .par_chunks(width)
@@ -184,7 +184,7 @@ fn rms(name: &'static str, value: f32) -> Result<f64> {
     Ok(value as f64)
 }
 
-/// Scales heights so that √((E[x̃²] + E[ỹ²]) / 2) of their slopes is `target` (or √E[ỹ²] when
+/// Scales heights so that √((E\[x̃²\] + E\[ỹ²\]) / 2) of their slopes is `target` (or √E\[ỹ²\] when
 /// `across_only`); returns the slopes. A field without slope fails.
 fn scaled_slopes(
     heights: &[f32],
@@ -221,7 +221,7 @@ fn scaled_slopes(
 /// Heights: periodic white Gaussian noise convolved (with wrapping) with a Gaussian of standard
 /// deviation ℓ/2, ℓ = `correlation_texels`, so the height autocorrelation is ∝ exp(−r²/ℓ²) (ℓ is the
 /// usual correlation length of a Gaussian surface). Slopes: central differences, then one scale factor
-/// on the heights makes the RMS slope over both axes, √((E[x̃²] + E[ỹ²]) / 2) over the texels, equal
+/// on the heights makes the RMS slope over both axes, √((E\[x̃²\] + E\[ỹ²\]) / 2) over the texels, equal
 /// to `rms_slope` exactly (up to f32 rounding). Each axis then matches it within the statistical
 /// fluctuation of the field (a few % when the map spans many correlation lengths); a single factor
 /// keeps the slopes a true gradient field. The slope distribution is close to a centred Gaussian of
@@ -253,7 +253,7 @@ pub fn bumpy(
 /// Parameters of [`brushed`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BrushedParams {
-    /// RMS slope across the brushing direction, √E[ỹ²] (exact after rescaling). Default 0.15.
+    /// RMS slope across the brushing direction, √E\[ỹ²\] (exact after rescaling). Default 0.15.
     pub rms_slope: f32,
     /// Correlation length along the brushing direction (+u), in texels. Default 32.
     pub length_texels: f32,
@@ -275,9 +275,9 @@ impl Default for BrushedParams {
 ///
 /// The same Gaussian random height field as [`bumpy`] with correlation lengths `length_texels` along u
 /// and `width_texels` along v; one factor scales the heights so that the RMS slope across the grooves,
-/// √E[ỹ²], equals `rms_slope`. The RMS slope along them is smaller by about width/length (a stretched
+/// √E\[ỹ²\], equals `rms_slope`. The RMS slope along them is smaller by about width/length (a stretched
 /// field), limited by the central differences at widths near one texel: with the defaults the ratio
-/// √E[ỹ²] / √E[x̃²] is about 13 (tests require > 8). The P-NDF is a thin streak along ỹ.
+/// √E\[ỹ²\] / √E\[x̃²\] is about 13 (tests require > 8). The P-NDF is a thin streak along ỹ.
 ///
 /// # Errors
 /// As [`bumpy`], for each parameter (lengths bounded by the map size along their axis).

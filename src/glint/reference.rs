@@ -9,11 +9,11 @@
 //!
 //! D_P(m) = p(m) / cos θ_m = ∫ δ(ω_n(u) − m) k_P(u) du / cos θ_m,
 //!
-//! i.e. [Chermain2019] eq. 8 with the 1/cos θ that turns "fraction of geometric area" into "microfacet
+//! i.e. \[Chermain2019\] eq. 8 with the 1/cos θ that turns "fraction of geometric area" into "microfacet
 //! area per unit solid angle", the same convention as the mixture's lobes D_i = P22/cos⁴θ (eq. 2).
 //!
 //! # Reference
-//! [Chermain2019] eq. 8 (P-NDF), §5.1.1 (comparison to ground truth), §5.2.2 (naive reference).
+//! \[Chermain2019\] eq. 8 (P-NDF), §5.1.1 (comparison to ground truth), §5.2.2 (naive reference).
 
 use super::bins::HemisphereBins;
 use super::footprint::Footprint;
@@ -150,7 +150,7 @@ fn cholesky(cov: Mat2) -> [f64; 3] {
 
 /// The ground-truth P-NDF of the interpolated normal map seen through `footprint`, binned.
 ///
-/// D_P(m) = ∫ δ(ω_n(u) − m) k_P(u) du / cos θ_m (module docs; [Chermain2019] eq. 8), with k_P the
+/// D_P(m) = ∫ δ(ω_n(u) − m) k_P(u) du / cos θ_m (module docs; \[Chermain2019\] eq. 8), with k_P the
 /// Gaussian or parallelogram view of the footprint in texel units of `map` (clamps included).
 ///
 /// Sampling: [`REFERENCE_BATCHES`] independent batches, each an m × m jittered stratification of the
@@ -168,7 +168,7 @@ fn cholesky(cov: Mat2) -> [f64; 3] {
 /// O(16 · bins) for the per-task histograms.
 ///
 /// # Reference
-/// [Chermain2019] eq. 8, §5.1.1.
+/// \[Chermain2019\] eq. 8, §5.1.1.
 pub fn binned_pndf(
     map: &NormalMap,
     footprint: &Footprint,
@@ -363,7 +363,7 @@ pub fn tv_distance(
 ///
 /// with separable Smith masking of the lobe, G1 = A/V and V(w) = ∫⟨w, m⟩⁺ D dm ([`Ndf::visible_area`];
 /// written with V so that nothing divides by a vanishing A). Averaged over a footprint this converges
-/// to the P-BRDF of [Chermain2019] eq. 7 with the ground-truth P-NDF as σε → 0 (the lobes' A is the
+/// to the P-BRDF of \[Chermain2019\] eq. 7 with the ground-truth P-NDF as σε → 0 (the lobes' A is the
 /// tilted facet's projected area per unit geometric area, like the patch A_P of eq. 17). Use
 /// σε = 0.01 as the paper does.
 ///
@@ -371,7 +371,7 @@ pub fn tv_distance(
 /// outside f32 range give 0.
 ///
 /// # Reference
-/// [Chermain2019] §5.2.2 (naive normal-map reference with σε = 0.01).
+/// \[Chermain2019\] §5.2.2 (naive normal-map reference with σε = 0.01).
 pub fn naive_brdf(map: &NormalMap, uv: Vec2, wo: Vec3, wi: Vec3, sigma_eps: f32) -> f32 {
     if !(crate::frame::is_upper(wo) && crate::frame::is_upper(wi)) {
         return 0.0;
