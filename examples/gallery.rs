@@ -18,11 +18,19 @@ type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
 fn main() -> Res<()> {
     let out = common::out_dir()?;
     let quick = !common::has_flag("--full");
-    let parts: [(&str, &str, Part); 1] = [(
-        "Analytic core",
-        "NDF slices, Smith masking and Fresnel curves.",
-        common::curves::run,
-    )];
+    let parts: [(&str, &str, Part); 2] = [
+        (
+            "Analytic core",
+            "NDF slices, Smith masking and Fresnel curves.",
+            common::curves::run,
+        ),
+        (
+            "Normal maps and ground-truth P-NDFs",
+            "The four procedural maps and the P-NDF of their interpolated normals seen through \
+             footprints of 1 to 4096 texels (projected hemisphere, log scale).",
+            common::pndf_images::run,
+        ),
+    ];
     let mut sections = Vec::new();
     for (title, blurb, run) in parts {
         let t = Instant::now();
