@@ -131,7 +131,7 @@ impl Beckmann {
 /// Returns a finite value for every a > 0 (Λ ≈ 1/(2a√π) → capped at `f32::MAX` as a → 0).
 ///
 /// # Reference
-/// [Walter2007] §5.1 (Beckmann G1), [Heitz2014] (Λ of the Beckmann distribution); the continued fraction is [Abramowitz1964] 7.1.14.
+/// [Walter2007] §5.1 (Beckmann G1), [Heitz2014] (Λ of the Beckmann distribution); the continued fraction is [AbramowitzStegun1964] 7.1.14.
 #[inline]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > 0)` also rejects NaN
 fn lambda_of_a(a: f32) -> f32 {
