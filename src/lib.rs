@@ -29,6 +29,7 @@ pub mod bxdf;
 mod error;
 pub mod frame;
 pub mod fresnel;
+pub mod glint;
 mod math;
 pub mod ndf;
 pub mod warp;

@@ -6,6 +6,11 @@
 //! functions over a dense grid. No `mul_add`: without `target-cpu` flags it becomes a slow software
 //! call, so every polynomial is a plain Horner scheme.
 
+// Coefficients are kept exactly as published; f32 rounds them.
+#![allow(clippy::excessive_precision)]
+// `!(x <= y)` is the intended NaN-rejecting comparison throughout.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 /// 1/√π.
 pub(crate) const INV_SQRT_PI: f32 = 0.564_189_6;
 
@@ -69,7 +74,7 @@ pub(crate) fn erf(x: f32) -> f32 {
     if ax < 0.5 {
         let x2 = x * x;
         // Coefficients (−1)ⁿ / (n! (2n+1)) · 2/√π, n = 0..7.
-        let p = 1.128_379_2
+        let p = std::f32::consts::FRAC_2_SQRT_PI
             + x2 * (-0.376_126_4
                 + x2 * (0.112_837_92
                     + x2 * (-0.026_866_17

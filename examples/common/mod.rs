@@ -5,6 +5,8 @@
 //! `examples/<name>.rs` mains and the `gallery` run the same code.
 #![allow(dead_code)]
 
+pub mod curves;
+pub mod pndf_images;
 pub mod lobes;
 
 use plotters::prelude::*;
@@ -172,6 +174,8 @@ pub struct Chart<'a> {
     pub scatter: bool,
     /// Image size in pixels.
     pub size: (u32, u32),
+    /// Fixed y range (e.g. a floor for log plots of functions that underflow); `None` fits the data.
+    pub y_range: Option<(f64, f64)>,
 }
 
 impl<'a> Chart<'a> {
@@ -186,6 +190,7 @@ impl<'a> Chart<'a> {
             markers: false,
             scatter: false,
             size: (800, 500),
+            y_range: None,
         }
     }
 }
@@ -221,16 +226,24 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
             series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
             chart.x_scale,
         );
-        let (y0, y1) = range_of(
-            series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
-            chart.y_scale,
-        );
+        let (y0, y1) = chart.y_range.unwrap_or_else(|| {
+            range_of(
+                series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+                chart.y_scale,
+            )
+        });
+        let keep_y = |v: f64| keep(v, chart.y_scale) && v >= y0.min(y1) && v <= y0.max(y1);
+        let y_fmt = |v: &f64| match chart.y_scale {
+            Scale::Log => format!("{v:.0e}"),
+            Scale::Linear => format!("{v:.3}"),
+        };
         macro_rules! draw {
             ($ctx:expr) => {{
                 let mut ctx = $ctx;
                 ctx.configure_mesh()
                     .x_desc(chart.x_label)
                     .y_desc(chart.y_label)
+                    .y_label_formatter(&y_fmt)
                     .draw()?;
                 for (i, s) in series.iter().enumerate() {
                     let color = Palette99::pick(i).to_rgba();
@@ -238,7 +251,7 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
                         .points
                         .iter()
                         .copied()
-                        .filter(|p| keep(p.0, chart.x_scale) && keep(p.1, chart.y_scale))
+                        .filter(|p| keep(p.0, chart.x_scale) && keep_y(p.1))
                         .collect();
                     if chart.scatter {
                         ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))?

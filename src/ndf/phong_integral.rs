@@ -96,7 +96,7 @@ pub fn phong_lobe_integral_arvo(n: u32, cos_theta: f32) -> f32 {
     }
     let c = (cos_theta as f64).clamp(-1.0, 1.0);
     let s2 = ((1.0 - c) * (1.0 + c)).max(0.0);
-    let (a, mut k, mut t_k) = if n % 2 == 0 {
+    let (a, mut k, mut t_k) = if n.is_multiple_of(2) {
         (PI / 2.0, 0u32, PI / 2.0)
     } else {
         (PI - c.acos(), 1u32, s2.sqrt())

@@ -1,0 +1,189 @@
+//! The mip chain of slope moments of a normal map (mean slope and second moments per texel).
+//!
+//! Private: exposed through [`NormalMap::moments`](super::NormalMap::moments),
+//! [`NormalMap::filtered_moments`](super::NormalMap::filtered_moments) and friends, where the
+//! definitions are documented.
+
+use glam::Vec2;
+use rayon::prelude::*;
+
+/// One level of the chain: `width × height` texels of `[E\[x̃\], E\[ỹ\], E\[x̃²\], E\[ỹ²\], E\[x̃ỹ\]]`, row major.
+#[derive(Clone, Debug)]
+pub(crate) struct MomentLevel {
+    pub width: usize,
+    pub height: usize,
+    pub data: Vec<[f32; 5]>,
+}
+
+/// The whole chain, level 0 (the map) to the 1 × 1 level.
+#[derive(Clone, Debug)]
+pub(crate) struct MomentPyramid {
+    levels: Vec<MomentLevel>,
+}
+
+/// For a reduction of `n` texels to `m` (m ≤ n) along one axis: for each output texel, the input
+/// texels its interval [o n/m, (o+1) n/m) overlaps, with the overlap fraction as weight (sums to 1).
+fn axis_weights(n: usize, m: usize) -> Vec<Vec<(usize, f64)>> {
+    let ratio = n as f64 / m as f64;
+    (0..m)
+        .map(|o| {
+            let lo = o as f64 * ratio;
+            let hi = ((o + 1) as f64 * ratio).min(n as f64);
+            let first = lo.floor() as usize;
+            let last = (hi.ceil() as usize).min(n);
+            (first..last)
+                .filter_map(|k| {
+                    let w = (hi.min(k as f64 + 1.0) - lo.max(k as f64)) / ratio;
+                    (w > 0.0).then_some((k, w))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+impl MomentPyramid {
+    /// Sizes of every level: each halves both sizes (rounding down, at least 1) until 1 × 1.
+    pub fn level_sizes(width: usize, height: usize) -> Vec<(usize, usize)> {
+        let mut sizes = vec![(width, height)];
+        let (mut w, mut h) = (width, height);
+        while w > 1 || h > 1 {
+            w = (w / 2).max(1);
+            h = (h / 2).max(1);
+            sizes.push((w, h));
+        }
+        sizes
+    }
+
+    /// Builds the chain from the map's slopes (parallel over rows, deterministic).
+    pub fn build(width: usize, height: usize, slopes: &[Vec2]) -> MomentPyramid {
+        let base: Vec<[f32; 5]> = slopes
+            .par_iter()
+            .map(|s| [s.x, s.y, s.x * s.x, s.y * s.y, s.x * s.y])
+            .collect();
+        let mut levels = vec![MomentLevel {
+            width,
+            height,
+            data: base,
+        }];
+        for &(w, h) in &Self::level_sizes(width, height)[1..] {
+            let prev = levels.last().expect("level 0 exists");
+            let next = downsample(prev, w, h);
+            levels.push(next);
+        }
+        MomentPyramid { levels }
+    }
+
+    /// Level `l`, if it exists.
+    pub fn level(&self, l: usize) -> Option<&MomentLevel> {
+        self.levels.get(l)
+    }
+
+    /// Trilinear lookup (see `NormalMap::filtered_moments` for the definition).
+    pub fn filtered(&self, width: usize, height: usize, center: Vec2, radius: f32) -> [f32; 5] {
+        let center = Vec2::select(center.is_finite_mask(), center, Vec2::ZERO);
+        let top = (self.levels.len() - 1) as f32;
+        // NaN and non-positive radii select level 0; +∞ selects the top level.
+        let lod = if radius > 0.0 {
+            (2.0 * radius).log2().clamp(0.0, top)
+        } else {
+            0.0
+        };
+        let l0 = lod.floor();
+        let t = (lod - l0) as f64;
+        let l0 = l0 as usize;
+        let a = self.bilinear(l0, width, height, center);
+        let out = if t > 0.0 && l0 + 1 < self.levels.len() {
+            let b = self.bilinear(l0 + 1, width, height, center);
+            std::array::from_fn(|k| a[k] * (1.0 - t) + b[k] * t)
+        } else {
+            a
+        };
+        out.map(|v| v as f32)
+    }
+
+    /// Bilinear lookup within level `l` at a level-0 texel position, with wrapping.
+    fn bilinear(&self, l: usize, width: usize, height: usize, center: Vec2) -> [f64; 5] {
+        let level = &self.levels[l];
+        // Level texels are (width / w_l) × (height / h_l) level-0 texels wide.
+        let px = center.x as f64 * level.width as f64 / width as f64 - 0.5;
+        let py = center.y as f64 * level.height as f64 / height as f64 - 0.5;
+        let (bx, by) = (px.floor(), py.floor());
+        let (fx, fy) = (px - bx, py - by);
+        let at = |i: f64, j: f64| {
+            let i = (i as i64).rem_euclid(level.width as i64) as usize;
+            let j = (j as i64).rem_euclid(level.height as i64) as usize;
+            level.data[j * level.width + i]
+        };
+        let c = [
+            (at(bx, by), (1.0 - fx) * (1.0 - fy)),
+            (at(bx + 1.0, by), fx * (1.0 - fy)),
+            (at(bx, by + 1.0), (1.0 - fx) * fy),
+            (at(bx + 1.0, by + 1.0), fx * fy),
+        ];
+        std::array::from_fn(|k| c.iter().map(|(m, w)| m[k] as f64 * w).sum())
+    }
+}
+
+/// Area-weighted reduction of one level to `w × h` texels (f64 accumulation, parallel over output rows).
+fn downsample(prev: &MomentLevel, w: usize, h: usize) -> MomentLevel {
+    let wx = axis_weights(prev.width, w);
+    let wy = axis_weights(prev.height, h);
+    let mut data = vec![[0.0f32; 5]; w * h];
+    data.par_chunks_mut(w).enumerate().for_each(|(oy, row)| {
+        let mut acc = vec![[0.0f64; 5]; w];
+        for &(iy, wyk) in &wy[oy] {
+            let src = &prev.data[iy * prev.width..(iy + 1) * prev.width];
+            for (ox, a) in acc.iter_mut().enumerate() {
+                for &(ix, wxk) in &wx[ox] {
+                    let weight = wxk * wyk;
+                    for k in 0..5 {
+                        a[k] += src[ix][k] as f64 * weight;
+                    }
+                }
+            }
+        }
+        for (dst, a) in row.iter_mut().zip(&acc) {
+            *dst = a.map(|v| v as f32);
+        }
+    });
+    MomentLevel {
+        width: w,
+        height: h,
+        data,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weights_partition_each_input() {
+        for (n, m) in [(8, 4), (5, 2), (7, 3), (3, 1), (1, 1), (9, 4)] {
+            let wts = axis_weights(n, m);
+            // Each output's weights sum to 1 (a convex combination)…
+            for o in &wts {
+                let s: f64 = o.iter().map(|p| p.1).sum();
+                assert!((s - 1.0).abs() < 1e-12, "{n}->{m}: {s}");
+            }
+            // …and every input contributes a total of m/n (its area share), so averages are preserved.
+            for k in 0..n {
+                let s: f64 = wts.iter().flatten().filter(|p| p.0 == k).map(|p| p.1).sum();
+                assert!(
+                    (s - m as f64 / n as f64).abs() < 1e-12,
+                    "{n}->{m} input {k}: {s}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn level_sizes_reach_one() {
+        assert_eq!(
+            MomentPyramid::level_sizes(5, 2),
+            vec![(5, 2), (2, 1), (1, 1)]
+        );
+        assert_eq!(MomentPyramid::level_sizes(1, 1), vec![(1, 1)]);
+        assert_eq!(MomentPyramid::level_sizes(8, 8).len(), 4);
+    }
+}
