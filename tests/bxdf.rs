@@ -944,7 +944,7 @@ fn chi2_cases_classic(full: bool) -> Vec<Case> {
     for &g in gammas {
         for (k, &t) in thetas.iter().enumerate() {
             // Default run: alternate the angle between models so that each model sees one of them.
-            let pick = |i: usize| full || (i + k) % 2 == 0;
+            let pick = |i: usize| full || (i + k).is_multiple_of(2);
             if pick(0) {
                 let p = phong(0.5, 0.5, g, PhongNormalization::EnergyConserving);
                 v.push(case(format!("phong lafortune γ={g}"), p, t));

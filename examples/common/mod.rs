@@ -6,8 +6,8 @@
 #![allow(dead_code)]
 
 pub mod curves;
-pub mod pndf_images;
 pub mod lobes;
+pub mod pndf_images;
 
 use plotters::prelude::*;
 use std::error::Error;

@@ -21,7 +21,7 @@ use std::f32::consts::{FRAC_1_PI, PI, TAU};
 /// it decreases toward grazing `wo` (checked by quadrature in `tests/bxdf.rs`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum BlinnPhongNormalization {
-    /// N = (γ+8)/(8π), the popular approximation ([AkenineMoller2008], §7.6). **Gains energy** near
+    /// N = (γ+8)/(8π), the popular approximation (\[AkenineMoller2008\], §7.6). **Gains energy** near
     /// normal incidence: the albedo there is (γ+8)(γ + 2^(−γ/2)) / ((γ+2)(γ+4)), up to ≈ 1.075 near
     /// γ = 10 (→ 1 for γ = 0 and γ → ∞).
     RealTimeRendering,
@@ -49,12 +49,12 @@ impl BlinnPhongNormalization {
 ///
 /// Sampling: the specular lobe is chosen with probability s/(d+s), d = mean(ρ_d), s = mean(ρ_s) times
 /// the lobe's normal-incidence albedo; it draws h with density (γ+1)/(2π) cos^γ θ_h about n and
-/// reflects `wo` about it: p(wi) = (γ+1)/(2π) cos^γ θ_h / (4 wo·h) ([Blinn1977] lobe, the 1/(4 wo·h)
-/// Jacobian of reflection as in [Walter2007], eq. 14). Draws with wo·h ≤ 0 or below the horizon →
+/// reflects `wo` about it: p(wi) = (γ+1)/(2π) cos^γ θ_h / (4 wo·h) (\[Blinn1977\] lobe, the 1/(4 wo·h)
+/// Jacobian of reflection as in \[Walter2007\], eq. 14). Draws with wo·h ≤ 0 or below the horizon →
 /// `None`.
 ///
 /// # Reference
-/// [Blinn1977]; normalisations [AkenineMoller2008] and the derivation in docs/bxdf.md.
+/// \[Blinn1977\]; normalisations \[AkenineMoller2008\] and the derivation in docs/bxdf.md.
 ///
 /// # Degenerate cases
 /// `wo`, `wi` not strictly above the horizon, zero-length or non-finite: f = 0, pdf = 0, `sample` →

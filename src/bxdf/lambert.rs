@@ -30,7 +30,7 @@ pub(crate) fn unit_rgb(name: &'static str, v: Vec3) -> Result<Vec3> {
 /// cos θ_i / π (perfect importance sampling: the weight f cos θ_i / pdf is ρ).
 ///
 /// # Reference
-/// [Lambert1760]; the cosine-weighted hemisphere sampler is [`crate::warp::square_to_cosine_hemisphere`]
+/// \[Lambert1760\]; the cosine-weighted hemisphere sampler is [`crate::warp::square_to_cosine_hemisphere`]
 /// (Malley's method).
 ///
 /// # Degenerate cases

@@ -21,10 +21,10 @@ use glam::{Vec2, Vec3};
 /// Which Smith masking-shadowing function the BRDF uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Masking {
-    /// G2 = G1(wo) G1(wi): masking and shadowing treated as independent ([Walter2007], eq. 23).
+    /// G2 = G1(wo) G1(wi): masking and shadowing treated as independent (\[Walter2007\], eq. 23).
     Separable,
     /// G2 = 1/(1 + Λ(wo) + Λ(wi)): accounts for the correlation of masking and shadowing through the
-    /// height of the microfacet ([Heitz2014], eq. 99). The default: more accurate than the separable
+    /// height of the microfacet (\[Heitz2014\], eq. 99). The default: more accurate than the separable
     /// form for every configuration (the separable form double-counts occlusion), at the same cost.
     #[default]
     HeightCorrelated,
@@ -33,10 +33,10 @@ pub enum Masking {
 /// How [`MicrofacetBrdf::sample`] draws the micronormal.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Sampling {
-    /// m ~ D(m) cos θ_m ([Walter2007], §5.3): ignores `wo`, wastes draws on back-facing normals at
+    /// m ~ D(m) cos θ_m (\[Walter2007\], §5.3): ignores `wo`, wastes draws on back-facing normals at
     /// grazing angles.
     Normals,
-    /// m ~ D_wo(m) = G1(wo, m) ⟨wo, m⟩ D(m) / A(wo), the normals visible from `wo` ([Heitz2014b]):
+    /// m ~ D_wo(m) = G1(wo, m) ⟨wo, m⟩ D(m) / A(wo), the normals visible from `wo` (\[Heitz2014b\]):
     /// lower variance, never a back-facing m. The default.
     #[default]
     VisibleNormals,
@@ -44,9 +44,9 @@ pub enum Sampling {
 
 /// The microfacet BRDF f(wo, wi) = F(wo·h) · G2(wo, wi, h) · D(h) / (4 A(wo) A(wi)), h = normalize(wo + wi).
 ///
-/// With a centred NDF (A = cos θ) this is the Torrance-Sparrow model ([TorranceSparrow1967],
-/// [Walter2007] eq. 20), called Cook-Torrance with Beckmann's D ([CookTorrance1982]); with a glint patch
-/// it is the P-BRDF of [Chermain2019], eq. 7. Implemented as F · D(h)/4 · M(wo, wi) with the masking
+/// With a centred NDF (A = cos θ) this is the Torrance-Sparrow model (\[TorranceSparrow1967\],
+/// \[Walter2007\] eq. 20), called Cook-Torrance with Beckmann's D (\[CookTorrance1982\]); with a glint patch
+/// it is the P-BRDF of \[Chermain2019\], eq. 7. Implemented as F · D(h)/4 · M(wo, wi) with the masking
 /// factor M = G2/(A_o A_i) written through `visible_area` (module docs), so nothing divides by A.
 ///
 /// Reciprocal when F(wo·h) is (it is: wo·h = wi·h) and the NDF's masking is; single scattering only:
@@ -54,17 +54,34 @@ pub enum Sampling {
 /// docs/results.md).
 ///
 /// Sampling: draw m ([`Sampling`]), wi = reflect(wo, m), pdf = p_m(m) / (4 |wo·m|) (the Jacobian of
-/// reflection, [Walter2007] eq. 14). `None` when wo·m ≤ 0 or wi is below the horizon; the pdf is then the
+/// reflection, \[Walter2007\] eq. 14). `None` when wo·m ≤ 0 or wi is below the horizon; the pdf is then the
 /// density of the directions that are produced (it integrates to less than 1 over the hemisphere).
 ///
 /// # Reference
-/// [TorranceSparrow1967]; [CookTorrance1982]; [Walter2007] eq. 20; [Heitz2014] eq. 99;
-/// [Chermain2019] eq. 7.
+/// \[TorranceSparrow1967\]; \[CookTorrance1982\]; \[Walter2007\] eq. 20; \[Heitz2014\] eq. 99;
+/// \[Chermain2019\] eq. 7.
 ///
 /// # Degenerate cases
 /// `wo`, `wi` not strictly above the horizon, zero-length or non-finite, wo = −wi, wo·h ≤ 0, V or the
 /// masking denominator not positive: f = 0, pdf = 0, `sample` → `None`. Values that overflow f32 are
 /// returned as 0.
+///
+/// # Example
+/// ```
+/// use brdf::bxdf::{Bxdf, MicrofacetBrdf};
+/// use brdf::fresnel::SchlickFresnel;
+/// use brdf::ndf::Ggx;
+/// use brdf::{Vec2, Vec3};
+///
+/// let brdf = MicrofacetBrdf::new(Ggx::isotropic(0.3)?, SchlickFresnel::new(Vec3::splat(0.04))?);
+/// let wo = Vec3::new(0.6, 0.0, 0.8);
+/// if let Some(s) = brdf.sample(wo, 0.5, Vec2::new(0.3, 0.7)) {
+///     // With visible-normal sampling the weight f cos θi / pdf is F G2 / G1(wo) <= F.
+///     assert!(s.weight().max_element() <= 1.0);
+///     assert_eq!(s.f, brdf.eval(wo, s.wi));
+/// }
+/// # Ok::<(), brdf::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MicrofacetBrdf<D, F> {
     ndf: D,

@@ -2,6 +2,12 @@
 //!
 //! Frame: local shading frame, z = geometric normal; `wo` (toward the viewer) and `wi` (toward the light)
 //! are unit vectors pointing away from the surface. Reflection needs both strictly above the horizon.
+//!
+//! Models: [`Lambert`]; the Phong family — [`Phong`] (modified form, normalisations in
+//! [`PhongNormalization`], optional Schlick Fresnel) and [`OriginalPhong`] (cos^γ θr / cos θi); the
+//! [`BlinnPhongLobe`]; and [`MicrofacetBrdf`], generic over any [`crate::ndf::Ndf`] (centred NDFs,
+//! non-centred lobes, glint patches) and any [`crate::fresnel::Fresnel`]. Which are reciprocal and which
+//! conserve or normalise energy: docs/bxdf.md.
 
 use glam::{Vec2, Vec3};
 

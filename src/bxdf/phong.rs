@@ -112,23 +112,23 @@ pub enum PhongNormalization {
     ///
     /// Reciprocal. Not energy conserving: E_s(n) = 2πρ_s/(γ+2) exceeds ρ_s for γ < 2π − 2 ≈ 4.28.
     Unnormalized,
-    /// N = (γ+1)/(2π): the factor derived for the *original* Phong form ([Phong1975] as normalised in
+    /// N = (γ+1)/(2π): the factor derived for the *original* Phong form (\[Phong1975\] as normalised in
     /// the lecture), applied to the modified form.
     ///
     /// Reciprocal; energy conserving (E_s ≤ ρ_s (γ+1)/(γ+2) < ρ_s) but loses energy everywhere.
     EnergyConservingOriginal,
-    /// N = (γ+2)/(2π): the modified Phong of [Lafortune1994].
+    /// N = (γ+2)/(2π): the modified Phong of \[Lafortune1994\].
     ///
     /// Reciprocal; energy conserving, with E_s = ρ_s exactly at normal incidence only (it darkens toward
     /// grazing angles).
     EnergyConserving,
-    /// N(wo) = 1/I(γ, cos θ_o) with I by Arvo's recurrence ([Arvo1995]); γ must be an integer
+    /// N(wo) = 1/I(γ, cos θ_o) with I by Arvo's recurrence (\[Arvo1995\]); γ must be an integer
     /// (≤ [`ARVO_MAX_GAMMA`]), cost O(γ) per evaluation.
     ///
     /// Energy normalised: E_s(wo) = ρ_s for every `wo`. Not reciprocal (N depends on `wo` only).
     EnergyNormalizedArvo,
     /// N(wo) = 1/I(γ, cos θ_o) with I in closed form through the incomplete beta function
-    /// ([MallettYuksel2020]); real γ, O(1) per evaluation (one `beta_inc`, ~200 ns).
+    /// (\[MallettYuksel2020\]); real γ, O(1) per evaluation (one `beta_inc`, ~200 ns).
     ///
     /// Energy normalised: E_s(wo) = ρ_s for every `wo`. Not reciprocal.
     EnergyNormalizedMallettYuksel,
@@ -170,12 +170,27 @@ impl PhongNormalization {
 /// choose a lobe.
 ///
 /// # Reference
-/// Lecture [VSB2024] (slides "Modified Phong BRDF", "Energy-normalization"); [Lafortune1994];
-/// [Arvo1995]; [MallettYuksel2020]; Fresnel [Schlick1994].
+/// Lecture \[VSB2024\] (slides "Modified Phong BRDF", "Energy-normalization"); \[Lafortune1994\];
+/// \[Arvo1995\]; \[MallettYuksel2020\]; Fresnel \[Schlick1994\].
 ///
 /// # Degenerate cases
 /// `wo`, `wi` not strictly above the horizon, zero-length or non-finite: f = 0, pdf = 0, `sample` →
 /// `None`. The specular lobe is 0 where cos θ_r ≤ 0 (also for γ = 0).
+///
+/// # Example
+/// ```
+/// use brdf::bxdf::{Bxdf, Phong, PhongNormalization};
+/// use brdf::Vec3;
+///
+/// // Energy normalised: the specular lobe reflects exactly ρ_s for every wo (not reciprocal).
+/// let p = Phong::new(Vec3::splat(0.2), Vec3::splat(0.8), 50.0,
+///                    PhongNormalization::EnergyNormalizedMallettYuksel)?;
+/// assert!(!p.is_reciprocal());
+/// let wo = Vec3::new(0.6, 0.0, 0.8);
+/// let mirror = Vec3::new(-0.6, 0.0, 0.8);
+/// assert!(p.eval(wo, mirror).x > p.eval(wo, Vec3::Z).x);
+/// # Ok::<(), brdf::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Phong {
     rho_d: Vec3,
@@ -368,7 +383,7 @@ pub enum OriginalPhongNormalization {
 /// weight mean(ρ_s) · N · 2π/(γ+1).
 ///
 /// # Reference
-/// [Phong1975]; its reading as a BRDF and the normaliser (γ+1)/(2π): lecture [VSB2024] (slides
+/// \[Phong1975\]; its reading as a BRDF and the normaliser (γ+1)/(2π): lecture \[VSB2024\] (slides
 /// "Modified Phong BRDF", "Original Phong BRDF Energy-conserving").
 ///
 /// # Degenerate cases
