@@ -317,9 +317,9 @@ fn furnace_phong_energy_normalized_is_one() {
 
 #[test]
 fn arvo_and_mallett_yuksel_agree() {
-    // Both compute 1/I(γ, cos θo), by an O(γ) recurrence and by the incomplete beta function, in f32
-    // at the end: they agree to 2e-5 relative (a few f32 ulps plus the ~1e-10 error of statrs'
-    // beta_inc, amplified by at most the condition number of the closed form at these angles).
+    // Both compute I(γ, cos θo) in f64 (an O(γ) recurrence and the incomplete beta function) and
+    // round once to f32 before 1/I: they agree to a few f32 ulps (1e-6 relative ≈ 8 ulps; observed
+    // bit-identical on this grid).
     for gamma in (0..=12).chain([25, 50, 100, 501]) {
         let a = phong(
             0.0,
@@ -337,7 +337,7 @@ fn arvo_and_mallett_yuksel_agree() {
             let wo = support::dir(t, 0.0);
             let (na, nm) = (a.normalizer(wo), m.normalizer(wo));
             assert!(
-                (na - nm).abs() <= 2e-5 * na,
+                (na - nm).abs() <= 1e-6 * na,
                 "γ={gamma} θo={t}: Arvo {na} vs M-Y {nm}"
             );
         }
