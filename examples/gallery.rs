@@ -18,11 +18,17 @@ type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
 fn main() -> Res<()> {
     let out = common::out_dir()?;
     let quick = !common::has_flag("--full");
-    let parts: [(&str, &str, Part); 2] = [
+    let parts: [(&str, &str, Part); 3] = [
         (
             "Analytic core",
             "NDF slices, Smith masking and Fresnel curves.",
             common::curves::run,
+        ),
+        (
+            "Classic BRDF lobes",
+            "f·cos in the plane of incidence (polar plots) and over the projected hemisphere, for \
+             Lambert, the Phong family, Blinn-Phong and the microfacet BRDF.",
+            common::lobes::run,
         ),
         (
             "Normal maps and ground-truth P-NDFs",
