@@ -42,3 +42,8 @@ pub use error::{Error, Result};
 pub use fresnel::Fresnel;
 pub use glam::{Vec2, Vec3};
 pub use ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
+
+/// The README's examples, compiled and run as doctests so that the quick start stays true.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
