@@ -30,6 +30,10 @@ pub mod glint;
 pub mod ndf;
 pub mod warp;
 
+pub use bxdf::{
+    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, MicrofacetBrdf, OriginalPhong, Phong,
+    PhongNormalization,
+};
 pub use error::{Error, Result};
 pub use fresnel::Fresnel;
 pub use glam::{Vec2, Vec3};

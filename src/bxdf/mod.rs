@@ -5,6 +5,20 @@
 
 use glam::{Vec2, Vec3};
 
+mod blinn_phong;
+mod lambert;
+mod lobe;
+mod microfacet;
+mod phong;
+mod shim;
+
+pub use blinn_phong::{BlinnPhongLobe, BlinnPhongNormalization};
+pub use lambert::Lambert;
+pub use microfacet::{Masking, MicrofacetBrdf, Sampling};
+pub use phong::{
+    ARVO_MAX_GAMMA, OriginalPhong, OriginalPhongNormalization, Phong, PhongNormalization,
+};
+
 /// Which kinds of lobe a sample came from (a small bit set).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct LobeFlags(u8);

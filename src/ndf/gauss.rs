@@ -82,7 +82,11 @@ pub(crate) fn ramp_neg(t: f64) -> f64 {
 /// Computed as z + G(−z) for z > 0 (both terms ≥ 0) and [`ramp_neg`]`(−z)` otherwise.
 #[inline]
 pub(crate) fn ramp(z: f64) -> f64 {
-    if z > 0.0 { z + ramp_neg(z) } else { ramp_neg(-z) }
+    if z > 0.0 {
+        z + ramp_neg(z)
+    } else {
+        ramp_neg(-z)
+    }
 }
 
 /// ln N(x; y) and φ(x)/N(x; y), where N(x; y) = G(x) + y Φ(x) = ∫_{−∞}^x (x + y − s) φ(s) ds, y ≥ 0.
@@ -367,7 +371,9 @@ mod tests {
         // G(z) = ∫_{−∞}^z (z − s) φ(s) ds by quadrature on [z − 40, z] (the rest is < e^{−800}).
         // Tolerance 1e-12 relative: the 8-point rule on 400 panels of width 0.1 is exact to ~1e-15
         // for this smooth integrand; the CF branch is within 3e-14 (see `mills_cf`).
-        for &z in &[-30.0, -12.0, -7.5, -5.5, -5.0, -4.9, -2.0, -0.3, 0.0, 0.7, 3.0, 6.0, 20.0] {
+        for &z in &[
+            -30.0, -12.0, -7.5, -5.5, -5.0, -4.9, -2.0, -0.3, 0.0, 0.7, 3.0, 6.0, 20.0,
+        ] {
             let reference = integrate(
                 |s: f64| (z - s) * (-0.5 * s * s).exp() * INV_SQRT_2PI,
                 z - 40.0,
@@ -392,7 +398,10 @@ mod tests {
             let direct = std_pdf(t) - t * 0.5 * libm::erfc(t * FRAC_1_SQRT_2);
             let cf = ramp_neg(t);
             let tol = 4.4e-16 * (0.5 * t * t) * (1.0 + t * t) + 3e-14;
-            assert!(((cf - direct) / direct).abs() < tol, "t = {t}: {cf:e} vs {direct:e}");
+            assert!(
+                ((cf - direct) / direct).abs() < tol,
+                "t = {t}: {cf:e} vs {direct:e}"
+            );
         }
     }
 
@@ -476,8 +485,8 @@ mod tests {
             1.0 - 2f64.powi(-26),
         ];
         let a_values = [
-            -1e4, -300.0, -40.0, -9.0, -6.0, -5.0, -4.9, -2.0, -0.5, -1e-9, 0.0, 1e-9, 0.4, 1.0, 3.0,
-            8.0, 50.0, 1e3, 1e6,
+            -1e4, -300.0, -40.0, -9.0, -6.0, -5.0, -4.9, -2.0, -0.5, -1e-9, 0.0, 1e-9, 0.4, 1.0,
+            3.0, 8.0, 50.0, 1e3, 1e6,
         ];
         for &a in &a_values {
             for &u in &us {
@@ -502,10 +511,8 @@ mod tests {
                 } else {
                     0.0
                 };
-                let tol = 1e-9 * tail
-                    + 1e-15
-                    + direct
-                    + 1e-15 * (1.0 + a.abs()) * (1.0 + (-a).max(0.0));
+                let tol =
+                    1e-9 * tail + 1e-15 + direct + 1e-15 * (1.0 + a.abs()) * (1.0 + (-a).max(0.0));
                 assert!(
                     (f - u).abs() <= tol.max(1e-15),
                     "a = {a}, u = {u}: x = {x}, F(x) = {f} (|F − u| = {:e}, tol {tol:e})",

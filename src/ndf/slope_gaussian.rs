@@ -201,7 +201,11 @@ impl SlopeGaussian {
     /// out so that no code path can fail.
     const UNIT_FALLBACK: Self = SlopeGaussian {
         mean: Vec2::ZERO,
-        chol: [std::f32::consts::FRAC_1_SQRT_2, 0.0, std::f32::consts::FRAC_1_SQRT_2],
+        chol: [
+            std::f32::consts::FRAC_1_SQRT_2,
+            0.0,
+            std::f32::consts::FRAC_1_SQRT_2,
+        ],
         inv_chol: [std::f32::consts::SQRT_2, 0.0, std::f32::consts::SQRT_2],
     };
 
@@ -525,7 +529,11 @@ fn ensure_facing(wo: Vec3, m: Vec3) -> Vec3 {
         m.z as f64 + k * wo.z as f64,
     ];
     let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-    let n = Vec3::new((n[0] / len) as f32, (n[1] / len) as f32, (n[2] / len) as f32);
+    let n = Vec3::new(
+        (n[0] / len) as f32,
+        (n[1] / len) as f32,
+        (n[2] / len) as f32,
+    );
     if n.is_finite() && n.z > 0.0 && facing(wo, n) > 0.0 {
         n
     } else {
@@ -604,7 +612,10 @@ mod tests {
             let p = (-0.5 * q).exp() / (2.0 * PI * sx * sy * (1.0 - rho * rho).sqrt());
             let got = g.p22(Vec2::new(x as f32, y as f32)) as f64;
             // f32 exp of an argument up to ~30: relative error ≤ ~30 × 2⁻²³ ≈ 4e-6, plus storage.
-            assert!((got - p).abs() <= 1e-5 * p + 1e-30, "({x}, {y}): {got} vs {p}");
+            assert!(
+                (got - p).abs() <= 1e-5 * p + 1e-30,
+                "({x}, {y}): {got} vs {p}"
+            );
         }
         assert_eq!(g.p22(Vec2::new(f32::NAN, 0.0)), 0.0);
         assert_eq!(g.p22(Vec2::new(f32::INFINITY, 0.0)), 0.0);
@@ -613,7 +624,12 @@ mod tests {
     #[test]
     fn masking_identities_hold() {
         let g = lobe(0.4, 0.1, 0.3, 0.2, 0.5);
-        for &(x, y, z) in &[(0.0f32, 0.0f32, 1.0f32), (0.5, 0.1, 0.8), (-0.9, 0.2, 0.3), (0.9, 0.3, 0.1)] {
+        for &(x, y, z) in &[
+            (0.0f32, 0.0f32, 1.0f32),
+            (0.5, 0.1, 0.8),
+            (-0.9, 0.2, 0.3),
+            (0.9, 0.3, 0.1),
+        ] {
             let w = Vec3::new(x, y, z).normalize();
             let parts = g.visible_area_parts(w);
             let a = g.projected_area(w);
@@ -670,7 +686,11 @@ mod tests {
         // Perfect correlation along the diagonal: var = 0.05 on both axes, c = 0.05 (ρ = 1).
         let g = SlopeGaussian::from_moments([0.0, 0.0, 0.05, 0.05, 0.05], 0.01);
         let cov = g.covariance();
-        let (sxx, sxy, syy) = (cov.x_axis.x as f64, cov.x_axis.y as f64, cov.y_axis.y as f64);
+        let (sxx, sxy, syy) = (
+            cov.x_axis.x as f64,
+            cov.x_axis.y as f64,
+            cov.y_axis.y as f64,
+        );
         // c clamped to √((σx² − σ²)(σy² − σ²)) = 0.05 − 1e-4: minor eigenvalue exactly σ_min².
         assert!((sxy - (0.05 - 1e-4)).abs() < 1e-8, "{sxy}");
         let mean_eig = 0.5 * (sxx + syy);
@@ -680,7 +700,10 @@ mod tests {
         // Anti-correlated with distinct variances: clamp to −√((0.09 − σ²)(0.01 − σ²)).
         let g = SlopeGaussian::from_moments([0.0, 0.0, 0.09, 0.01, -0.5], 0.01);
         let c = g.covariance().x_axis.y as f64;
-        assert!((c + ((0.09f64 - 1e-4) * (0.01 - 1e-4)).sqrt()).abs() < 1e-8, "{c}");
+        assert!(
+            (c + ((0.09f64 - 1e-4) * (0.01 - 1e-4)).sqrt()).abs() < 1e-8,
+            "{c}"
+        );
 
         // A valid moment set is reproduced: σx = 0.3, σy = 0.1, ρ = 0.4, mean (0.5, 0.2).
         let (mx, my, sx, sy, r) = (0.5f64, 0.2f64, 0.3f64, 0.1f64, 0.4f64);
@@ -716,9 +739,18 @@ mod tests {
         }
         // Bad sigma_min → DEFAULT_SIGMA_MIN; tiny sigma_min → SIGMA_MIN_FLOOR.
         let flat = [0.0, 0.0, 0.0, 0.0, 0.0];
-        assert!(centred(SlopeGaussian::from_moments(flat, f32::NAN), DEFAULT_SIGMA_MIN));
-        assert!(centred(SlopeGaussian::from_moments(flat, -1.0), DEFAULT_SIGMA_MIN));
-        assert!(centred(SlopeGaussian::from_moments(flat, 1e-20), SIGMA_MIN_FLOOR));
+        assert!(centred(
+            SlopeGaussian::from_moments(flat, f32::NAN),
+            DEFAULT_SIGMA_MIN
+        ));
+        assert!(centred(
+            SlopeGaussian::from_moments(flat, -1.0),
+            DEFAULT_SIGMA_MIN
+        ));
+        assert!(centred(
+            SlopeGaussian::from_moments(flat, 1e-20),
+            SIGMA_MIN_FLOOR
+        ));
         // Huge second moments beyond f32-representable lobes: fallback, not a panic.
         let g = SlopeGaussian::from_moments([0.0, 0.0, f32::MAX, f32::MAX, 0.0], 0.01);
         assert!(g.d(Vec3::Z).is_finite());
@@ -728,7 +760,10 @@ mod tests {
     fn bad_constructor_input_names_the_parameter() {
         let id = Mat2::IDENTITY;
         let e = SlopeGaussian::new(Vec2::new(f32::NAN, 0.0), id).unwrap_err();
-        assert!(matches!(e, Error::InvalidParameter { name: "mean", .. }), "{e}");
+        assert!(
+            matches!(e, Error::InvalidParameter { name: "mean", .. }),
+            "{e}"
+        );
         let cases = [
             Mat2::from_cols_array(&[f32::NAN, 0.0, 0.0, 1.0]),
             Mat2::from_cols_array(&[1.0, 0.5, 0.0, 1.0]),
