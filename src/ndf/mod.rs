@@ -5,7 +5,7 @@
 
 use glam::{Vec2, Vec3};
 
-mod gauss;
+pub(crate) mod gauss;
 mod slope_gaussian;
 pub use slope_gaussian::*;
 
