@@ -98,6 +98,7 @@ pub(crate) fn non_negative(name: &'static str, value: f32) -> Result<f32> {
 }
 
 /// Checks that a scalar parameter is finite.
+#[allow(dead_code)] // not used by every layer yet
 pub(crate) fn finite(name: &'static str, value: f32) -> Result<f32> {
     if value.is_finite() {
         Ok(value)

@@ -16,7 +16,10 @@
 //!   unit geometric area (cos θ for centred NDFs). Smith: ∫ ⟨w, m⟩ D(m) dm = A(w) (1 + Λ(w)).
 //! - **Microfacet BRDF.** f = F · G2 · D(h) / (4 A(wo) A(wi)).
 //! - **Values.** `Bxdf::eval` returns f (RGB, no cosine); `pdf` is per unit solid angle of `wi`.
-//! - **Randomness.** Samplers take their random numbers as arguments (`uc: f32`, `u: Vec2`).
+//! - **Randomness.** Samplers take their random numbers as arguments (`uc: f32`, `u: Vec2`); the
+//!   warps from [0, 1)² to disks, hemispheres and cones are in [`warp`].
+//! - **Fresnel.** `eta` = n_inside / n_outside; a negative cosine means light arriving from inside
+//!   (see [`fresnel`]).
 //! - **Roughness.** α is exposed directly. Beckmann α = √2·σ (σ = RMS slope per axis).
 //! - **Precision.** Public API in `f32`; builders and reference integrators accumulate in `f64`.
 //! - **Errors.** Constructors validate and return [`Result`]; evaluation never fails, never panics and
@@ -27,6 +30,7 @@ mod error;
 pub mod frame;
 pub mod fresnel;
 pub mod glint;
+mod math;
 pub mod ndf;
 pub mod warp;
 
@@ -37,4 +41,4 @@ pub use bxdf::{
 pub use error::{Error, Result};
 pub use fresnel::Fresnel;
 pub use glam::{Vec2, Vec3};
-pub use ndf::SlopeGaussian;
+pub use ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};

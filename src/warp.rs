@@ -94,7 +94,7 @@ fn concentric_polar(u: Vec2) -> DiskPolar {
 /// Degenerate cases: `u` is clamped into [0, 1]² (NaN → 0).
 ///
 /// # Reference
-/// [ShirleyChiu1997] (the concentric map; the two-branch form above is the equivalent one without
+/// \[ShirleyChiu1997\] (the concentric map; the two-branch form above is the equivalent one without
 /// the quadrant cases).
 #[inline]
 pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
@@ -111,7 +111,7 @@ pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
 /// and non-finite input, give (½, ½).
 ///
 /// # Reference
-/// [ShirleyChiu1997].
+/// \[ShirleyChiu1997\].
 #[inline]
 pub fn concentric_disk_to_square(p: Vec2) -> Vec2 {
     if !p.is_finite() {
@@ -137,7 +137,7 @@ pub fn concentric_disk_to_square(p: Vec2) -> Vec2 {
 /// may exceed 1 by a rounding error, has density 1/π. Non-finite input gives 0.
 ///
 /// # Reference
-/// [ShirleyChiu1997].
+/// \[ShirleyChiu1997\].
 #[inline]
 pub fn pdf_concentric_disk(p: Vec2) -> f32 {
     if p.length_squared() <= 1.0 + 4.0 * f32::EPSILON {
@@ -155,7 +155,7 @@ pub fn pdf_concentric_disk(p: Vec2) -> f32 {
 /// Degenerate cases: `u` is clamped into [0, 1]² (NaN → 0).
 ///
 /// # Reference
-/// [Malley1988] (project a uniform disk point onto the hemisphere); [ShirleyChiu1997] for the disk.
+/// \[Malley1988\] (project a uniform disk point onto the hemisphere); \[ShirleyChiu1997\] for the disk.
 #[inline]
 pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
     let d = concentric_polar(u);
@@ -170,7 +170,7 @@ pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
 /// maps to the point of its mirror image (x, y, −z). Zero-length or non-finite `w` gives (½, ½).
 ///
 /// # Reference
-/// [Malley1988], [ShirleyChiu1997].
+/// \[Malley1988\], \[ShirleyChiu1997\].
 #[inline]
 pub fn cosine_hemisphere_to_square(w: Vec3) -> Vec2 {
     match w.try_normalize() {
@@ -184,7 +184,7 @@ pub fn cosine_hemisphere_to_square(w: Vec3) -> Vec2 {
 /// `w` must be a unit vector. Directions below the horizon and non-finite input give 0.
 ///
 /// # Reference
-/// [Malley1988].
+/// \[Malley1988\].
 #[inline]
 pub fn pdf_cosine_hemisphere(w: Vec3) -> f32 {
     if w.is_finite() {
@@ -203,7 +203,7 @@ pub fn pdf_cosine_hemisphere(w: Vec3) -> f32 {
 /// Degenerate cases: `u` is clamped into [0, 1]² (NaN → 0); u.x = 0 gives a horizon direction.
 ///
 /// # Reference
-/// Archimedes' hat-box theorem (dω = dz dφ); the sampling form as in [Pharr2023], Appendix A.5.
+/// Archimedes' hat-box theorem (dω = dz dφ); the sampling form as in \[Pharr2023\], Appendix A.5.
 #[inline]
 pub fn square_to_uniform_hemisphere(u: Vec2) -> Vec3 {
     let z = clamp01(u.x);
@@ -219,7 +219,7 @@ pub fn square_to_uniform_hemisphere(u: Vec2) -> Vec3 {
 /// (1, 0), the preimage of the pole.
 ///
 /// # Reference
-/// [Pharr2023], Appendix A.5.
+/// \[Pharr2023\], Appendix A.5.
 #[inline]
 pub fn uniform_hemisphere_to_square(w: Vec3) -> Vec2 {
     match w.try_normalize() {
@@ -233,7 +233,7 @@ pub fn uniform_hemisphere_to_square(w: Vec3) -> Vec2 {
 /// `w` must be a unit vector. Directions below the horizon and non-finite input give 0.
 ///
 /// # Reference
-/// [Pharr2023], Appendix A.5.
+/// \[Pharr2023\], Appendix A.5.
 #[inline]
 pub fn pdf_uniform_hemisphere(w: Vec3) -> f32 {
     if w.z >= 0.0 && w.is_finite() {
@@ -265,7 +265,7 @@ fn cone_cos_max(cos_theta_max: f32) -> f32 {
 /// (−1 is the whole sphere) and NaN counts as 1; cos θ_max = 1 (an empty cone) always returns +z.
 ///
 /// # Reference
-/// [Pharr2023], Appendix A.5 (sampling cones).
+/// \[Pharr2023\], Appendix A.5 (sampling cones).
 #[inline]
 pub fn square_to_uniform_cone(u: Vec2, cos_theta_max: f32) -> Vec3 {
     let c = cone_cos_max(cos_theta_max);
@@ -285,7 +285,7 @@ pub fn square_to_uniform_cone(u: Vec2, cos_theta_max: f32) -> Vec3 {
 /// non-finite `w` gives (0, 0), the preimage of +z.
 ///
 /// # Reference
-/// [Pharr2023], Appendix A.5.
+/// \[Pharr2023\], Appendix A.5.
 #[inline]
 pub fn uniform_cone_to_square(w: Vec3, cos_theta_max: f32) -> Vec2 {
     let c = cone_cos_max(cos_theta_max);
@@ -313,7 +313,7 @@ pub fn uniform_cone_to_square(w: Vec3, cos_theta_max: f32) -> Vec2 {
 /// `cos_theta_max` is clamped into [−1, 1] as in the sampler.
 ///
 /// # Reference
-/// [Pharr2023], Appendix A.5.
+/// \[Pharr2023\], Appendix A.5.
 #[inline]
 pub fn pdf_uniform_cone(w: Vec3, cos_theta_max: f32) -> f32 {
     let c = cone_cos_max(cos_theta_max);
@@ -334,7 +334,7 @@ pub fn pdf_uniform_cone(w: Vec3, cos_theta_max: f32) -> f32 {
 /// Degenerate cases: `u` is clamped as above (NaN → 0); u.x = 0 gives the origin.
 ///
 /// # Reference
-/// [BoxMuller1958].
+/// \[BoxMuller1958\].
 #[inline]
 pub fn square_to_gaussian_2d(u: Vec2) -> Vec2 {
     let ux = clamp01(u.x).min(ONE_MINUS_EPSILON);
@@ -352,7 +352,7 @@ pub fn square_to_gaussian_2d(u: Vec2) -> Vec2 {
 /// input gives (0, 0).
 ///
 /// # Reference
-/// [BoxMuller1958].
+/// \[BoxMuller1958\].
 #[inline]
 pub fn gaussian_2d_to_square(p: Vec2) -> Vec2 {
     if p.is_nan() {
@@ -369,7 +369,7 @@ pub fn gaussian_2d_to_square(p: Vec2) -> Vec2 {
 /// density. Non-finite input gives 0.
 ///
 /// # Reference
-/// [BoxMuller1958].
+/// \[BoxMuller1958\].
 #[inline]
 pub fn pdf_gaussian_2d(p: Vec2) -> f32 {
     if p.is_finite() {
@@ -392,7 +392,7 @@ pub fn pdf_gaussian_2d(p: Vec2) -> f32 {
 /// Degenerate cases: `u` is clamped into [0, 1]² (NaN → 0).
 ///
 /// # Reference
-/// [ShirleyChiu1997] for the disk; [Snyder1987], ch. 24 (Lambert azimuthal equal-area projection:
+/// \[ShirleyChiu1997\] for the disk; \[Snyder1987\], ch. 24 (Lambert azimuthal equal-area projection:
 /// ρ = 2 sin(θ/2), here divided by √2 so that the hemisphere fills the unit disk).
 #[inline]
 pub fn square_to_hemisphere_equal_area(u: Vec2) -> Vec3 {
@@ -414,7 +414,7 @@ pub fn square_to_hemisphere_equal_area(u: Vec2) -> Vec3 {
 /// straight down (−z, no azimuth) counts as +x. Zero-length or non-finite `w` gives (½, ½).
 ///
 /// # Reference
-/// [ShirleyChiu1997], [Snyder1987].
+/// \[ShirleyChiu1997\], \[Snyder1987\].
 #[inline]
 pub fn hemisphere_to_square_equal_area(w: Vec3) -> Vec2 {
     let Some(w) = w.try_normalize() else {
@@ -434,7 +434,7 @@ pub fn hemisphere_to_square_equal_area(w: Vec3) -> Vec2 {
 /// non-finite input the density is 0.
 ///
 /// # Reference
-/// [Snyder1987].
+/// \[Snyder1987\].
 #[inline]
 pub fn pdf_hemisphere_equal_area(w: Vec3) -> f32 {
     pdf_uniform_hemisphere(w)

@@ -210,7 +210,13 @@ fn jacobian_points(concentric: bool, h: f32) -> Vec<Vec2> {
 fn pdf_is_the_inverse_jacobian() {
     let h = 1e-3f32;
     let tol = 2e-3;
-    let directions: [(&str, bool, &dyn Fn(Vec2) -> Vec3, &dyn Fn(Vec3) -> f32); 6] = [
+    type DirectionCase<'a> = (
+        &'a str,
+        bool,
+        &'a dyn Fn(Vec2) -> Vec3,
+        &'a dyn Fn(Vec3) -> f32,
+    );
+    let directions: [DirectionCase; 6] = [
         (
             "cosine",
             true,
@@ -259,7 +265,13 @@ fn pdf_is_the_inverse_jacobian() {
             assert!((product - 1.0).abs() < tol, "{name} at {u}: {product}");
         }
     }
-    let planar: [(&str, bool, &dyn Fn(Vec2) -> Vec2, &dyn Fn(Vec2) -> f32); 2] = [
+    type PlanarCase<'a> = (
+        &'a str,
+        bool,
+        &'a dyn Fn(Vec2) -> Vec2,
+        &'a dyn Fn(Vec2) -> f32,
+    );
+    let planar: [PlanarCase; 2] = [
         (
             "disk",
             true,

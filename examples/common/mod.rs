@@ -5,6 +5,9 @@
 //! `examples/<name>.rs` mains and the `gallery` run the same code.
 #![allow(dead_code)]
 
+pub mod curves;
+pub mod pndf_images;
+
 use plotters::prelude::*;
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -83,7 +86,11 @@ pub fn colormap(t: f32) -> [u8; 3] {
         [0.369, 0.789, 0.383],
         [0.993, 0.906, 0.144],
     ];
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 } * 4.0;
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    } * 4.0;
     let i = (t as usize).min(3);
     let f = t - i as f32;
     let mut out = [0u8; 3];
@@ -166,6 +173,8 @@ pub struct Chart<'a> {
     pub scatter: bool,
     /// Image size in pixels.
     pub size: (u32, u32),
+    /// Fixed y range (e.g. a floor for log plots of functions that underflow); `None` fits the data.
+    pub y_range: Option<(f64, f64)>,
 }
 
 impl<'a> Chart<'a> {
@@ -180,6 +189,7 @@ impl<'a> Chart<'a> {
             markers: false,
             scatter: false,
             size: (800, 500),
+            y_range: None,
         }
     }
 }
@@ -215,16 +225,24 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
             series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
             chart.x_scale,
         );
-        let (y0, y1) = range_of(
-            series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
-            chart.y_scale,
-        );
+        let (y0, y1) = chart.y_range.unwrap_or_else(|| {
+            range_of(
+                series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+                chart.y_scale,
+            )
+        });
+        let keep_y = |v: f64| keep(v, chart.y_scale) && v >= y0.min(y1) && v <= y0.max(y1);
+        let y_fmt = |v: &f64| match chart.y_scale {
+            Scale::Log => format!("{v:.0e}"),
+            Scale::Linear => format!("{v:.3}"),
+        };
         macro_rules! draw {
             ($ctx:expr) => {{
                 let mut ctx = $ctx;
                 ctx.configure_mesh()
                     .x_desc(chart.x_label)
                     .y_desc(chart.y_label)
+                    .y_label_formatter(&y_fmt)
                     .draw()?;
                 for (i, s) in series.iter().enumerate() {
                     let color = Palette99::pick(i).to_rgba();
@@ -232,15 +250,12 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
                         .points
                         .iter()
                         .copied()
-                        .filter(|p| keep(p.0, chart.x_scale) && keep(p.1, chart.y_scale))
+                        .filter(|p| keep(p.0, chart.x_scale) && keep_y(p.1))
                         .collect();
                     if chart.scatter {
-                        ctx.draw_series(
-                            pts.iter()
-                                .map(|&p| Circle::new(p, 4, color.filled())),
-                        )?
-                        .label(s.label.clone())
-                        .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
+                        ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))?
+                            .label(s.label.clone())
+                            .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
                     } else {
                         ctx.draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?
                             .label(s.label.clone())
@@ -274,9 +289,9 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
             (Scale::Linear, Scale::Log) => {
                 draw!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?)
             }
-            (Scale::Log, Scale::Log) => draw!(
-                builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?
-            ),
+            (Scale::Log, Scale::Log) => {
+                draw!(builder.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?)
+            }
         }
         root.present()?;
     }

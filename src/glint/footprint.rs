@@ -17,8 +17,8 @@
 //! (s, s).
 //!
 //! # Reference
-//! [Chermain2019] §4.1 (Gaussian footprint k_P); Igehy 1999 (ray differentials); [Atanasov2020] §4
-//! (parallelogram footprint of the bin map).
+//! \[Chermain2019\] §4.1 (Gaussian footprint k_P); \[Igehy1999\] (ray differentials); \[Atanasov2020\] §2
+//! (the pixel footprint A of the bin map, from ray differentials).
 
 use glam::{Mat2, Vec2};
 
@@ -54,7 +54,9 @@ pub const MAX_EXTENT_PERIODS: f32 = 2.0;
 ///
 /// Build one per shading point with [`Footprint::from_differentials`]; read it in texel units of a map
 /// with [`Footprint::gaussian_texels`] or [`Footprint::parallelogram_texels`]. See the
-/// [module docs](self) for the two views and the clamps.
+/// [`glint` module docs](crate::glint) and the constants for the two views and the clamps; the
+/// source file's module comment has the full discussion. Map sizes of 0 given to the views are
+/// treated as 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Footprint {
     uv: Vec2,
@@ -237,7 +239,7 @@ impl Footprint {
     /// kernel is k_P(p) = exp(−½ (p − c)ᵀ Σ⁻¹ (p − c)) / (2π √det Σ), normalised over the plane.
     ///
     /// # Reference
-    /// [Chermain2019] §4.1.
+    /// \[Chermain2019\], §4.1.
     pub fn gaussian_texels(&self, width: usize, height: usize) -> (Vec2, Mat2) {
         let v = self.texel_view(width, height);
         (to_vec2(v.center), to_mat2(v.cov))

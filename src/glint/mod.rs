@@ -6,17 +6,60 @@
 //! P-NDF D_P(ω_h) (Chermain 2019, eq. 8) is an [`Ndf`] that any microfacet BRDF consumes:
 //! `MicrofacetBrdf::new(model.patch(&footprint), fresnel)`.
 //!
-//! Texel-space conventions (texel (i, j) covers [i, i+1) × [j, j+1) with its sample at the centre,
-//! uv = texel coordinate / size, maps tile, texel row 0 is the bottom row of an image file) are
-//! documented on [`NormalMap`] and in `docs/glint.md`.
+//! More in `docs/glint.md`.
+//!
+//! ## Texel space (every glint model relies on this)
+//!
+//! - A map has `width` × `height` texels (any size ≥ 1 × 1, not necessarily square or a power of two),
+//!   stored row major: texel (i, j) is `slopes()[j * width + i]`, column i ∈ [0, width), row j ∈ [0, height).
+//! - **Texel units.** Texel (i, j) covers the square [i, i + 1) × [j, j + 1); its sample sits at the
+//!   centre (i + ½, j + ½).
+//! - **uv.** uv = texel coordinate / (width, height), so uv ∈ [0, 1)² covers the map once; row j = 0 is
+//!   v = 0. The map **tiles**: every position p ∈ ℝ² is valid and texel indices wrap (`rem_euclid`).
+//! - **Tangent frame.** The slope x̃ is along +u (increasing column), ỹ along +v (increasing row). A
+//!   slope ñ = (x̃, ỹ) is the slope of the normal ω_n = normalize(−x̃, −ỹ, 1) (crate convention), so for a
+//!   height field h the slope is its gradient (∂h/∂u, ∂h/∂v) in texel units (see
+//!   [`NormalMap::from_heights`]).
+//! - **Image files.** Files are stored top row first, but texture coordinates conventionally put v = 0
+//!   at the *bottom* of the picture (OpenGL, pbrt, Blender). The loader follows that convention: the
+//!   **bottom row of the file is texel row 0** (v = 0) and the top row is row `height − 1`, so +v (and the
+//!   slope's ỹ) points up in the picture. With [`TangentConvention::OpenGl`] (green = +Y = up) the green
+//!   channel is then taken as is; [`TangentConvention::DirectX`] (green = down) flips it. A renderer whose
+//!   v = 0 is the *top* of the picture passes (u, 1 − v) and negates the v components of its ray
+//!   differentials.
+//!
+//! ## The reference surface
+//!
+//! The surface a glint model approximates is the **bilinearly interpolated normal map**: at a texel
+//! position p, the four texels whose centres surround p contribute their unit normals with bilinear
+//! weights, and the sum is renormalised ([`NormalMap::normal_at_texel`]). It is continuous everywhere,
+//! across texel and tile borders, and exact at texel centres. Because every stored normal lies strictly
+//! above the horizon, the blend does too, so the interpolated slope is always defined.
+//!
+//! ## Footprints
+//!
+//! A [`Footprint`] has two consistent views: the parallelogram {uv + a ∂uv/∂x + b ∂uv/∂y : a, b ∈
+//! [−½, ½]} and the Gaussian of the same mean and covariance Σ = (∂uv/∂x ∂uv/∂xᵀ + ∂uv/∂y ∂uv/∂yᵀ)/12,
+//! both of area |det| (= 12 √det Σ), read in texel units of a map with documented clamps
+//! ([`MIN_WIDTH_TEXELS`], [`MAX_ANISOTROPY`], [`MAX_EXTENT_PERIODS`]).
+//!
+//! ## Ground truth
+//!
+//! [`binned_pndf`] estimates the P-NDF of the interpolated map through a footprint on equal-area
+//! [`HemisphereBins`], with ∫ D cos θ dω = 1 (D_P(m) = ∫ δ(ω_n(u) − m) k_P(u) du / cos θ_m);
+//! [`tv_distance`] compares a model with it; [`naive_brdf`] is the per-position shading reference.
 
+mod bins;
 mod footprint;
 #[cfg(feature = "image")]
 mod image_io;
 mod mixture;
 mod moments;
 mod normal_map;
+mod procedural;
+mod reference;
 
+pub use bins::HemisphereBins;
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 pub use mixture::{
     BeckmannMixture, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES, DEFAULT_MASKING, DEFAULT_SAMPLES,
@@ -26,6 +69,10 @@ pub use mixture::{
 pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
 };
+pub use procedural::{
+    BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
+};
+pub use reference::{BinnedPndf, Kernel, REFERENCE_BATCHES, binned_pndf, naive_brdf, tv_distance};
 
 use crate::ndf::Ndf;
 
@@ -69,7 +116,7 @@ use crate::ndf::Ndf;
 /// ```
 ///
 /// # Reference
-/// [Chermain2019] §4 (P-NDF, P-Smith term and patch projected area A_P).
+/// \[Chermain2019\] §4 (P-NDF, P-Smith term and patch projected area A_P).
 pub trait GlintNdf {
     /// The P-NDF of one footprint; may borrow the representation.
     type Patch<'a>: Ndf
@@ -77,6 +124,6 @@ pub trait GlintNdf {
         Self: 'a;
 
     /// The P-NDF of the surface seen through one ray footprint:
-    /// D_P(ω_h) = ∫ δ(ω_n(u) − ω_h) k_P(u) du ([Chermain2019] eq. 8), as approximated by the model.
+    /// D_P(ω_h) = ∫ δ(ω_n(u) − ω_h) k_P(u) du (\[Chermain2019\] eq. 8), as approximated by the model.
     fn patch(&self, footprint: &Footprint) -> Self::Patch<'_>;
 }

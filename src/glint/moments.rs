@@ -7,7 +7,7 @@
 use glam::Vec2;
 use rayon::prelude::*;
 
-/// One level of the chain: `width × height` texels of `[E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]`, row major.
+/// One level of the chain: `width × height` texels of `[E\[x̃\], E\[ỹ\], E\[x̃²\], E\[ỹ²\], E\[x̃ỹ\]]`, row major.
 #[derive(Clone, Debug)]
 pub(crate) struct MomentLevel {
     pub width: usize,

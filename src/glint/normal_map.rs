@@ -1,35 +1,10 @@
 //! Normal maps: a tiled grid of per-texel slopes and the bilinearly interpolated surface they define.
 //!
-//! # Texel space (every glint model relies on this)
-//!
-//! - A map has `width` × `height` texels (any size ≥ 1 × 1, not necessarily square or a power of two),
-//!   stored row major: texel (i, j) is `slopes()[j * width + i]`, column i ∈ [0, width), row j ∈ [0, height).
-//! - **Texel units.** Texel (i, j) covers the square [i, i + 1) × [j, j + 1); its sample sits at the
-//!   centre (i + ½, j + ½).
-//! - **uv.** uv = texel coordinate / (width, height), so uv ∈ [0, 1)² covers the map once; row j = 0 is
-//!   v = 0. The map **tiles**: every position p ∈ ℝ² is valid and texel indices wrap (`rem_euclid`).
-//! - **Tangent frame.** The slope x̃ is along +u (increasing column), ỹ along +v (increasing row). A
-//!   slope ñ = (x̃, ỹ) is the slope of the normal ω_n = normalize(−x̃, −ỹ, 1) (crate convention), so for a
-//!   height field h the slope is its gradient (∂h/∂u, ∂h/∂v) in texel units (see
-//!   [`NormalMap::from_heights`]).
-//! - **Image files.** Files are stored top row first, but texture coordinates conventionally put v = 0
-//!   at the *bottom* of the picture (OpenGL, pbrt, Blender). The loader follows that convention: the
-//!   **bottom row of the file is texel row 0** (v = 0) and the top row is row `height − 1`, so +v (and the
-//!   slope's ỹ) points up in the picture. With [`TangentConvention::OpenGl`] (green = +Y = up) the green
-//!   channel is then taken as is; [`TangentConvention::DirectX`] (green = down) flips it. A renderer whose
-//!   v = 0 is the *top* of the picture passes (u, 1 − v) and negates the v components of its ray
-//!   differentials.
-//!
-//! # The reference surface
-//!
-//! The surface a glint model approximates is the **bilinearly interpolated normal map**: at a texel
-//! position p, the four texels whose centres surround p contribute their unit normals with bilinear
-//! weights, and the sum is renormalised ([`NormalMap::normal_at_texel`]). It is continuous everywhere,
-//! across texel and tile borders, and exact at texel centres. Because every stored normal lies strictly
-//! above the horizon, the blend does too, so the interpolated slope is always defined.
+//! The texel-space, uv, tangent-frame and image-file conventions are documented once, in the public
+//! docs of [`crate::glint`]; read them there.
 //!
 //! # Reference
-//! [Chermain2019] §3 (slope representation, interpolated normals); [Dupuy2013] (slope moments, mipmaps).
+//! \[Chermain2019\] §3 (slope representation, interpolated normals); \[Dupuy2013\] (slope moments, mipmaps).
 
 use super::moments::MomentPyramid;
 use crate::frame::{normal_to_slope, slope_to_normal};
@@ -44,7 +19,7 @@ pub const MAX_SLOPE: f32 = 1.0e4;
 
 /// How a normal map file encodes the direction of its green (Y) channel.
 ///
-/// Texel row 0 is the bottom row of the picture (see the [module docs](self)), so +v points up in the
+/// Texel row 0 is the bottom row of the picture (see the [`glint` module docs](crate::glint)), so +v points up in the
 /// picture.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum TangentConvention {
@@ -84,7 +59,7 @@ pub enum NormalRepair {
 
 /// A tiled normal map: per-texel slopes (f32) of a bilinearly interpolated surface.
 ///
-/// See the [module docs](self) for the texel, uv and tangent-frame conventions. Cloning copies the
+/// See the [`glint` module docs](crate::glint) for the texel, uv and tangent-frame conventions. Cloning copies the
 /// slopes; the slope-moment pyramid (built on first use by [`NormalMap::moments`] and friends) is
 /// cloned if it was already built.
 #[derive(Clone)]
@@ -173,6 +148,13 @@ pub(crate) fn check_repair(repair: NormalRepair) -> Result<()> {
             }
         }
     }
+}
+
+/// normalize(−x̃, −ỹ, 1) for a stored slope (finite, |ñ| ≤ MAX_SLOPE, so 1 + |ñ|² neither overflows nor
+/// vanishes): the same value as [`slope_to_normal`] without its fallback checks.
+#[inline]
+fn unit_normal(s: Vec2) -> Vec3 {
+    Vec3::new(-s.x, -s.y, 1.0) / (1.0 + s.length_squared()).sqrt()
 }
 
 /// Wraps a texel index into [0, n).
@@ -330,7 +312,7 @@ impl NormalMap {
     /// The unit normal of texel (i, j), with wrapping: normalize(−x̃, −ỹ, 1).
     #[inline]
     pub fn texel_normal(&self, i: i64, j: i64) -> Vec3 {
-        slope_to_normal(self.texel_slope(i, j))
+        unit_normal(self.texel_slope(i, j))
     }
 
     /// The unnormalised bilinear blend of the four texel normals around the texel position `p`.
@@ -344,13 +326,17 @@ impl NormalMap {
         let q = p - Vec2::splat(0.5);
         let base = q.floor();
         let f = q - base;
-        // Wrap first so that i + 1 cannot overflow (`as` saturates huge coordinates).
-        let i = wrap(base.x as i64, self.width) as i64;
-        let j = wrap(base.y as i64, self.height) as i64;
-        let n00 = self.texel_normal(i, j);
-        let n10 = self.texel_normal(i + 1, j);
-        let n01 = self.texel_normal(i, j + 1);
-        let n11 = self.texel_normal(i + 1, j + 1);
+        // Wrap once (`as` saturates huge coordinates, so nothing overflows); the +1 neighbours wrap by
+        // a comparison instead of a division.
+        let i0 = wrap(base.x as i64, self.width);
+        let j0 = wrap(base.y as i64, self.height);
+        let i1 = if i0 + 1 == self.width { 0 } else { i0 + 1 };
+        let j1 = if j0 + 1 == self.height { 0 } else { j0 + 1 };
+        let (r0, r1) = (j0 * self.width, j1 * self.width);
+        let n00 = unit_normal(self.slopes[r0 + i0]);
+        let n10 = unit_normal(self.slopes[r0 + i1]);
+        let n01 = unit_normal(self.slopes[r1 + i0]);
+        let n11 = unit_normal(self.slopes[r1 + i1]);
         let bottom = n00 * (1.0 - f.x) + n10 * f.x;
         let top = n01 * (1.0 - f.x) + n11 * f.x;
         bottom * (1.0 - f.y) + top * f.y
@@ -363,7 +349,7 @@ impl NormalMap {
     /// Non-finite coordinates are replaced by 0.
     ///
     /// # Reference
-    /// [Chermain2019] §3 (the microsurface is the interpolated normal map).
+    /// \[Chermain2019\] §3 (the microsurface is the interpolated normal map).
     #[inline]
     pub fn normal_at_texel(&self, p: Vec2) -> Vec3 {
         self.blended_normal(p).try_normalize().unwrap_or(Vec3::Z)
@@ -424,19 +410,19 @@ impl NormalMap {
     }
 
     /// The slope moments of every texel of mip level `level` (row major), `None` beyond the last level:
-    /// `[E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]`.
+    /// `[E\[x̃\], E\[ỹ\], E\[x̃²\], E\[ỹ²\], E\[x̃ỹ\]]`.
     ///
     /// Level 0 holds each texel's own slope and its products (x̃, ỹ, x̃², ỹ², x̃ỹ): the texel's slope is
     /// taken as constant over the texel. Level l + 1 has size (max(1, ⌊w/2⌋), max(1, ⌊h/2⌋)) and each of
     /// its texels is the area-weighted average of the level-l texels its rectangle of the uv square
     /// overlaps: for even sizes exactly the 2 × 2 box; an odd size spreads 3 texels over the new texels
-    /// with fractional weights (still a convex combination, so E[x̃²] ≥ E[x̃]² is preserved).
+    /// with fractional weights (still a convex combination, so E\[x̃²\] ≥ E\[x̃\]² is preserved).
     /// Averages are accumulated in f64 and stored in f32.
     ///
     /// The first call builds the whole pyramid (O(texels), parallel); later calls are free.
     ///
     /// # Reference
-    /// [Dupuy2013] (LEAN/LEADR-style moment mipmaps); [Chermain2019] §4.2.2 (mipmapped moments for the
+    /// \[Dupuy2013\] (LEAN/LEADR-style moment mipmaps); \[Chermain2019\] §4.2.2 (mipmapped moments for the
     /// approximate masking).
     pub fn moments(&self, level: usize) -> Option<&[[f32; 5]]> {
         self.pyramid().level(level).map(|l| l.data.as_slice())
@@ -452,13 +438,13 @@ impl NormalMap {
     /// (i, j) has its centre at (i + ½, j + ½) level texels); between the levels ⌊λ⌋ and ⌈λ⌉ linearly.
     ///
     /// The result is a convex combination of level-0 texel moments, so it is a valid set of moments
-    /// (variances E[x̃²] − E[x̃]² ≥ 0 up to rounding). NaN or non-positive radii select level 0, +∞ the
+    /// (variances E\[x̃²\] − E\[x̃\]² ≥ 0 up to rounding). NaN or non-positive radii select level 0, +∞ the
     /// 1 × 1 level;
     /// a non-finite centre is replaced by 0. See [`moments_mean_covariance`] to turn the result into a
     /// mean slope and a covariance.
     ///
     /// # Reference
-    /// [Chermain2019] §4.2.2; [Dupuy2013] §4.
+    /// \[Chermain2019\] §4.2.2; \[Dupuy2013\] §4.
     pub fn filtered_moments(&self, center_texel: Vec2, radius_texels: f32) -> [f32; 5] {
         self.pyramid()
             .filtered(self.width, self.height, center_texel, radius_texels)
@@ -466,15 +452,15 @@ impl NormalMap {
 }
 
 /// The mean slope and the 2 × 2 slope covariance of a set of moments
-/// `[E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]`.
+/// `[E\[x̃\], E\[ỹ\], E\[x̃²\], E\[ỹ²\], E\[x̃ỹ\]]`.
 ///
-/// σx² = E[x̃²] − E[x̃]², σy² = E[ỹ²] − E[ỹ]², c = E[x̃ỹ] − E[x̃]E[ỹ], computed in f64. Rounding can make a
+/// σx² = E\[x̃²\] − E\[x̃\]², σy² = E\[ỹ²\] − E\[ỹ\]², c = E\[x̃ỹ\] − E\[x̃\]E\[ỹ\], computed in f64. Rounding can make a
 /// variance slightly negative: variances are clamped at 0 and the correlation is clamped so that the
 /// matrix stays positive semi-definite (|c| ≤ σx σy). Adding a minimum roughness (e.g. σ_ε² on the
 /// diagonal) is the caller's choice.
 ///
 /// # Reference
-/// [Chermain2019] eq. 5.
+/// \[Chermain2019\] eq. 5.
 pub fn moments_mean_covariance(m: &[f32; 5]) -> (Vec2, glam::Mat2) {
     let [ex, ey, exx, eyy, exy] = m.map(|v| v as f64);
     let vx = (exx - ex * ex).max(0.0);

@@ -3,6 +3,23 @@
 //! Frame: local shading frame, z = geometric normal; `w`, `wo`, `m` are unit vectors pointing away from
 //! the surface. Every NDF is normalised so that ∫ D(m) (m·ω_g) dm = 1 over the hemisphere.
 
+mod beckmann;
+mod blinn_phong;
+mod ggx;
+mod masking;
+mod phong_integral;
+
+pub use beckmann::{
+    Beckmann, MIN_ALPHA, alpha_from_roughness, beckmann_alpha_from_shininess,
+    shininess_from_beckmann_alpha,
+};
+pub use blinn_phong::{BlinnPhong, MAX_GAMMA, MAX_VISIBLE_TRIES};
+pub use ggx::Ggx;
+pub use masking::{
+    g1_vcavity, g2_height_correlated_from_lambda, g2_separable_from_lambda, g2_vcavity,
+};
+pub use phong_integral::{phong_lobe_integral, phong_lobe_integral_arvo};
+
 use glam::{Vec2, Vec3};
 
 pub(crate) mod gauss;

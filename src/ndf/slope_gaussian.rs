@@ -1,12 +1,12 @@
 //! The non-centred anisotropic Beckmann lobe [`SlopeGaussian`]: a 2D Gaussian of slopes with mean μ
-//! and covariance Σ, the building block of the glint mixture of [Chermain2019] (§3.2, eq. 2-6).
+//! and covariance Σ, the building block of the glint mixture of \[Chermain2019\] (§3.2, eq. 2-6).
 //!
 //! A micronormal m = normalize(−x̃, −ỹ, 1) has slope ñ = (x̃, ỹ); the lobe is the slope density
 //! P22(ñ) = exp(−½ (ñ − μ)ᵀ Σ⁻¹ (ñ − μ)) / (2π √|Σ|) and the NDF D(m) = P22(ñ(m)) / cos⁴θ_m.
 //! Its masking terms are exact for every view direction w: with the projected slope q = ñ·(cos φ_w,
 //! sin φ_w) ~ N(q̄, s²), the signed projected area is A_s = cos θ − sin θ q̄, the visible projected area
 //! V(w) = ∫⟨w, m⟩⁺ D dm = s_w G(A_s / s_w) with s_w = sin θ · s and G(z) = E[(z − Z)⁺] the normal ramp,
-//! and Λ = V/A − 1 ([Dupuy2013], [Heitz2014]). Visible normals are sampled exactly by inverting the
+//! and Λ = V/A − 1 (\[Dupuy2013\], \[Heitz2014\]). Visible normals are sampled exactly by inverting the
 //! 1D tilted density ∝ (a − z₁)⁺ φ(z₁) along the view direction in whitened slope space.
 //! Derivations: docs/slope_gaussian.md.
 //!
@@ -20,7 +20,7 @@ use glam::{Mat2, Vec2, Vec3};
 use std::f64::consts::PI;
 
 /// Default floor on the slope standard deviation used by [`SlopeGaussian::from_moments`]:
-/// σ_ε = 0.01, the near-specular roughness of [Chermain2019] §5.2.2.
+/// σ_ε = 0.01, the near-specular roughness of \[Chermain2019\] §5.2.2.
 pub const DEFAULT_SIGMA_MIN: f32 = 0.01;
 
 /// Smallest `sigma_min` that [`SlopeGaussian::from_moments`] honours (smaller positive values are
@@ -53,8 +53,8 @@ const FRAC_1_2PI: f32 = 0.159_154_94;
 /// every lobe, however far its mean is tilted.
 ///
 /// # Reference
-/// [Chermain2019] eq. 2 and 4 (lobe), eq. 5-6 (moments); [Dupuy2013] (Λ of this lobe);
-/// [Heitz2014] (Smith masking, visible normals).
+/// \[Chermain2019\] eq. 2 and 4 (lobe), eq. 5-6 (moments); \[Dupuy2013\] (Λ of this lobe);
+/// \[Heitz2014\] (Smith masking, visible normals).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SlopeGaussian {
     /// Mean slope μ.
@@ -99,7 +99,7 @@ impl SlopeGaussian {
     ///   `f32` range.
     ///
     /// # Reference
-    /// [Chermain2019] eq. 4.
+    /// \[Chermain2019\] eq. 4.
     pub fn new(mean: Vec2, cov: Mat2) -> Result<Self> {
         for v in [mean.x, mean.y] {
             crate::error::finite("mean", v)?;
@@ -121,7 +121,8 @@ impl SlopeGaussian {
             return Err(err("must be symmetric"));
         }
         let sxy = 0.5 * (c01 + c10);
-        if !(c00 * c11 - sxy * sxy > 0.0) {
+        let det = c00 * c11 - sxy * sxy;
+        if det.is_nan() || det <= 0.0 {
             return Err(err("must be positive definite (determinant > 0)"));
         }
         Self::from_cov_f64(mean, c00, sxy, c11)
@@ -137,7 +138,7 @@ impl SlopeGaussian {
     /// `alpha_x * alpha_y` if the lobe leaves the `f32` range (α below ~1e-18 or above ~1e18).
     ///
     /// # Reference
-    /// [Walter2007] eq. 25; [Chermain2019] eq. 2 with μ = 0.
+    /// \[Walter2007\] eq. 25; \[Chermain2019\] eq. 2 with μ = 0.
     pub fn beckmann(alpha_x: f32, alpha_y: f32) -> Result<Self> {
         let ax = positive("alpha_x", alpha_x)? as f64;
         let ay = positive("alpha_y", alpha_y)? as f64;
@@ -150,14 +151,14 @@ impl SlopeGaussian {
         )
     }
 
-    /// The lobe fitted to slope moments, as [Chermain2019] eq. 5-6 builds it (infallible, for hot
+    /// The lobe fitted to slope moments, as \[Chermain2019\] eq. 5-6 builds it (infallible, for hot
     /// paths).
     ///
-    /// `m` = [E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]. In `f64`:
-    /// - μ = (E[x̃], E[ỹ]);
-    /// - σx² = max(E[x̃²] − E[x̃]², σ_min²), σy² likewise (the floor: a flat region still reflects
+    /// `m` = `[E(x̃), E(ỹ), E(x̃²), E(ỹ²), E(x̃ỹ)]` (expectations over the footprint). In `f64`:
+    /// - μ = (E(x̃), E(ỹ));
+    /// - σx² = max(E(x̃²) − E(x̃)², σ_min²), σy² likewise (the floor: a flat region still reflects
     ///   like a near-mirror of roughness σ_min, not a Dirac);
-    /// - c = E[x̃ỹ] − E[x̃] E[ỹ] (the paper's eq. 5 prints c², a typo), clamped to
+    /// - c = E(x̃ỹ) − E(x̃) E(ỹ) (the paper's eq. 5 prints c², a typo), clamped to
     ///   |c| ≤ √((σx² − σ_min²)(σy² − σ_min²)). This makes Σ − σ_min² I positive semi-definite, so
     ///   **every** direction of Σ has variance ≥ σ_min² (not only the axes) and Σ is positive definite
     ///   with |Σ| ≥ σ_min⁴. A perfectly correlated (one-dimensional) slope set thus keeps a minor axis
@@ -170,7 +171,7 @@ impl SlopeGaussian {
     /// above ~1e37), the centred isotropic lobe of σ = σ_min is returned.
     ///
     /// # Reference
-    /// [Chermain2019] eq. 4-6.
+    /// \[Chermain2019\] eq. 4-6.
     pub fn from_moments(m: [f32; 5], sigma_min: f32) -> Self {
         let s = if sigma_min.is_finite() && sigma_min > 0.0 {
             sigma_min.max(SIGMA_MIN_FLOOR)
@@ -218,7 +219,7 @@ impl SlopeGaussian {
         let l11 = sxx.sqrt();
         let l21 = sxy / l11;
         let l22_sq = syy - l21 * l21;
-        if !(l22_sq > 0.0) {
+        if l22_sq.is_nan() || l22_sq <= 0.0 {
             return None;
         }
         let l22 = l22_sq.sqrt();
@@ -266,7 +267,7 @@ impl SlopeGaussian {
     /// The mean normal ω_n̄ = normalize(−μx, −μy, 1): the normal of the mean slope.
     ///
     /// # Reference
-    /// [Chermain2019] eq. 13 (ω_n̄ᵢ).
+    /// \[Chermain2019\] eq. 13 (ω_n̄ᵢ).
     pub fn mean_normal(&self) -> Vec3 {
         slope_to_normal_f64(self.mean.x as f64, self.mean.y as f64)
     }
@@ -276,7 +277,7 @@ impl SlopeGaussian {
     /// `f32`: one 2×2 triangular product and one `exp`. Non-finite slopes give 0.
     ///
     /// # Reference
-    /// [Chermain2019] eq. 4.
+    /// \[Chermain2019\] eq. 4.
     #[inline]
     pub fn p22(&self, slope: Vec2) -> f32 {
         let [i11, i21, i22] = self.inv_chol;
@@ -297,7 +298,7 @@ impl SlopeGaussian {
     /// 0 for w below the horizon or not finite.
     ///
     /// # Reference
-    /// [Chermain2019] eq. 17 (per lobe, unclamped).
+    /// \[Chermain2019\] eq. 17 (per lobe, unclamped).
     #[inline]
     pub fn signed_projected_area(&self, w: Vec3) -> f32 {
         self.view_terms(w).map_or(0.0, |t| t.a_s as f32)
@@ -307,7 +308,7 @@ impl SlopeGaussian {
     /// mixtures that accumulate Σ Wᵢ A_s,i and Σ Wᵢ V_i. Zeros for invalid w.
     ///
     /// # Reference
-    /// [Chermain2019] eq. 13, 17; derivation in docs/slope_gaussian.md.
+    /// \[Chermain2019\] eq. 13, 17; derivation in docs/slope_gaussian.md.
     #[inline]
     pub fn visible_area_parts(&self, w: Vec3) -> VisibleAreaParts {
         match self.view_terms(w) {
@@ -350,7 +351,7 @@ impl SlopeGaussian {
             return None;
         }
         let c = facing(wo, m);
-        if !(c > 0.0) {
+        if c.is_nan() || c <= 0.0 {
             return None;
         }
         let ln_v = if t.s_w > 0.0 {
@@ -378,7 +379,7 @@ impl Ndf for SlopeGaussian {
     /// 0 for m.z ≤ 0 or non-finite m; values beyond `f32::MAX` are clamped to it.
     ///
     /// # Reference
-    /// [Chermain2019] eq. 2.
+    /// \[Chermain2019\] eq. 2.
     #[inline]
     fn d(&self, m: Vec3) -> f32 {
         let Some(s) = crate::frame::normal_to_slope(m) else {
@@ -400,12 +401,12 @@ impl Ndf for SlopeGaussian {
     /// A_s ≤ 0 (the mean facet faces away from w: everything is masked) or when Λ overflows.
     ///
     /// # Reference
-    /// [Dupuy2013] (non-centred anisotropic Beckmann Λ); [Heitz2014] eq. 72 (centred case).
+    /// \[Dupuy2013\] (non-centred anisotropic Beckmann Λ); \[Heitz2014\] eq. 72 (centred case).
     fn lambda(&self, w: Vec3) -> f32 {
         let Some(t) = self.view_terms(w) else {
             return 0.0;
         };
-        if !(t.a_s > 0.0) {
+        if t.a_s.is_nan() || t.a_s <= 0.0 {
             return f32::MAX;
         }
         if t.s_w == 0.0 {
@@ -418,7 +419,7 @@ impl Ndf for SlopeGaussian {
     /// A(w) = max(A_s(w), 0) = max(cos θ − sin θ q̄, 0) = ⟨ω_n̄, w⟩ / (ω_n̄·ω_g).
     ///
     /// # Reference
-    /// [Chermain2019] eq. 17 (one lobe).
+    /// \[Chermain2019\] eq. 17 (one lobe).
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
         self.view_terms(w).map_or(0.0, |t| t.a_s.max(0.0) as f32)
@@ -431,7 +432,7 @@ impl Ndf for SlopeGaussian {
     /// normal incidence. Never divides by sin θ. 0 for invalid w.
     ///
     /// # Reference
-    /// docs/slope_gaussian.md; [Chermain2019] eq. 12-13 (the integral per lobe).
+    /// docs/slope_gaussian.md; \[Chermain2019\] eq. 12-13 (the integral per lobe).
     #[inline]
     fn visible_area(&self, w: Vec3) -> f32 {
         self.view_terms(w)
@@ -442,6 +443,9 @@ impl Ndf for SlopeGaussian {
     ///
     /// z = √(−2 ln u₁) (cos 2πu₂, sin 2πu₂) with u clamped into [2⁻²⁶, 1 − 2⁻²⁶] (NaN → ½), so every
     /// u gives a finite unit upper-hemisphere normal.
+    ///
+    /// # Reference
+    /// \[BoxMuller1958\]; \[Chermain2019\] eq. 2 (the slope density being sampled).
     fn sample_normal(&self, u: Vec2) -> Vec3 {
         let (u1, u2) = (clamp_u(u.x), clamp_u(u.y));
         let r = (-2.0 * u1.ln()).sqrt();
@@ -462,7 +466,7 @@ impl Ndf for SlopeGaussian {
     /// returned normal always has a positive [`Ndf::pdf_visible`].
     ///
     /// # Reference
-    /// [Heitz2014] §5 (visible normals); derivation in docs/slope_gaussian.md.
+    /// \[Heitz2014\] §5 (visible normals); derivation in docs/slope_gaussian.md.
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
         let Some(t) = self.view_terms(wo) else {
             return self.sample_normal(u);

@@ -1,0 +1,87 @@
+//! The crate's main job: every example on embedded defaults, in one run, with an HTML index.
+//!
+//! `cargo run --release --example gallery [-- --out DIR] [--full]`
+//! writes the charts and images of every example into DIR (default `target/brdf-out/`) and an
+//! `index.html` that shows each with one line of explanation. By default the examples run in their
+//! quick settings so that the whole gallery stays within a few minutes on 2 cores; `--full` runs them
+//! at full size.
+
+mod common;
+
+use common::{Artifact, Res};
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
+
+fn main() -> Res<()> {
+    let out = common::out_dir()?;
+    let quick = !common::has_flag("--full");
+    let parts: [(&str, &str, Part); 2] = [
+        (
+            "Analytic core",
+            "NDF slices, Smith masking and Fresnel curves.",
+            common::curves::run,
+        ),
+        (
+            "Normal maps and ground-truth P-NDFs",
+            "The four procedural maps and the P-NDF of their interpolated normals seen through \
+             footprints of 1 to 4096 texels (projected hemisphere, log scale).",
+            common::pndf_images::run,
+        ),
+    ];
+    let mut sections = Vec::new();
+    for (title, blurb, run) in parts {
+        let t = Instant::now();
+        let artifacts = run(&out, quick)?;
+        println!(
+            "{title}: {} files in {:.1} s",
+            artifacts.len(),
+            t.elapsed().as_secs_f64()
+        );
+        sections.push((title, blurb, artifacts));
+    }
+    let index = out.join("index.html");
+    std::fs::write(&index, html(&out, &sections))?;
+    println!("wrote {}", index.display());
+    Ok(())
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+fn html(out: &Path, sections: &[(&str, &str, Vec<Artifact>)]) -> String {
+    let mut s = String::from(
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>brdf gallery</title>\
+         <style>body{font-family:sans-serif;max-width:1100px;margin:auto}figure{display:inline-block;\
+         margin:8px;max-width:520px;vertical-align:top}img{max-width:500px;image-rendering:pixelated}\
+         figcaption{font-size:14px}</style></head><body><h1>brdf gallery</h1>\n",
+    );
+    for (title, blurb, artifacts) in sections {
+        let _ = writeln!(s, "<h2>{}</h2><p>{}</p>", escape(title), escape(blurb));
+        for a in artifacts {
+            let rel = a.path.strip_prefix(out).unwrap_or(&a.path);
+            let rel = escape(&rel.to_string_lossy());
+            let is_image = rel.ends_with(".png") || rel.ends_with(".svg");
+            if is_image {
+                let _ = writeln!(
+                    s,
+                    "<figure><a href=\"{rel}\"><img src=\"{rel}\"></a><figcaption>{}</figcaption></figure>",
+                    escape(&a.caption)
+                );
+            } else {
+                let _ = writeln!(
+                    s,
+                    "<p><a href=\"{rel}\">{rel}</a>: {}</p>",
+                    escape(&a.caption)
+                );
+            }
+        }
+    }
+    s.push_str("</body></html>\n");
+    s
+}
