@@ -474,7 +474,7 @@ impl Ndf for MixturePatch<'_> {
             return 0.0;
         }
         let a = self.projected_area(w);
-        if !(a > 0.0) {
+        if a.is_nan() || a <= 0.0 {
             return f32::MAX;
         }
         let l = (self.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32;
@@ -569,7 +569,7 @@ impl Ndf for MixturePatch<'_> {
             return 0.0;
         }
         let v = self.exact_visible_area(g, wo);
-        if !(v > 0.0) {
+        if v.is_nan() || v <= 0.0 {
             return 0.0;
         }
         let p = (c as f64 * self.untruncated_d(g, m) / v) as f32;
