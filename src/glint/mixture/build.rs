@@ -1,5 +1,5 @@
 //! Per-lobe slope moments of the interpolated normal map under the Gaussian seed kernels k_i,
-//! integrated by quasi-Monte Carlo ([Chermain2019] eq. 5-6).
+//! integrated by quasi-Monte Carlo (\[Chermain2019\] eq. 5-6).
 //!
 //! Every lobe sees the same kernel shape, so the quadrature nodes are computed once: an R2
 //! low-discrepancy point set (Roberts 2018, the additive recurrence with the plastic number) in

@@ -1,4 +1,4 @@
-//! The Beckmann-mixture P-NDF of [Chermain2019]: one non-centred anisotropic Beckmann lobe per seed
+//! The Beckmann-mixture P-NDF of \[Chermain2019\]: one non-centred anisotropic Beckmann lobe per seed
 //! point of a normal map, Gaussian position weights, exact or approximate patch masking, and a
 //! bounding-box hierarchy that keeps D_P evaluations local.
 //!
@@ -23,10 +23,10 @@ use crate::glint::{Footprint, GlintNdf, NormalMap};
 use crate::ndf::SlopeGaussian;
 use hierarchy::{LobePyramid, SlopeTree, lobe_box};
 
-/// Default seed spacing h = 1 texel: one lobe per texel, at the texel centres ([Chermain2019] §5.1.1).
+/// Default seed spacing h = 1 texel: one lobe per texel, at the texel centres (\[Chermain2019\] §5.1.1).
 pub const DEFAULT_SPACING: f32 = 1.0;
 
-/// Default floor σ_ε = 0.01 of the lobes' slope standard deviation ([Chermain2019] §3.2).
+/// Default floor σ_ε = 0.01 of the lobes' slope standard deviation (\[Chermain2019\] §3.2).
 pub const DEFAULT_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
 
 /// Default number of quasi-Monte Carlo nodes per lobe for the moments (eq. 6).
@@ -38,7 +38,7 @@ pub const DEFAULT_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
 pub const DEFAULT_SAMPLES: usize = 256;
 
 /// Default truncation of the seed kernel k_i for the moment integral, in standard deviations per
-/// axis: ±3 σ, the support [Chermain2019] §5 gives k_i (the box holds 99.46 % of its mass; the moments
+/// axis: ±3 σ, the support \[Chermain2019\] §5 gives k_i (the box holds 99.46 % of its mass; the moments
 /// are those of the truncated kernel).
 pub const DEFAULT_KERNEL_SIGMAS: f32 = 3.0;
 
@@ -68,11 +68,11 @@ pub const DEFAULT_MASKING: MaskingMode = MaskingMode::Exact;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum MaskingMode {
     /// Exact: V_P(w) = Σ W_i V_i(w) over every lobe of the footprint, A_P(w) from the patch mean
-    /// slope ([Chermain2019] eq. 13-17). O(lobes) per direction.
+    /// slope (\[Chermain2019\] eq. 13-17). O(lobes) per direction.
     #[default]
     Exact,
     /// Approximate: the Smith terms of one Beckmann lobe filtered from the moment mip chain
-    /// ([Chermain2019] §4.2.2). O(1) per direction.
+    /// (\[Chermain2019\] §4.2.2). O(1) per direction.
     Approximate,
 }
 
@@ -174,7 +174,7 @@ pub struct MixtureMemory {
     pub mip_bytes: usize,
 }
 
-/// The Beckmann-mixture glint representation of a normal map ([Chermain2019]).
+/// The Beckmann-mixture glint representation of a normal map (\[Chermain2019\]).
 ///
 /// The microsurface is Σ_i D_i(ω_m) k_i(u) (eq. 1): seed points u_i on a grid of spacing h, Gaussian
 /// kernels k_i of σ = h / (2√(2 ln 2)) (half the peak at the midpoint between neighbours) with
@@ -186,7 +186,7 @@ pub struct MixtureMemory {
 /// per lobe) and the moment mip chain (~6.7 bytes per lobe), see [`BeckmannMixture::memory`].
 ///
 /// # Reference
-/// [Chermain2019] §3 (eq. 1-6), §4 (eq. 7-17), §5 (hierarchy).
+/// \[Chermain2019\] §3 (eq. 1-6), §4 (eq. 7-17), §5 (hierarchy).
 #[derive(Clone, Debug)]
 pub struct BeckmannMixture {
     width: usize,
@@ -286,7 +286,7 @@ impl BeckmannMixture {
     /// The lobe at grid position (i, j) (wrapping), as a [`SlopeGaussian`].
     ///
     /// # Reference
-    /// [Chermain2019] eq. 2-5.
+    /// \[Chermain2019\] eq. 2-5.
     pub fn lobe(&self, i: i64, j: i64) -> SlopeGaussian {
         let (nx, ny) = (self.grid[0] as i64, self.grid[1] as i64);
         let k = (j.rem_euclid(ny) * nx + i.rem_euclid(nx)) as usize;

@@ -1,5 +1,5 @@
 //! The patch of a footprint: position weights W_i, D_P through the slope-box quadtree, exact and
-//! approximate masking terms, and the two samplers ([Chermain2019] §4-5).
+//! approximate masking terms, and the two samplers (\[Chermain2019\] §4-5).
 //!
 //! Per-footprint work (done once in [`MixturePatch::new`]): the effective Gaussian k_i ∗ k_P in lobe
 //! units, the rectangle of lobes within `weight_sigmas` of it, their normalised weights W_i (stored
@@ -122,7 +122,7 @@ struct Gathered {
 
 /// The P-NDF of one footprint of a [`BeckmannMixture`]: an [`Ndf`] with D_P(h) = Σ W_i D_i(h).
 ///
-/// - `d`: [Chermain2019] eq. 9 through the slope-box quadtree; lobes whose slope box (1 −
+/// - `d`: \[Chermain2019\] eq. 9 through the slope-box quadtree; lobes whose slope box (1 −
 ///   `slope_tail` of their mass) does not contain h's slope are skipped.
 /// - Masking, [`MaskingMode::Exact`]: V_P(w) = Σ W_i V_i(w) (V_i = ∫⟨w,m⟩⁺D_i, always ≥ 0), and the
 ///   **signed** patch projected area A_P(w) = Σ W_i (cos θ − w_xy·μ_i) = cos θ − w_xy·μ_P (μ_P the
@@ -135,7 +135,7 @@ struct Gathered {
 /// - Level of detail: a footprint of more than `lod_lobes` lobes is the filtered lobe alone.
 ///
 /// # Reference
-/// [Chermain2019] eq. 7-17, §4.2.2, §5.
+/// \[Chermain2019\] eq. 7-17, §4.2.2, §5.
 #[derive(Clone, Debug)]
 pub struct MixturePatch<'a> {
     mixture: &'a BeckmannMixture,
@@ -275,7 +275,7 @@ impl<'a> MixturePatch<'a> {
         self.gathered.is_none()
     }
 
-    /// The Beckmann lobe of the footprint's filtered moments ([Chermain2019] §4.2.2): trilinear lookup
+    /// The Beckmann lobe of the footprint's filtered moments (\[Chermain2019\] §4.2.2): trilinear lookup
     /// in the moment mip chain at level log₂(√(footprint area in lobes)).
     pub fn filtered_lobe(&self) -> &SlopeGaussian {
         &self.filtered
@@ -311,7 +311,7 @@ impl<'a> MixturePatch<'a> {
     /// D_P(m) and the number of lobes whose D_i was evaluated (the hierarchy's leaves reached).
     ///
     /// # Reference
-    /// [Chermain2019] eq. 9, §5.
+    /// \[Chermain2019\] eq. 9, §5.
     pub fn d_with_stats(&self, m: Vec3) -> (f32, usize) {
         let Some(g) = &self.gathered else {
             return (self.filtered.d(m), 0);
@@ -405,7 +405,7 @@ impl<'a> MixturePatch<'a> {
     /// (the filtered lobe's under the level of detail).
     ///
     /// # Reference
-    /// [Chermain2019] eq. 12-13 (with V_i in place of the clamped ⟨ω_n̄i, w⟩/(ω_n̄i·ω_g)(1 + Λ_i)).
+    /// \[Chermain2019\] eq. 12-13 (with V_i in place of the clamped ⟨ω_n̄i, w⟩/(ω_n̄i·ω_g)(1 + Λ_i)).
     pub fn visible_area_exact(&self, w: Vec3) -> f32 {
         match &self.gathered {
             Some(g) => self.exact_visible_area(g, w) as f32,
@@ -417,7 +417,7 @@ impl<'a> MixturePatch<'a> {
     /// negative; 0 for invalid w).
     ///
     /// # Reference
-    /// [Chermain2019] eq. 17 without the per-lobe clamp.
+    /// \[Chermain2019\] eq. 17 without the per-lobe clamp.
     pub fn signed_projected_area(&self, w: Vec3) -> f32 {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
@@ -427,7 +427,7 @@ impl<'a> MixturePatch<'a> {
     }
 
     /// The paper's patch projected area with clamped per-lobe areas, Σ W_i max(cos θ − w_xy·μ_i, 0)
-    /// ([Chermain2019] eq. 17 as printed). Not used by the patch (see docs/mixture.md); exposed for
+    /// (\[Chermain2019\] eq. 17 as printed). Not used by the patch (see docs/mixture.md); exposed for
     /// comparison. The filtered lobe's A under the level of detail.
     pub fn paper_projected_area(&self, w: Vec3) -> f32 {
         match &self.gathered {
@@ -459,7 +459,7 @@ impl<'a> MixturePatch<'a> {
 }
 
 impl Ndf for MixturePatch<'_> {
-    /// D_P(m) = Σ W_i D_i(m) ([Chermain2019] eq. 9); see [`MixturePatch::d_with_stats`].
+    /// D_P(m) = Σ W_i D_i(m) (\[Chermain2019\] eq. 9); see [`MixturePatch::d_with_stats`].
     fn d(&self, m: Vec3) -> f32 {
         self.d_with_stats(m).0
     }
@@ -468,7 +468,7 @@ impl Ndf for MixturePatch<'_> {
     /// away from w), 0 for invalid w.
     ///
     /// # Reference
-    /// [Chermain2019] eq. 15 (exact), §4.2.2 (approximate).
+    /// \[Chermain2019\] eq. 15 (exact), §4.2.2 (approximate).
     fn lambda(&self, w: Vec3) -> f32 {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
@@ -484,7 +484,7 @@ impl Ndf for MixturePatch<'_> {
     /// A_P(w): max(signed A_P, 0) (exact) or the filtered lobe's A (approximate / level of detail).
     ///
     /// # Reference
-    /// [Chermain2019] eq. 17, §4.2.2.
+    /// \[Chermain2019\] eq. 17, §4.2.2.
     fn projected_area(&self, w: Vec3) -> f32 {
         match (&self.gathered, self.masking) {
             (Some(_), MaskingMode::Exact) => self.signed_projected_area(w).max(0.0),
