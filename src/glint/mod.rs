@@ -53,6 +53,7 @@ mod bins;
 mod footprint;
 #[cfg(feature = "image")]
 mod image_io;
+mod mixture;
 mod moments;
 mod normal_map;
 mod procedural;
@@ -60,6 +61,11 @@ mod reference;
 
 pub use bins::HemisphereBins;
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
+pub use mixture::{
+    BeckmannMixture, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES, DEFAULT_MASKING, DEFAULT_SAMPLES,
+    DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL, DEFAULT_SPACING, DEFAULT_WEIGHT_SIGMAS, MaskingMode,
+    MixtureMemory, MixtureParams, MixturePatch, PatchOptions,
+};
 pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
 };

@@ -22,7 +22,7 @@ pub use phong_integral::{phong_lobe_integral, phong_lobe_integral_arvo};
 
 use glam::{Vec2, Vec3};
 
-mod gauss;
+pub(crate) mod gauss;
 mod slope_gaussian;
 pub use slope_gaussian::*;
 

@@ -1,0 +1,206 @@
+//! The two pyramids over the lobe grid: the implicit quadtree of slope bounding boxes that prunes
+//! D_P evaluations (\[Chermain2019\] §5), and the mip chain of lobe moments that serves the approximate
+//! masking terms and the level of detail (\[Chermain2019\] §4.2.2).
+//!
+//! Lobes sit on a regular grid, so positions are implicit: a node of level l ≥ 1 is the block of
+//! 2^l × 2^l lobes starting at lobe (x·2^l, y·2^l) (clipped at the grid's edge), and stores only the
+//! union of its lobes' slope boxes as [x_min, y_min, x_max, y_max] in `f32` (16 bytes). Level 0 (the
+//! lobes' own boxes) is not stored: it is rebuilt from the moments at query time by [`lobe_box`].
+
+use crate::ndf::SlopeGaussian;
+use glam::Vec2;
+
+/// The slope box of one lobe: mean ± k (√Σxx, √Σyy), the axis-aligned box of the ellipse
+/// (ñ − μ)ᵀ Σ⁻¹ (ñ − μ) ≤ k², which holds a fraction 1 − e^{−k²/2} of the lobe's mass.
+#[inline]
+pub(super) fn lobe_box(g: &SlopeGaussian, k: f32) -> [f32; 4] {
+    let l = g.cholesky();
+    let (l11, l21, l22) = (l.x_axis.x, l.x_axis.y, l.y_axis.y);
+    let hx = k * l11.abs();
+    let hy = k * (l21 * l21 + l22 * l22).sqrt();
+    let m = g.mean();
+    [m.x - hx, m.y - hy, m.x + hx, m.y + hy]
+}
+
+/// Whether a slope lies in a box (NaN slopes never do).
+#[inline]
+pub(super) fn contains(b: &[f32; 4], s: Vec2) -> bool {
+    s.x >= b[0] && s.y >= b[1] && s.x <= b[2] && s.y <= b[3]
+}
+
+fn union(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
+    [
+        a[0].min(b[0]),
+        a[1].min(b[1]),
+        a[2].max(b[2]),
+        a[3].max(b[3]),
+    ]
+}
+
+/// Sizes of the levels over an `nx × ny` grid: level l has ⌈nx/2^l⌉ × ⌈ny/2^l⌉ nodes, up to 1 × 1.
+pub(super) fn level_sizes(nx: usize, ny: usize) -> Vec<[usize; 2]> {
+    let mut sizes = vec![[nx, ny]];
+    let (mut w, mut h) = (nx, ny);
+    while w > 1 || h > 1 {
+        w = w.div_ceil(2);
+        h = h.div_ceil(2);
+        sizes.push([w, h]);
+    }
+    sizes
+}
+
+/// The implicit quadtree of slope boxes. `boxes[l - 1]` holds level l ≥ 1, row major.
+#[derive(Clone, Debug)]
+pub(super) struct SlopeTree {
+    pub sizes: Vec<[usize; 2]>,
+    pub boxes: Vec<Vec<[f32; 4]>>,
+}
+
+impl SlopeTree {
+    /// Builds the tree from the level-0 boxes (row major over the lobe grid).
+    pub fn build(nx: usize, ny: usize, leaf: &[[f32; 4]]) -> SlopeTree {
+        let sizes = level_sizes(nx, ny);
+        let mut boxes: Vec<Vec<[f32; 4]>> = Vec::with_capacity(sizes.len().saturating_sub(1));
+        for l in 1..sizes.len() {
+            let [pw, ph] = sizes[l - 1];
+            let [w, h] = sizes[l];
+            let prev: &[[f32; 4]] = if l == 1 { leaf } else { &boxes[l - 2] };
+            let mut level = Vec::with_capacity(w * h);
+            for y in 0..h {
+                for x in 0..w {
+                    let mut b = [
+                        f32::INFINITY,
+                        f32::INFINITY,
+                        f32::NEG_INFINITY,
+                        f32::NEG_INFINITY,
+                    ];
+                    for cy in (2 * y)..(2 * y + 2).min(ph) {
+                        for cx in (2 * x)..(2 * x + 2).min(pw) {
+                            b = union(b, prev[cy * pw + cx]);
+                        }
+                    }
+                    level.push(b);
+                }
+            }
+            boxes.push(level);
+        }
+        SlopeTree { sizes, boxes }
+    }
+
+    /// Index of the top level (its single node is the root); 0 for a 1 × 1 grid.
+    #[inline]
+    pub fn top(&self) -> usize {
+        self.sizes.len() - 1
+    }
+
+    /// The box of node (x, y) of level l ≥ 1.
+    #[inline]
+    pub fn node_box(&self, l: usize, x: usize, y: usize) -> &[f32; 4] {
+        &self.boxes[l - 1][y * self.sizes[l][0] + x]
+    }
+
+    /// Bytes held by the tree's boxes.
+    pub fn bytes(&self) -> usize {
+        self.boxes.iter().map(|b| b.len() * 16).sum()
+    }
+}
+
+/// The mip chain of lobe moments: level 0 = the lobes, level l + 1 = the average of the (up to)
+/// 2 × 2 children of each node, accumulated in `f64`.
+#[derive(Clone, Debug)]
+pub(super) struct LobePyramid {
+    pub sizes: Vec<[usize; 2]>,
+    /// `levels[l - 1]` holds level l ≥ 1 (level 0 is the lobe array itself).
+    pub levels: Vec<Vec<[f32; 5]>>,
+}
+
+impl LobePyramid {
+    pub fn build(nx: usize, ny: usize, lobes: &[[f32; 5]]) -> LobePyramid {
+        let sizes = level_sizes(nx, ny);
+        let mut levels: Vec<Vec<[f32; 5]>> = Vec::new();
+        for l in 1..sizes.len() {
+            let [pw, ph] = sizes[l - 1];
+            let [w, h] = sizes[l];
+            let prev: &[[f32; 5]] = if l == 1 { lobes } else { &levels[l - 2] };
+            let mut level = Vec::with_capacity(w * h);
+            for y in 0..h {
+                for x in 0..w {
+                    let mut acc = [0.0f64; 5];
+                    let mut n = 0.0;
+                    for cy in (2 * y)..(2 * y + 2).min(ph) {
+                        for cx in (2 * x)..(2 * x + 2).min(pw) {
+                            let m = prev[cy * pw + cx];
+                            for k in 0..5 {
+                                acc[k] += m[k] as f64;
+                            }
+                            n += 1.0;
+                        }
+                    }
+                    level.push(acc.map(|v| (v / n) as f32));
+                }
+            }
+            levels.push(level);
+        }
+        LobePyramid { sizes, levels }
+    }
+
+    fn level<'a>(&'a self, lobes: &'a [[f32; 5]], l: usize) -> &'a [[f32; 5]] {
+        if l == 0 { lobes } else { &self.levels[l - 1] }
+    }
+
+    /// Bilinear lookup of level `l` at a position given in lobe units (lobe i has its centre at
+    /// i + ½), with wrapping; in `f64`.
+    fn bilinear(&self, lobes: &[[f32; 5]], l: usize, p: [f64; 2]) -> [f64; 5] {
+        let [w, h] = self.sizes[l];
+        let data = self.level(lobes, l);
+        let scale = (1u64 << l) as f64;
+        let px = p[0] / scale - 0.5;
+        let py = p[1] / scale - 0.5;
+        let (bx, by) = (px.floor(), py.floor());
+        let (fx, fy) = (px - bx, py - by);
+        let at = |i: f64, j: f64| {
+            let i = (i as i64).rem_euclid(w as i64) as usize;
+            let j = (j as i64).rem_euclid(h as i64) as usize;
+            data[j * w + i]
+        };
+        let c = [
+            (at(bx, by), (1.0 - fx) * (1.0 - fy)),
+            (at(bx + 1.0, by), fx * (1.0 - fy)),
+            (at(bx, by + 1.0), (1.0 - fx) * fy),
+            (at(bx + 1.0, by + 1.0), fx * fy),
+        ];
+        std::array::from_fn(|k| c.iter().map(|(m, wt)| m[k] as f64 * wt).sum())
+    }
+
+    /// Trilinear lookup: level of detail `lod` (clamped to [0, top], NaN → 0), position in lobe
+    /// units. A convex combination of lobe moments, so a valid moment set.
+    pub fn filtered(&self, lobes: &[[f32; 5]], p: [f64; 2], lod: f64) -> [f32; 5] {
+        let top = (self.sizes.len() - 1) as f64;
+        let lod = if lod.is_nan() {
+            0.0
+        } else {
+            lod.clamp(0.0, top)
+        };
+        let p = if p[0].is_finite() && p[1].is_finite() {
+            p
+        } else {
+            [0.0, 0.0]
+        };
+        let l0 = lod.floor();
+        let t = lod - l0;
+        let l0 = l0 as usize;
+        let a = self.bilinear(lobes, l0, p);
+        let out = if t > 0.0 && l0 + 1 < self.sizes.len() {
+            let b = self.bilinear(lobes, l0 + 1, p);
+            std::array::from_fn(|k| a[k] * (1.0 - t) + b[k] * t)
+        } else {
+            a
+        };
+        out.map(|v| v as f32)
+    }
+
+    /// Bytes held by levels ≥ 1.
+    pub fn bytes(&self) -> usize {
+        self.levels.iter().map(|l| l.len() * 20).sum()
+    }
+}

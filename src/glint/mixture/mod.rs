@@ -1,0 +1,329 @@
+//! The Beckmann-mixture P-NDF of \[Chermain2019\]: one non-centred anisotropic Beckmann lobe per seed
+//! point of a normal map, Gaussian position weights, exact or approximate patch masking, and a
+//! bounding-box hierarchy that keeps D_P evaluations local.
+//!
+//! - [`BeckmannMixture::build`] integrates the five slope moments of the *interpolated* normal map
+//!   under each seed kernel k_i (eq. 5-6) and stores them (5 `f32` per lobe), with an implicit
+//!   quadtree of slope boxes (§5) and a mip chain of the moments (§4.2.2).
+//! - [`BeckmannMixture::patch`] turns a [`Footprint`] into a [`MixturePatch`], an [`Ndf`](crate::ndf::Ndf) whose
+//!   D_P(h) = Σ W_i D_i(h) (eq. 9) and whose masking terms are exact (eq. 10-17) or approximate
+//!   (§4.2.2), so that `MicrofacetBrdf::new(patch, fresnel)` is the P-BRDF of eq. 7.
+//!
+//! The model, the hierarchy layout, the deviations from the paper and the defaults with their
+//! measurements are in docs/mixture.md.
+
+mod build;
+mod hierarchy;
+mod patch;
+
+pub use patch::MixturePatch;
+
+use crate::error::{Error, Result, positive};
+use crate::glint::{Footprint, GlintNdf, NormalMap};
+use crate::ndf::SlopeGaussian;
+use hierarchy::{LobePyramid, SlopeTree, lobe_box};
+
+/// Default seed spacing h = 1 texel: one lobe per texel, at the texel centres (\[Chermain2019\] §5.1.1).
+pub const DEFAULT_SPACING: f32 = 1.0;
+
+/// Default floor σ_ε = 0.01 of the lobes' slope standard deviation (\[Chermain2019\] §3.2).
+pub const DEFAULT_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
+
+/// Default number of quasi-Monte Carlo nodes per lobe for the moments (eq. 6).
+///
+/// Measured (docs/results.md, `accuracy_table` test, 64² crops of the four procedural maps): the
+/// largest error of any lobe's slope standard deviation against 16384 nodes is 0.29-0.87 σ_ε at 256
+/// nodes (1.0-2.5 σ_ε at 64, 2.9-7.6 σ_ε at 16), the largest mean-slope error 1.7e-3-4.3e-3. Cost is
+/// linear in the count (one interpolated-normal lookup per node).
+pub const DEFAULT_SAMPLES: usize = 256;
+
+/// Default truncation of the seed kernel k_i for the moment integral, in standard deviations per
+/// axis: ±3 σ, the support \[Chermain2019\] §5 gives k_i (the box holds 99.46 % of its mass; the moments
+/// are those of the truncated kernel).
+pub const DEFAULT_KERNEL_SIGMAS: f32 = 3.0;
+
+/// Default truncation of the position weights W_i: lobes whose centre lies more than this many
+/// standard deviations of k_i ∗ k_P from the footprint centre, along either axis, are left out
+/// (then the kept weights are renormalised to sum to 1). 3, as the paper's ±3σ boxes.
+pub const DEFAULT_WEIGHT_SIGMAS: f32 = 3.0;
+
+/// Default tail mass left outside a lobe's slope bounding box: 10⁻⁶.
+///
+/// The box is that of the ellipse holding 1 − tail of the lobe, k² = −2 ln(tail) (k = 5.26 here);
+/// D_P ignores a lobe outside its box, so D_P integrates to at least 1 − tail and the samplers (which
+/// draw the untruncated lobes) disagree with the pdf by at most `tail` in total variation. The paper
+/// uses the 99 % box (tail 0.01, k = 3.03): 1.8× fewer lobes touched per query (docs/mixture.md) but
+/// a normalisation error up to 1 %.
+pub const DEFAULT_SLOPE_TAIL: f32 = 1.0e-6;
+
+/// Default level-of-detail threshold: footprints covering more than this many lobes (area in lobe
+/// cells) are served by the single filtered lobe (D, masking and sampling). See docs/mixture.md for
+/// the error and time measurements behind it.
+pub const DEFAULT_LOD_LOBES: f32 = 16384.0;
+
+/// Default masking mode of patches.
+pub const DEFAULT_MASKING: MaskingMode = MaskingMode::Exact;
+
+/// How a patch computes A_P, Λ_P (and so G1, G2 and the P-BRDF's normalisation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum MaskingMode {
+    /// Exact: V_P(w) = Σ W_i V_i(w) over every lobe of the footprint, A_P(w) from the patch mean
+    /// slope (\[Chermain2019\] eq. 13-17). O(lobes) per direction.
+    #[default]
+    Exact,
+    /// Approximate: the Smith terms of one Beckmann lobe filtered from the moment mip chain
+    /// (\[Chermain2019\] §4.2.2). O(1) per direction.
+    Approximate,
+}
+
+/// Per-patch options: the masking mode and the level-of-detail threshold.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PatchOptions {
+    /// Exact or approximate masking terms ([`DEFAULT_MASKING`]).
+    pub masking: MaskingMode,
+    /// Footprints of more than this many lobes use the filtered lobe alone ([`DEFAULT_LOD_LOBES`]);
+    /// `f32::INFINITY` disables the rule.
+    pub lod_lobes: f32,
+}
+
+impl Default for PatchOptions {
+    fn default() -> Self {
+        PatchOptions {
+            masking: DEFAULT_MASKING,
+            lod_lobes: DEFAULT_LOD_LOBES,
+        }
+    }
+}
+
+/// Build parameters of a [`BeckmannMixture`]. `Default` gives the documented `DEFAULT_*` values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MixtureParams {
+    /// Seed spacing h in texels (> 0). The lobe grid has max(1, round(width / h)) × max(1,
+    /// round(height / h)) lobes, so the spacing actually used per axis is width / nx (height / ny):
+    /// an integer number of lobes tiles the map.
+    pub spacing: f32,
+    /// Floor σ_ε of the lobes' slope standard deviation (> 0).
+    pub sigma_min: f32,
+    /// Quasi-Monte Carlo nodes per lobe for the moments (≥ 1).
+    pub samples: usize,
+    /// Truncation of k_i for the moment integral, in σ (> 0).
+    pub kernel_sigmas: f32,
+    /// Truncation of the position weights, in σ (> 0).
+    pub weight_sigmas: f32,
+    /// Mass left outside each lobe's slope box (0 < tail < 1).
+    pub slope_tail: f32,
+    /// Options of the patches made by [`GlintNdf::patch`].
+    pub patch: PatchOptions,
+}
+
+impl Default for MixtureParams {
+    fn default() -> Self {
+        MixtureParams {
+            spacing: DEFAULT_SPACING,
+            sigma_min: DEFAULT_SIGMA_MIN,
+            samples: DEFAULT_SAMPLES,
+            kernel_sigmas: DEFAULT_KERNEL_SIGMAS,
+            weight_sigmas: DEFAULT_WEIGHT_SIGMAS,
+            slope_tail: DEFAULT_SLOPE_TAIL,
+            patch: PatchOptions::default(),
+        }
+    }
+}
+
+impl MixtureParams {
+    fn validate(&self) -> Result<()> {
+        positive("spacing", self.spacing)?;
+        positive("sigma_min", self.sigma_min)?;
+        positive("kernel_sigmas", self.kernel_sigmas)?;
+        positive("weight_sigmas", self.weight_sigmas)?;
+        if self.samples == 0 {
+            return Err(Error::InvalidParameter {
+                name: "samples",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
+        }
+        if !(self.slope_tail > 0.0 && self.slope_tail < 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "slope_tail",
+                value: self.slope_tail as f64,
+                reason: "must be in (0, 1)",
+            });
+        }
+        if self.patch.lod_lobes.is_nan() || self.patch.lod_lobes < 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "lod_lobes",
+                value: self.patch.lod_lobes as f64,
+                reason: "must be >= 0 (infinity disables the level of detail)",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Memory held by a [`BeckmannMixture`], in bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MixtureMemory {
+    /// Number of lobes.
+    pub lobes: usize,
+    /// The lobes' moments (20 bytes each).
+    pub lobe_bytes: usize,
+    /// The slope-box quadtree (levels ≥ 1, 16 bytes per node).
+    pub hierarchy_bytes: usize,
+    /// The moment mip chain above the lobes (20 bytes per node), for approximate masking and LOD.
+    pub mip_bytes: usize,
+}
+
+/// The Beckmann-mixture glint representation of a normal map (\[Chermain2019\]).
+///
+/// The microsurface is Σ_i D_i(ω_m) k_i(u) (eq. 1): seed points u_i on a grid of spacing h, Gaussian
+/// kernels k_i of σ = h / (2√(2 ln 2)) (half the peak at the midpoint between neighbours) with
+/// ∫ k_i = h², and per seed the Beckmann lobe D_i = P22_i / cos⁴θ (eq. 2, 4) whose slope Gaussian has
+/// the moments of the interpolated map's slopes under k_i (eq. 5-6), built with
+/// [`SlopeGaussian::from_moments`] (σ floored at σ_ε, covariance kept positive definite).
+///
+/// Stored per lobe: the 5 moments as `f32` (20 bytes); plus the quadtree of slope boxes (~5.3 bytes
+/// per lobe) and the moment mip chain (~6.7 bytes per lobe), see [`BeckmannMixture::memory`].
+///
+/// # Reference
+/// \[Chermain2019\] §3 (eq. 1-6), §4 (eq. 7-17), §5 (hierarchy).
+#[derive(Clone, Debug)]
+pub struct BeckmannMixture {
+    width: usize,
+    height: usize,
+    grid: [usize; 2],
+    /// Texels per lobe along x and y.
+    spacing: [f64; 2],
+    lobes: Vec<[f32; 5]>,
+    tree: SlopeTree,
+    pyramid: LobePyramid,
+    params: MixtureParams,
+    /// Half-width of the slope boxes in lobe standard deviations, k = √(−2 ln tail).
+    box_k: f32,
+}
+
+impl BeckmannMixture {
+    /// Builds the mixture of `map` (parallel, deterministic whatever the thread count).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the field of `params` that is invalid (`spacing`,
+    /// `sigma_min`, `samples`, `kernel_sigmas`, `weight_sigmas`, `slope_tail`, `lod_lobes`);
+    /// [`Error::InvalidSize`] if the lobe grid would exceed 2³¹ lobes.
+    pub fn build(map: &NormalMap, params: MixtureParams) -> Result<Self> {
+        Self::build_with_progress(map, params, None)
+    }
+
+    /// [`BeckmannMixture::build`] reporting progress: `progress` receives fractions in (0, 1] as rows
+    /// of lobes complete (possibly from several threads).
+    ///
+    /// # Errors
+    /// As [`BeckmannMixture::build`].
+    pub fn build_with_progress(
+        map: &NormalMap,
+        params: MixtureParams,
+        progress: Option<&(dyn Fn(f32) + Sync)>,
+    ) -> Result<Self> {
+        params.validate()?;
+        let (width, height) = (map.width(), map.height());
+        let h = params.spacing as f64;
+        let nx = ((width as f64 / h).round() as usize).max(1);
+        let ny = ((height as f64 / h).round() as usize).max(1);
+        if nx.checked_mul(ny).is_none_or(|n| n > (1usize << 31)) {
+            return Err(Error::InvalidSize {
+                width: nx,
+                height: ny,
+                reason: "the lobe grid (map size / spacing) exceeds 2^31 lobes",
+            });
+        }
+        let spacing = [width as f64 / nx as f64, height as f64 / ny as f64];
+        let lobes = build::all_moments(map, &params, [nx, ny], spacing, progress);
+        let box_k = (-2.0 * (params.slope_tail as f64).ln()).sqrt() as f32;
+        let leaf: Vec<[f32; 4]> = lobes
+            .iter()
+            .map(|m| lobe_box(&SlopeGaussian::from_moments(*m, params.sigma_min), box_k))
+            .collect();
+        let tree = SlopeTree::build(nx, ny, &leaf);
+        let pyramid = LobePyramid::build(nx, ny, &lobes);
+        Ok(BeckmannMixture {
+            width,
+            height,
+            grid: [nx, ny],
+            spacing,
+            lobes,
+            tree,
+            pyramid,
+            params,
+            box_k,
+        })
+    }
+
+    /// The parameters the mixture was built with.
+    pub fn params(&self) -> &MixtureParams {
+        &self.params
+    }
+
+    /// The map size (width, height) in texels.
+    pub fn map_size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// The lobe grid (nx, ny).
+    pub fn grid(&self) -> (usize, usize) {
+        (self.grid[0], self.grid[1])
+    }
+
+    /// The spacing actually used, in texels per lobe along x and y.
+    pub fn spacing(&self) -> (f32, f32) {
+        (self.spacing[0] as f32, self.spacing[1] as f32)
+    }
+
+    /// The stored moments, row major over the lobe grid:
+    /// `[E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]` of the interpolated map's slopes under k_i.
+    pub fn moments(&self) -> &[[f32; 5]] {
+        &self.lobes
+    }
+
+    /// The lobe at grid position (i, j) (wrapping), as a [`SlopeGaussian`].
+    ///
+    /// # Reference
+    /// \[Chermain2019\] eq. 2-5.
+    pub fn lobe(&self, i: i64, j: i64) -> SlopeGaussian {
+        let (nx, ny) = (self.grid[0] as i64, self.grid[1] as i64);
+        let k = (j.rem_euclid(ny) * nx + i.rem_euclid(nx)) as usize;
+        self.lobe_at(k)
+    }
+
+    #[inline]
+    fn lobe_at(&self, k: usize) -> SlopeGaussian {
+        SlopeGaussian::from_moments(self.lobes[k], self.params.sigma_min)
+    }
+
+    /// The slope-box half-width k in lobe standard deviations: √(−2 ln `slope_tail`).
+    pub fn box_sigmas(&self) -> f32 {
+        self.box_k
+    }
+
+    /// Bytes held by the lobes, the hierarchy and the mip chain.
+    pub fn memory(&self) -> MixtureMemory {
+        MixtureMemory {
+            lobes: self.lobes.len(),
+            lobe_bytes: self.lobes.len() * 20,
+            hierarchy_bytes: self.tree.bytes(),
+            mip_bytes: self.pyramid.bytes(),
+        }
+    }
+
+    /// The patch of a footprint with explicit options (masking mode, level of detail).
+    pub fn patch_with(&self, footprint: &Footprint, options: PatchOptions) -> MixturePatch<'_> {
+        MixturePatch::new(self, footprint, options)
+    }
+}
+
+impl GlintNdf for BeckmannMixture {
+    type Patch<'a> = MixturePatch<'a>;
+
+    /// The P-NDF of a footprint with the options of [`MixtureParams::patch`].
+    fn patch(&self, footprint: &Footprint) -> MixturePatch<'_> {
+        MixturePatch::new(self, footprint, self.params.patch)
+    }
+}

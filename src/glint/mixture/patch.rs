@@ -1,0 +1,621 @@
+//! The patch of a footprint: position weights W_i, D_P through the slope-box quadtree, exact and
+//! approximate masking terms, and the two samplers (\[Chermain2019\] §4-5).
+//!
+//! Per-footprint work (done once in [`MixturePatch::new`]): the effective Gaussian k_i ∗ k_P in lobe
+//! units, the rectangle of lobes within `weight_sigmas` of it, their normalised weights W_i (stored
+//! densely per "slot" of the rectangle, with a cdf for sampling), the patch mean slope and the
+//! filtered lobe of the moment mip chain. An axis of the rectangle at least one period long is
+//! folded onto the lobe grid (a lobe's slot then carries the sum of its periodic images' weights),
+//! so a patch never holds more slots than the map has lobes.
+
+use super::hierarchy::{contains, lobe_box};
+use super::{BeckmannMixture, MaskingMode, PatchOptions, build::kernel_sigma};
+use crate::frame::normal_to_slope;
+use crate::glint::Footprint;
+use crate::ndf::{Ndf, SlopeGaussian};
+use glam::{Vec2, Vec3};
+use std::sync::OnceLock;
+
+/// The slots of one axis of the weight rectangle.
+#[derive(Clone, Copy, Debug)]
+struct AxisSlots {
+    /// First unwrapped lobe index (unused when folded).
+    start: i64,
+    /// Number of slots.
+    len: usize,
+    /// Lobes along this axis.
+    n: usize,
+    /// Folded onto [0, n) (slot = lobe index).
+    folded: bool,
+}
+
+impl AxisSlots {
+    /// Lobe indices I with |I + ½ − c| ≤ half, folded if they span a period or more.
+    fn new(c: f64, half: f64, n: usize) -> AxisSlots {
+        let lo = (c - 0.5 - half).ceil();
+        let hi = (c - 0.5 + half).floor();
+        let len = if hi >= lo { (hi - lo) as usize + 1 } else { 1 };
+        let start = if hi >= lo {
+            lo as i64
+        } else {
+            (c - 0.5).round() as i64
+        };
+        if len >= n {
+            AxisSlots {
+                start,
+                len: n,
+                n,
+                folded: true,
+            }
+        } else {
+            AxisSlots {
+                start,
+                len,
+                n,
+                folded: false,
+            }
+        }
+    }
+
+    /// The slot of unwrapped lobe index I (which must lie in the rectangle).
+    #[inline]
+    fn slot_of_unwrapped(&self, i: i64) -> usize {
+        if self.folded {
+            i.rem_euclid(self.n as i64) as usize
+        } else {
+            (i - self.start) as usize
+        }
+    }
+
+    /// The lobe index of a slot.
+    #[inline]
+    fn lobe_of_slot(&self, s: usize) -> usize {
+        if self.folded {
+            s
+        } else {
+            (self.start + s as i64).rem_euclid(self.n as i64) as usize
+        }
+    }
+
+    /// The unwrapped lobe indices whose weights are summed (the whole ±half range when folded).
+    fn unwrapped_range(&self, c: f64, half: f64) -> (i64, i64) {
+        if self.folded {
+            (
+                (c - 0.5 - half).ceil() as i64,
+                (c - 0.5 + half).floor() as i64,
+            )
+        } else {
+            (self.start, self.start + self.len as i64 - 1)
+        }
+    }
+
+    /// Segments [lo, hi) of lobe indices with slot = i + off, covering the slots.
+    fn segments(&self) -> ([(usize, usize, i64); 2], usize) {
+        let mut out = [(0, 0, 0); 2];
+        if self.folded {
+            out[0] = (0, self.n, 0);
+            return (out, 1);
+        }
+        let first = self.start.rem_euclid(self.n as i64) as usize;
+        let run = self.len.min(self.n - first);
+        out[0] = (first, first + run, -(first as i64));
+        if run < self.len {
+            out[1] = (0, self.len - run, run as i64);
+            (out, 2)
+        } else {
+            (out, 1)
+        }
+    }
+}
+
+/// The gathered lobes of a footprint.
+#[derive(Clone, Debug)]
+struct Gathered {
+    axes: [AxisSlots; 2],
+    /// Normalised W per slot, row major (slot_y * len_x + slot_x), summing to 1.
+    weights: Vec<f32>,
+    /// Cumulative weights (f64), last = Σ of `weights` in f64.
+    cdf: Vec<f64>,
+    /// Σ W_i μ_i: the patch mean slope.
+    mean_slope: Vec2,
+}
+
+/// The P-NDF of one footprint of a [`BeckmannMixture`]: an [`Ndf`] with D_P(h) = Σ W_i D_i(h).
+///
+/// - `d`: \[Chermain2019\] eq. 9 through the slope-box quadtree; lobes whose slope box (1 −
+///   `slope_tail` of their mass) does not contain h's slope are skipped.
+/// - Masking, [`MaskingMode::Exact`]: V_P(w) = Σ W_i V_i(w) (V_i = ∫⟨w,m⟩⁺D_i, always ≥ 0), and the
+///   **signed** patch projected area A_P(w) = Σ W_i (cos θ − w_xy·μ_i) = cos θ − w_xy·μ_P (μ_P the
+///   patch mean slope), clamped at 0; Λ_P = V_P/A_P − 1, G1 = A_P/V_P (eq. 10-17, see
+///   docs/mixture.md for why the per-lobe areas are not clamped as in eq. 17).
+///   [`MaskingMode::Approximate`]: A, Λ and V of the filtered lobe (§4.2.2).
+/// - Samplers: `sample_normal` draws a lobe ∝ W_i then its slope Gaussian (exactly D_P cos θ);
+///   `sample_visible` draws a lobe ∝ W_i V_i(wo) then that lobe's visible normal, density
+///   Σ W_i ⟨wo,m⟩⁺ D_i / V_P(wo) = `pdf_visible` (exact V_P in both masking modes).
+/// - Level of detail: a footprint of more than `lod_lobes` lobes is the filtered lobe alone.
+///
+/// # Reference
+/// \[Chermain2019\] eq. 7-17, §4.2.2, §5.
+#[derive(Clone, Debug)]
+pub struct MixturePatch<'a> {
+    mixture: &'a BeckmannMixture,
+    masking: MaskingMode,
+    /// The Beckmann lobe of the filtered moments (§4.2.2).
+    filtered: SlopeGaussian,
+    /// `None` when the level of detail serves the filtered lobe alone.
+    gathered: Option<Gathered>,
+    /// The gathered lobes as [`SlopeGaussian`]s (per slot), built on the first call that loops over
+    /// all of them (exact masking, visible sampling): 32 bytes per slot.
+    lobes: OnceLock<Vec<SlopeGaussian>>,
+}
+
+/// The effective Gaussian k_i ∗ k_P in lobe units: centre and inverse covariance.
+struct Effective {
+    c: [f64; 2],
+    /// Σ_eff = [[a, b], [b, d]].
+    cov: [f64; 3],
+    /// Σ_eff⁻¹.
+    inv: [f64; 3],
+}
+
+impl Effective {
+    fn new(mix: &BeckmannMixture, footprint: &Footprint) -> (Effective, f64) {
+        let (c, s) = footprint.gaussian_texels(mix.width, mix.height);
+        let [hx, hy] = mix.spacing;
+        let c = [c.x as f64 / hx, c.y as f64 / hy];
+        let (sxx, sxy, syy) = (
+            s.x_axis.x as f64 / (hx * hx),
+            s.x_axis.y as f64 / (hx * hy),
+            s.y_axis.y as f64 / (hy * hy),
+        );
+        let det_p = (sxx * syy - sxy * sxy).max(0.0);
+        let area = 12.0 * det_p.sqrt();
+        let k2 = kernel_sigma(1.0).powi(2);
+        let (a, b, d) = (sxx + k2, sxy, syy + k2);
+        let det = a * d - b * b;
+        let inv = [d / det, -b / det, a / det];
+        (
+            Effective {
+                c,
+                cov: [a, b, d],
+                inv,
+            },
+            area,
+        )
+    }
+
+    #[inline]
+    fn weight(&self, i: i64, j: i64) -> f64 {
+        let dx = i as f64 + 0.5 - self.c[0];
+        let dy = j as f64 + 0.5 - self.c[1];
+        let q = self.inv[0] * dx * dx + 2.0 * self.inv[1] * dx * dy + self.inv[2] * dy * dy;
+        (-0.5 * q).exp()
+    }
+}
+
+impl<'a> MixturePatch<'a> {
+    /// Gathers the footprint's lobes (see the module docs). Total: any footprint works.
+    pub fn new(
+        mixture: &'a BeckmannMixture,
+        footprint: &Footprint,
+        options: PatchOptions,
+    ) -> MixturePatch<'a> {
+        let (eff, area) = Effective::new(mixture, footprint);
+        let lod = 0.5 * area.max(1e-300).log2();
+        let filtered_m = mixture.pyramid.filtered(&mixture.lobes, eff.c, lod);
+        let filtered = SlopeGaussian::from_moments(filtered_m, mixture.params.sigma_min);
+        let gathered = if area > options.lod_lobes as f64 {
+            None
+        } else {
+            Some(Self::gather(mixture, &eff))
+        };
+        MixturePatch {
+            mixture,
+            masking: options.masking,
+            filtered,
+            gathered,
+            lobes: OnceLock::new(),
+        }
+    }
+
+    fn gather(mix: &BeckmannMixture, eff: &Effective) -> Gathered {
+        let t = mix.params.weight_sigmas as f64;
+        let half = [t * eff.cov[0].sqrt(), t * eff.cov[2].sqrt()];
+        let axes = [
+            AxisSlots::new(eff.c[0], half[0], mix.grid[0]),
+            AxisSlots::new(eff.c[1], half[1], mix.grid[1]),
+        ];
+        let (lx, ly) = (axes[0].len, axes[1].len);
+        let mut w = vec![0.0f64; lx * ly];
+        let (i0, i1) = axes[0].unwrapped_range(eff.c[0], half[0]);
+        let (j0, j1) = axes[1].unwrapped_range(eff.c[1], half[1]);
+        for j in j0..=j1 {
+            let sy = axes[1].slot_of_unwrapped(j);
+            for i in i0..=i1 {
+                let sx = axes[0].slot_of_unwrapped(i);
+                w[sy * lx + sx] += eff.weight(i, j);
+            }
+        }
+        let total: f64 = w.iter().sum();
+        // total ≥ the nearest lobe's weight ≥ exp(−½ · 2 · 0.5²/σ_k²) ≈ 0.06 (|d| ≤ ½ per axis,
+        // Σ_eff ≥ σ_k² I), so the division is safe.
+        let inv = if total > 0.0 { 1.0 / total } else { 0.0 };
+        let mut cdf = Vec::with_capacity(w.len());
+        let mut acc = 0.0;
+        let mut mean = [0.0f64; 2];
+        let weights: Vec<f32> = w
+            .iter()
+            .enumerate()
+            .map(|(s, &wi)| {
+                let wn = wi * inv;
+                acc += wn;
+                cdf.push(acc);
+                let k = axes[1].lobe_of_slot(s / lx) * mix.grid[0] + axes[0].lobe_of_slot(s % lx);
+                let m = mix.lobes[k];
+                mean[0] += wn * m[0] as f64;
+                mean[1] += wn * m[1] as f64;
+                wn as f32
+            })
+            .collect();
+        Gathered {
+            axes,
+            weights,
+            cdf,
+            mean_slope: Vec2::new(mean[0] as f32, mean[1] as f32),
+        }
+    }
+
+    /// The masking mode.
+    pub fn masking(&self) -> MaskingMode {
+        self.masking
+    }
+
+    /// Whether the level of detail replaced the mixture by the filtered lobe.
+    pub fn is_filtered_lobe(&self) -> bool {
+        self.gathered.is_none()
+    }
+
+    /// The Beckmann lobe of the footprint's filtered moments (\[Chermain2019\] §4.2.2): trilinear lookup
+    /// in the moment mip chain at level log₂(√(footprint area in lobes)).
+    pub fn filtered_lobe(&self) -> &SlopeGaussian {
+        &self.filtered
+    }
+
+    /// Number of lobe slots (weights) the patch holds (0 for the filtered lobe).
+    pub fn lobe_count(&self) -> usize {
+        self.gathered.as_ref().map_or(0, |g| g.weights.len())
+    }
+
+    /// The patch mean slope μ_P = Σ W_i μ_i (the filtered lobe's mean under the level of detail).
+    pub fn mean_slope(&self) -> Vec2 {
+        self.gathered
+            .as_ref()
+            .map_or(self.filtered.mean(), |g| g.mean_slope)
+    }
+
+    /// The normalised weights W_i and their lobes, for tests and tools: (W, lobe) per slot.
+    pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
+        let g = self.gathered.as_ref();
+        let n = g.map_or(0, |g| g.weights.len());
+        (0..n).filter_map(move |s| g.map(|g| (g.weights[s], self.slot_lobe(g, s))))
+    }
+
+    #[inline]
+    fn slot_lobe(&self, g: &Gathered, s: usize) -> SlopeGaussian {
+        let lx = g.axes[0].len;
+        let k =
+            g.axes[1].lobe_of_slot(s / lx) * self.mixture.grid[0] + g.axes[0].lobe_of_slot(s % lx);
+        self.mixture.lobe_at(k)
+    }
+
+    /// D_P(m) and the number of lobes whose D_i was evaluated (the hierarchy's leaves reached).
+    ///
+    /// # Reference
+    /// \[Chermain2019\] eq. 9, §5.
+    pub fn d_with_stats(&self, m: Vec3) -> (f32, usize) {
+        let Some(g) = &self.gathered else {
+            return (self.filtered.d(m), 0);
+        };
+        let Some(s) = normal_to_slope(m) else {
+            return (0.0, 0);
+        };
+        if !s.is_finite() {
+            return (0.0, 0);
+        }
+        let (p22, touched) = self.sum_p22(g, s);
+        let c = 1.0 + s.length_squared() as f64;
+        let d = (p22 * c * c) as f32;
+        (if d.is_finite() { d } else { f32::MAX }, touched)
+    }
+
+    /// Σ W_i P22_i(s) over the lobes whose slope box contains s, by a depth-first walk of the
+    /// quadtree restricted to each (x segment × y segment) of the footprint's slots.
+    fn sum_p22(&self, g: &Gathered, s: Vec2) -> (f64, usize) {
+        let mix = self.mixture;
+        let tree = &mix.tree;
+        let [nx, _] = mix.grid;
+        let lx = g.axes[0].len;
+        let (xs, nxs) = g.axes[0].segments();
+        let (ys, nys) = g.axes[1].segments();
+        let mut acc = 0.0f64;
+        let mut touched = 0usize;
+        // Depth-first stack: at most 3 pending siblings per level + 1, levels ≤ 33.
+        let mut stack = [(0u8, 0u32, 0u32); 128];
+        for &(x_lo, x_hi, x_off) in &xs[..nxs] {
+            for &(y_lo, y_hi, y_off) in &ys[..nys] {
+                let mut len = 1;
+                stack[0] = (tree.top() as u8, 0, 0);
+                while len > 0 {
+                    len -= 1;
+                    let (l, x, y) = stack[len];
+                    let (l, x, y) = (l as usize, x as usize, y as usize);
+                    let (bx0, by0) = (x << l, y << l);
+                    let (bx1, by1) = ((x + 1) << l, (y + 1) << l);
+                    if bx1 <= x_lo || bx0 >= x_hi || by1 <= y_lo || by0 >= y_hi {
+                        continue;
+                    }
+                    if l == 0 {
+                        let k = y * nx + x;
+                        let lobe = mix.lobe_at(k);
+                        if !contains(&lobe_box(&lobe, mix.box_k), s) {
+                            continue;
+                        }
+                        touched += 1;
+                        let sx = (x as i64 + x_off) as usize;
+                        let sy = (y as i64 + y_off) as usize;
+                        let w = g.weights[sy * lx + sx];
+                        acc += w as f64 * lobe.p22(s) as f64;
+                        continue;
+                    }
+                    if !contains(tree.node_box(l, x, y), s) {
+                        continue;
+                    }
+                    let [cw, ch] = tree.sizes[l - 1];
+                    for cy in (2 * y)..(2 * y + 2).min(ch) {
+                        for cx in (2 * x)..(2 * x + 2).min(cw) {
+                            stack[len] = ((l - 1) as u8, cx as u32, cy as u32);
+                            len += 1;
+                        }
+                    }
+                }
+            }
+        }
+        (acc, touched)
+    }
+
+    /// The gathered lobes per slot (built once).
+    fn slot_lobes(&self, g: &Gathered) -> &[SlopeGaussian] {
+        self.lobes
+            .get_or_init(|| (0..g.weights.len()).map(|s| self.slot_lobe(g, s)).collect())
+    }
+
+    /// Exact V_P(w) = Σ W_i V_i(w) in `f64` (0 for invalid w).
+    fn exact_visible_area(&self, g: &Gathered, w: Vec3) -> f64 {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        g.weights
+            .iter()
+            .zip(self.slot_lobes(g))
+            .map(|(&wi, lobe)| wi as f64 * lobe.visible_area(w) as f64)
+            .sum()
+    }
+
+    /// The exact visible area V_P(w) = Σ W_i V_i(w) = ∫ ⟨w, m⟩⁺ D_P(m) dm, whatever the masking mode
+    /// (the filtered lobe's under the level of detail).
+    ///
+    /// # Reference
+    /// \[Chermain2019\] eq. 12-13 (with V_i in place of the clamped ⟨ω_n̄i, w⟩/(ω_n̄i·ω_g)(1 + Λ_i)).
+    pub fn visible_area_exact(&self, w: Vec3) -> f32 {
+        match &self.gathered {
+            Some(g) => self.exact_visible_area(g, w) as f32,
+            None => self.filtered.visible_area(w),
+        }
+    }
+
+    /// The signed patch projected area A_s(w) = cos θ − w_xy·μ_P = Σ W_i ∫ (w·m) D_i dm (may be
+    /// negative; 0 for invalid w).
+    ///
+    /// # Reference
+    /// \[Chermain2019\] eq. 17 without the per-lobe clamp.
+    pub fn signed_projected_area(&self, w: Vec3) -> f32 {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let mu = self.mean_slope();
+        (w.z as f64 - (mu.x as f64 * w.x as f64 + mu.y as f64 * w.y as f64)) as f32
+    }
+
+    /// The paper's patch projected area with clamped per-lobe areas, Σ W_i max(cos θ − w_xy·μ_i, 0)
+    /// (\[Chermain2019\] eq. 17 as printed). Not used by the patch (see docs/mixture.md); exposed for
+    /// comparison. The filtered lobe's A under the level of detail.
+    pub fn paper_projected_area(&self, w: Vec3) -> f32 {
+        match &self.gathered {
+            Some(g) => (0..g.weights.len())
+                .map(|s| g.weights[s] as f64 * self.slot_lobe(g, s).projected_area(w) as f64)
+                .sum::<f64>() as f32,
+            None => self.filtered.projected_area(w),
+        }
+    }
+
+    /// Picks a slot by inverting the cdf at u ∈ [0, 1); returns the slot and u rescaled to [0, 1).
+    fn pick(g: &Gathered, u: f32) -> (usize, f32) {
+        let total = g.cdf.last().copied().unwrap_or(0.0);
+        let u = if u.is_nan() { 0.5 } else { u.clamp(0.0, 1.0) } as f64;
+        let target = u * total;
+        let s = g
+            .cdf
+            .partition_point(|&c| c <= target)
+            .min(g.cdf.len().saturating_sub(1));
+        let lo = if s == 0 { 0.0 } else { g.cdf[s - 1] };
+        let width = g.cdf[s] - lo;
+        let r = if width > 0.0 {
+            (target - lo) / width
+        } else {
+            0.5
+        };
+        (s, (r as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0))
+    }
+}
+
+impl Ndf for MixturePatch<'_> {
+    /// D_P(m) = Σ W_i D_i(m) (\[Chermain2019\] eq. 9); see [`MixturePatch::d_with_stats`].
+    fn d(&self, m: Vec3) -> f32 {
+        self.d_with_stats(m).0
+    }
+
+    /// Λ_P(w) = V_P(w)/A_P(w) − 1 (≥ 0); `f32::MAX` when A_P ≤ 0 < w_z (the patch's mean plane faces
+    /// away from w), 0 for invalid w.
+    ///
+    /// # Reference
+    /// \[Chermain2019\] eq. 15 (exact), §4.2.2 (approximate).
+    fn lambda(&self, w: Vec3) -> f32 {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let a = self.projected_area(w);
+        if a.is_nan() || a <= 0.0 {
+            return f32::MAX;
+        }
+        let l = (self.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32;
+        l.min(f32::MAX)
+    }
+
+    /// A_P(w): max(signed A_P, 0) (exact) or the filtered lobe's A (approximate / level of detail).
+    ///
+    /// # Reference
+    /// \[Chermain2019\] eq. 17, §4.2.2.
+    fn projected_area(&self, w: Vec3) -> f32 {
+        match (&self.gathered, self.masking) {
+            (Some(_), MaskingMode::Exact) => self.signed_projected_area(w).max(0.0),
+            _ => self.filtered.projected_area(w),
+        }
+    }
+
+    /// V_P(w) = A_P (1 + Λ_P): exact Σ W_i V_i(w), or the filtered lobe's V.
+    fn visible_area(&self, w: Vec3) -> f32 {
+        match (&self.gathered, self.masking) {
+            (Some(g), MaskingMode::Exact) => self.exact_visible_area(g, w) as f32,
+            _ => self.filtered.visible_area(w),
+        }
+    }
+
+    /// m ~ D_P(m) cos θ_m: lobe ∝ W_i with u.x (rescaled), then the lobe's slope Gaussian.
+    fn sample_normal(&self, u: Vec2) -> Vec3 {
+        let Some(g) = &self.gathered else {
+            return self.filtered.sample_normal(u);
+        };
+        let (s, ux) = Self::pick(g, u.x);
+        self.slot_lobe(g, s).sample_normal(Vec2::new(ux, u.y))
+    }
+
+    /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
+    /// visible normal. Two passes over the lobes (total, then the pick), no allocation. Invalid wo:
+    /// [`Ndf::sample_normal`].
+    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        let Some(g) = &self.gathered else {
+            return self.filtered.sample_visible(wo, u);
+        };
+        let total = self.exact_visible_area(g, wo);
+        if !(total > 0.0 && total.is_finite()) {
+            return self.sample_normal(u);
+        }
+        let ux = if u.x.is_nan() {
+            0.5
+        } else {
+            u.x.clamp(0.0, 1.0)
+        } as f64;
+        let target = ux * total;
+        let mut acc = 0.0;
+        let mut chosen = (0, 0.5f32);
+        let lobes = self.slot_lobes(g);
+        for (s, lobe) in lobes.iter().enumerate() {
+            let v = g.weights[s] as f64 * lobe.visible_area(wo) as f64;
+            if v > 0.0 {
+                chosen = (s, ((target - acc) / v) as f32);
+                if acc + v > target {
+                    break;
+                }
+            }
+            acc += v;
+        }
+        let (s, r) = chosen;
+        let r = r.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        lobes[s].sample_visible(wo, Vec2::new(r, u.y))
+    }
+
+    /// Σ W_i D_i(m) cos θ_m over **every** gathered lobe (no slope-box truncation): exactly the
+    /// density of [`Ndf::sample_normal`]. Differs from `d(m) cos θ_m` by at most the truncated tail
+    /// (`slope_tail` of each lobe's mass). O(lobes).
+    fn pdf_normal(&self, m: Vec3) -> f32 {
+        let Some(g) = &self.gathered else {
+            return self.filtered.pdf_normal(m);
+        };
+        if !(m.z > 0.0 && m.is_finite()) {
+            return 0.0;
+        }
+        let p = self.untruncated_d(g, m) * m.z as f64;
+        if p.is_finite() { p as f32 } else { 0.0 }
+    }
+
+    /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe, with the exact V_P in every masking
+    /// mode: exactly the density of [`Ndf::sample_visible`]. O(lobes).
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        let Some(g) = &self.gathered else {
+            return self.filtered.pdf_visible(wo, m);
+        };
+        let c = wo.dot(m);
+        if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
+            return 0.0;
+        }
+        let v = self.exact_visible_area(g, wo);
+        if v.is_nan() || v <= 0.0 {
+            return 0.0;
+        }
+        let p = (c as f64 * self.untruncated_d(g, m) / v) as f32;
+        if p.is_finite() { p } else { 0.0 }
+    }
+}
+
+impl MixturePatch<'_> {
+    /// Σ W_i D_i(m) over every gathered lobe, in `f64`.
+    fn untruncated_d(&self, g: &Gathered, m: Vec3) -> f64 {
+        g.weights
+            .iter()
+            .zip(self.slot_lobes(g))
+            .map(|(&w, lobe)| w as f64 * lobe.d(m) as f64)
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axis_segments_cover_the_slots_once() {
+        for &(c, half, n) in &[
+            (0.2, 1.3, 8usize),
+            (7.9, 2.0, 8),
+            (3.5, 0.1, 8),
+            (4.0, 9.0, 8),
+            (0.5, 0.0, 1),
+        ] {
+            let a = AxisSlots::new(c, half, n);
+            let (seg, k) = a.segments();
+            let mut seen = vec![0; a.len];
+            for &(lo, hi, off) in &seg[..k] {
+                for i in lo..hi {
+                    let s = (i as i64 + off) as usize;
+                    assert_eq!(a.lobe_of_slot(s), i, "{c} {half} {n}");
+                    seen[s] += 1;
+                }
+            }
+            assert!(seen.iter().all(|&v| v == 1), "{c} {half} {n}: {seen:?}");
+            let (lo, hi) = a.unwrapped_range(c, half);
+            for i in lo..=hi {
+                assert!(a.slot_of_unwrapped(i) < a.len);
+            }
+        }
+    }
+}
