@@ -18,7 +18,7 @@ type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
 fn main() -> Res<()> {
     let out = common::out_dir()?;
     let quick = !common::has_flag("--full");
-    let parts: [(&str, &str, Part); 3] = [
+    let parts: [(&str, &str, Part); 4] = [
         (
             "Analytic core",
             "NDF slices, Smith masking and Fresnel curves.",
@@ -35,6 +35,11 @@ fn main() -> Res<()> {
             "The four procedural maps and the P-NDF of their interpolated normals seen through \
              footprints of 1 to 4096 texels (projected hemisphere, log scale).",
             common::pndf_images::run,
+        ),
+        (
+            "Glints: the Beckmann mixture (Chermain 2019)",
+            "The mixture's P-NDF against the ground truth, per map and footprint size.",
+            common::mixture_images::run,
         ),
     ];
     let mut sections = Vec::new();

@@ -7,6 +7,7 @@
 
 pub mod curves;
 pub mod lobes;
+pub mod mixture_images;
 pub mod pndf_images;
 
 use plotters::prelude::*;

@@ -25,9 +25,9 @@ use brdf::{Vec2, Vec3};
 use std::path::Path;
 
 /// Footprint areas in texels².
-const FOOTPRINTS: [f32; 4] = [1.0, 16.0, 256.0, 4096.0];
+pub(super) const FOOTPRINTS: [f32; 4] = [1.0, 16.0, 256.0, 4096.0];
 /// Footprint centre (uv).
-const CENTER: Vec2 = Vec2::new(0.37, 0.61);
+pub(super) const CENTER: Vec2 = Vec2::new(0.37, 0.61);
 /// Decades shown by the logarithmic tone mapping.
 const DECADES: f64 = 4.0;
 /// sin θ at the rim of the P-NDF images.
@@ -60,7 +60,7 @@ fn settings(quick: bool) -> Settings {
 }
 
 /// The four procedural maps with their default parameters (bumpy: RMS slope 0.25, ℓ = 4 texels).
-fn maps(size: usize) -> Res<Vec<(&'static str, NormalMap)>> {
+pub(super) fn maps(size: usize) -> Res<Vec<(&'static str, NormalMap)>> {
     Ok(vec![
         ("bumpy", bumpy(size, size, 0.25, 4.0, 1)?),
         ("brushed", brushed(size, size, BrushedParams::default(), 2)?),
@@ -81,6 +81,12 @@ fn tone(d: f64, max: f64) -> Option<f32> {
 /// +y up).
 fn disk_image(r: &BinnedPndf, size: u32) -> Vec<u8> {
     let max = r.d().iter().copied().fold(0.0f64, f64::max);
+    disk_image_of(&|w| r.d_at(w), max, size)
+}
+
+/// RGB pixels of any function of the direction over the projected hemisphere disk, tone mapped
+/// against `max` like [`disk_image`].
+pub(super) fn disk_image_of(d: &dyn Fn(Vec3) -> f64, max: f64, size: u32) -> Vec<u8> {
     let mut rgb = Vec::with_capacity((size * size * 3) as usize);
     for row in 0..size {
         for col in 0..size {
@@ -89,7 +95,7 @@ fn disk_image(r: &BinnedPndf, size: u32) -> Vec<u8> {
             let r2 = x * x + y * y;
             let px = if r2 < SIN_MAX * SIN_MAX {
                 let w = Vec3::new(x, y, (1.0 - r2).sqrt());
-                tone(r.d_at(w), max).map_or([0, 0, 0], colormap)
+                tone(d(w), max).map_or([0, 0, 0], colormap)
             } else {
                 [0, 0, 0]
             };
@@ -120,7 +126,7 @@ fn map_crop(map: &NormalMap, center: Vec2, size: u32) -> Vec<u8> {
 }
 
 /// Places equally sized RGB panels side by side with a 4-pixel black gap.
-fn sheet(panels: &[Vec<u8>], size: u32) -> (u32, Vec<u8>) {
+pub(super) fn sheet(panels: &[Vec<u8>], size: u32) -> (u32, Vec<u8>) {
     let gap = 4u32;
     let width = panels.len() as u32 * (size + gap) - gap;
     let mut rgb = vec![0u8; (width * size * 3) as usize];
