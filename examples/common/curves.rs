@@ -18,6 +18,14 @@ fn dir(theta_deg: f64) -> Vec3 {
     Vec3::new(t.sin() as f32, 0.0, t.cos() as f32)
 }
 
+/// A named curve of `f(ω(θ))` for θ from 0° to 90° in degrees, ω(θ) in the plane y = 0.
+fn slice(label: impl Into<String>, f: impl Fn(Vec3) -> f32) -> Series {
+    Series::new(
+        label,
+        degrees(180, 90.0).map(|t| (t, f(dir(t)) as f64)).collect(),
+    )
+}
+
 /// Writes the NDF, G1 and Fresnel charts into `out`.
 pub fn run(out: &Path, _quick: bool) -> Res<Vec<Artifact>> {
     let mut artifacts = Vec::new();
@@ -28,18 +36,8 @@ pub fn run(out: &Path, _quick: bool) -> Res<Vec<Artifact>> {
     for &a in &alphas {
         let b = Beckmann::isotropic(a)?;
         let g = Ggx::isotropic(a)?;
-        series.push(Series::new(
-            format!("Beckmann α={a}"),
-            degrees(180, 90.0)
-                .map(|t| (t, b.d(dir(t)) as f64))
-                .collect(),
-        ));
-        series.push(Series::new(
-            format!("GGX α={a}"),
-            degrees(180, 90.0)
-                .map(|t| (t, g.d(dir(t)) as f64))
-                .collect(),
-        ));
+        series.push(slice(format!("Beckmann α={a}"), |w| b.d(w)));
+        series.push(slice(format!("GGX α={a}"), |w| g.d(w)));
     }
     let path = out.join("ndf_d.png");
     let mut chart = Chart::new("D(m) along θm", "θm (degrees)", "D (1/sr), log scale");
@@ -56,12 +54,7 @@ pub fn run(out: &Path, _quick: bool) -> Res<Vec<Artifact>> {
     for gamma in [2.0f32, 10.0, 50.0, 200.0] {
         let bp = BlinnPhong::new(gamma)?;
         let b = Beckmann::isotropic(beckmann_alpha_from_shininess(gamma))?;
-        series.push(Series::new(
-            format!("Blinn-Phong γ={gamma}"),
-            degrees(180, 90.0)
-                .map(|t| (t, bp.d(dir(t)) as f64))
-                .collect(),
-        ));
+        series.push(slice(format!("Blinn-Phong γ={gamma}"), |w| bp.d(w)));
         series.push(Series::new(
             format!("Beckmann α(γ={gamma})"),
             degrees(180, 90.0)
@@ -88,18 +81,10 @@ pub fn run(out: &Path, _quick: bool) -> Res<Vec<Artifact>> {
     for &a in &alphas {
         let b = Beckmann::isotropic(a)?;
         let g = Ggx::isotropic(a)?;
-        series.push(Series::new(
-            format!("Beckmann α={a}"),
-            degrees(180, 90.0)
-                .map(|t| (t, b.g1(dir(t), frame::NORMAL) as f64))
-                .collect(),
-        ));
-        series.push(Series::new(
-            format!("GGX α={a}"),
-            degrees(180, 90.0)
-                .map(|t| (t, g.g1(dir(t), frame::NORMAL) as f64))
-                .collect(),
-        ));
+        series.push(slice(format!("Beckmann α={a}"), |w| {
+            b.g1(w, frame::NORMAL)
+        }));
+        series.push(slice(format!("GGX α={a}"), |w| g.g1(w, frame::NORMAL)));
     }
     let path = out.join("ndf_g1.png");
     line_chart(
@@ -115,15 +100,9 @@ pub fn run(out: &Path, _quick: bool) -> Res<Vec<Artifact>> {
     // Fresnel reflectance against the angle of incidence.
     let mut series = Vec::new();
     for eta in [1.33f32, 1.5, 2.4] {
-        series.push(Series::new(
-            format!("dielectric η={eta}"),
-            degrees(180, 90.0)
-                .map(|t| {
-                    let c = t.to_radians().cos() as f32;
-                    (t, fresnel::dielectric(c, eta) as f64)
-                })
-                .collect(),
-        ));
+        series.push(slice(format!("dielectric η={eta}"), |w| {
+            fresnel::dielectric(w.z, eta)
+        }));
         let f0 = Vec3::splat(fresnel::f0_from_ior(eta));
         series.push(Series::new(
             format!("Schlick f0(η={eta})"),
@@ -135,26 +114,14 @@ pub fn run(out: &Path, _quick: bool) -> Res<Vec<Artifact>> {
                 .collect(),
         ));
     }
-    series.push(Series::new(
-        "glass from inside (η=1.5)",
-        degrees(180, 90.0)
-            .map(|t| {
-                let c = t.to_radians().cos() as f32;
-                (t, fresnel::dielectric(-c, 1.5) as f64)
-            })
-            .collect(),
-    ));
+    series.push(slice("glass from inside (η=1.5)", |w| {
+        fresnel::dielectric(-w.z, 1.5)
+    }));
     let gold = fresnel::ConductorFresnel::GOLD;
     for (k, name) in [(0usize, "R"), (1, "G"), (2, "B")] {
-        series.push(Series::new(
-            format!("gold {name}"),
-            degrees(180, 90.0)
-                .map(|t| {
-                    let c = t.to_radians().cos() as f32;
-                    (t, fresnel::conductor(c, gold.eta, gold.k)[k] as f64)
-                })
-                .collect(),
-        ));
+        series.push(slice(format!("gold {name}"), |w| {
+            fresnel::conductor(w.z, gold.eta, gold.k)[k]
+        }));
     }
     let path = out.join("fresnel.png");
     line_chart(
