@@ -1519,7 +1519,7 @@ fn check_values(
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(512))]
+    #![proptest_config(crate::support::proptest_config(512))]
 
     #[test]
     fn no_nan_inf_or_negative(

@@ -14,6 +14,8 @@ use brdf::fresnel::{
 };
 use proptest::prelude::*;
 
+mod support;
+
 /// Unit roundoff-level constant of f32 (2⁻²³).
 const EPS32: f64 = f32::EPSILON as f64;
 
@@ -517,11 +519,7 @@ fn vec_in_unit(v: Vec3) -> bool {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: 2000,
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    })]
+    #![proptest_config(support::proptest_config(2000))]
 
     #[test]
     fn dielectric_is_a_reflectance(c in -1.1f32..=1.1, eta in eta_range()) {

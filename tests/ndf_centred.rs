@@ -677,7 +677,7 @@ mod props {
     }
 
     proptest! {
-        #![proptest_config(ProptestConfig::with_cases(2000))]
+        #![proptest_config(crate::support::proptest_config(2000))]
 
         #[test]
         fn microfacet_is_total(
@@ -704,5 +704,29 @@ mod props {
             let g = shininess_from_beckmann_alpha(10f32.powf(log_alpha));
             check_ndf(&BlinnPhong::new(g).unwrap(), wo, wi, Vec2::new(u.0, u.1))?;
         }
+    }
+
+    /// Regression (found by CI's random seed, 2026-11-22): a visible normal 1.8e-4 above the horizon,
+    /// sampled for a grazing wo, had D = 0 because 1 − sin²θ rounded to 0 in f32, so its pdf was 0.
+    /// Expected D from the closed form in f64.
+    #[test]
+    fn blinn_phong_d_near_the_horizon() {
+        let g = shininess_from_beckmann_alpha(10f32.powf(-0.018173339));
+        let n = BlinnPhong::new(g).unwrap();
+        let wo = Vec3::new(1.0, 0.0, 3.5419762e-6);
+        let m = Vec3::new(0.00029909686, 1.0, 0.00017985377);
+        let (x, y, z) = (m.x as f64, m.y as f64, m.z as f64);
+        let cos = z / (x * x + y * y + z * z).sqrt();
+        let g64 = n.gamma() as f64;
+        let expected = (g64 + 2.0) / std::f64::consts::TAU * cos.powf(g64);
+        // f32 evaluation of exp/ln over a handful of operations: relative 1e-5.
+        assert!(
+            ((n.d(m) as f64) / expected - 1.0).abs() < 1e-5,
+            "{} vs {expected}",
+            n.d(m)
+        );
+        let hv = n.sample_visible(wo, Vec2::splat(0.99999994));
+        assert!(n.pdf_visible(wo, hv) > 0.0, "{hv:?}");
+        check_ndf(&n, wo, Vec3::Z, Vec2::splat(0.99999994)).unwrap();
     }
 }

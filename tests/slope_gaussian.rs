@@ -593,7 +593,7 @@ fn edged(u: [f32; 2], edge: u8) -> Vec2 {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+    #![proptest_config(crate::support::proptest_config(2000))]
 
     /// Random valid lobes (σ ∈ [1e-3, 3] log-uniform, |μ| ≤ 3, ρ ∈ (−0.99, 0.99)) and directions
     /// down to cos θ = 1e-7: every value is finite and ≥ 0, G1 ≤ 1, sampled normals are unit and

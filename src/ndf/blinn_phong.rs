@@ -130,8 +130,9 @@ impl SplitMix {
 }
 
 impl Ndf for BlinnPhong {
-    /// D(m) = (γ + 2)/(2π) cos^γ θ_m, with cos^γ θ = exp(γ/2 · ln(1 − sin²θ)) so that lobes narrower
-    /// than the f32 spacing of cos θ near 1 are still resolved. 0 for z ≤ 0 or non-finite m.
+    /// D(m) = (γ + 2)/(2π) cos^γ θ_m, with cos^γ θ = exp(γ/2 · ln(1 − sin²θ)) near the pole (so that
+    /// lobes narrower than the f32 spacing of cos θ near 1 are resolved) and exp(γ/2 · ln cos²θ)
+    /// near the horizon (so that cos θ < 2⁻¹² is not rounded to 0). 0 for z ≤ 0 or non-finite m.
     #[inline]
     fn d(&self, m: Vec3) -> f32 {
         if !(m.z > 0.0 && m.is_finite()) {
@@ -141,11 +142,17 @@ impl Ndf for BlinnPhong {
         if self.gamma == 0.0 {
             return norm;
         }
-        let s2 = (m.x * m.x + m.y * m.y) / m.length_squared();
-        if s2 >= 1.0 {
-            return 0.0;
-        }
-        norm * (0.5 * self.gamma * (-s2).ln_1p()).exp()
+        let len2 = m.length_squared();
+        let s2 = (m.x * m.x + m.y * m.y) / len2;
+        // ln cos²θ: through ln(1 − sin²θ) near the pole (narrow lobes), directly from cos²θ near the
+        // horizon, where 1 − sin²θ rounds to 0 in f32 although cos θ itself is representable.
+        let ln_c2 = if s2 < 0.5 {
+            (-s2).ln_1p()
+        } else {
+            (m.z * m.z / len2).ln()
+        };
+        let v = norm * (0.5 * self.gamma * ln_c2).exp();
+        if v.is_finite() { v } else { 0.0 }
     }
 
     /// Exact Smith Λ(w) = V(w)/cos θ_w − 1 (see [`Ndf::visible_area`]); ≥ 0; 0 below the horizon,

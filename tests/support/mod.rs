@@ -23,3 +23,25 @@ pub fn dir(theta_deg: f64, phi_deg: f64) -> glam::Vec3 {
         t.cos() as f32,
     )
 }
+
+/// The proptest configuration of every property suite: `cases` cases from a fixed seed, so that
+/// `cargo test` is reproducible in CI, and no failure-persistence files.
+///
+/// Exploration beyond the fixed seed: set `PROPTEST_RNG_SEED` (any u64) and `PROPTEST_CASES`, e.g.
+/// `PROPTEST_RNG_SEED=7 PROPTEST_CASES=100000 cargo test --release props`; the environment wins.
+pub fn proptest_config(cases: u32) -> proptest::test_runner::Config {
+    use proptest::test_runner::{Config, RngSeed};
+    let env = Config::default();
+    let explore = std::env::var_os("PROPTEST_RNG_SEED").is_some();
+    let env_cases = std::env::var_os("PROPTEST_CASES").is_some();
+    Config {
+        cases: if env_cases { env.cases } else { cases },
+        rng_seed: if explore {
+            env.rng_seed
+        } else {
+            RngSeed::Fixed(0x6272_6466)
+        },
+        failure_persistence: None,
+        ..env
+    }
+}
