@@ -8,6 +8,7 @@
 pub mod curves;
 pub mod lobes;
 pub mod mixture_images;
+pub mod orb;
 pub mod pndf_images;
 
 use plotters::prelude::*;
