@@ -112,7 +112,7 @@ impl Default for OrbOptions {
             size: 256,
             map: MapSource::Procedural("scratched".to_string()),
             map_size: 1024,
-            tiles: Vec2::new(4.0, 2.0),
+            tiles: Vec2::new(8.0, 4.0),
             spp: 512,
             naive_spp: 16,
             sigma_eps: brdf::glint::DEFAULT_SIGMA_MIN,
@@ -157,7 +157,7 @@ impl Scene {
             camera: Vec3::new(0.0, 0.0, 5.0),
             // The sphere subtends asin(1/5) = 11.5° (tan 0.204): 0.22 leaves a small margin.
             tan_half_fov: 0.22,
-            light: Vec3::new(-3.0, 4.0, 6.0),
+            light: Vec3::new(-2.0, 2.5, 7.0),
             intensity: 60.0,
             tiles,
             fresnel: ConductorFresnel::ALUMINIUM,
@@ -565,7 +565,9 @@ pub fn reference_noise(a: &Image, b: &Image, mask: &[bool]) -> f64 {
 // Output
 // ---------------------------------------------------------------------------------------------
 
-/// The exposure that maps the 99.5th percentile of the non-zero covered pixel values to 1.
+/// The exposure that maps the 90th percentile of the non-zero covered pixel values to 1 (0.5 after
+/// [`tone_map`]'s curve): glints span decades, so a high percentile would leave all but the
+/// brightest black.
 pub fn exposure_of(img: &Image, mask: &[bool]) -> f32 {
     let mut v: Vec<f64> = (0..img.pixels.len())
         .filter(|&k| mask[k])
@@ -576,7 +578,7 @@ pub fn exposure_of(img: &Image, mask: &[bool]) -> f32 {
         return 1.0;
     }
     v.sort_by(f64::total_cmp);
-    let p = v[((v.len() - 1) as f64 * 0.995) as usize];
+    let p = v[((v.len() - 1) as f64 * 0.9) as usize];
     if p > 0.0 { (1.0 / p) as f32 } else { 1.0 }
 }
 
@@ -590,7 +592,8 @@ fn srgb(c: f32) -> u8 {
     (s * 255.0).round() as u8
 }
 
-/// 8-bit sRGB of an image at `exposure` (clamped), background (pixel centre off the sphere) dark grey.
+/// 8-bit sRGB of an image at `exposure` through the curve c/(1 + c) per channel (Reinhard), so that
+/// the brightest glints saturate smoothly; background (pixel centre off the sphere) dark grey.
 pub fn tone_map(scene: &Scene, img: &Image, exposure: f32) -> Vec<u8> {
     let mut rgb = Vec::with_capacity(img.pixels.len() * 3);
     for (k, p) in img.pixels.iter().enumerate() {
@@ -602,6 +605,7 @@ pub fn tone_map(scene: &Scene, img: &Image, exposure: f32) -> Vec<u8> {
             rgb.extend_from_slice(&[24, 26, 30]);
         } else {
             let c = *p * exposure;
+            let c = c / (Vec3::ONE + c);
             rgb.extend_from_slice(&[srgb(c.x), srgb(c.y), srgb(c.z)]);
         }
     }
