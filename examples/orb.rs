@@ -106,8 +106,8 @@ mod tests {
             return 1.0;
         }
         let a = 1.0 / (alpha * tan);
-        let lambda = 0.5 * (libm::erf(a) - 1.0)
-            + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt());
+        let lambda =
+            0.5 * (libm::erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt());
         1.0 / (1.0 + lambda)
     }
 
@@ -136,7 +136,11 @@ mod tests {
                     // Independent geometry in f64: pinhole ray through the pixel centre,
                     // unit-sphere hit.
                     let s = 2.0 * 0.22 / SIZE as f64;
-                    let d = unit([(x as f64 + 0.5 - 16.0) * s, (16.0 - y as f64 - 0.5) * s, -1.0]);
+                    let d = unit([
+                        (x as f64 + 0.5 - 16.0) * s,
+                        (16.0 - y as f64 - 0.5) * s,
+                        -1.0,
+                    ]);
                     let o = [0.0, 0.0, 5.0];
                     let b = dot(o, d);
                     let disc = b * b - (dot(o, o) - 1.0);
@@ -161,7 +165,11 @@ mod tests {
                         / (4.0 * co)
                         * 60.0
                         / dot(to_l, to_l);
-                    let f = [fr.x as f64 * scalar, fr.y as f64 * scalar, fr.z as f64 * scalar];
+                    let f = [
+                        fr.x as f64 * scalar,
+                        fr.y as f64 * scalar,
+                        fr.z as f64 * scalar,
+                    ];
                     for c in 0..3 {
                         // Relative 1e-3: f32 geometry (directions to ~1e-6; D's exponent
                         // tan²/α² ≤ ~15 where the box keeps it amplifies that to ~1e-5) and f32
@@ -215,7 +223,10 @@ mod tests {
             for img in [&a, &b].into_iter().chain(methods.iter().map(|r| &r.image)) {
                 assert_eq!(img.pixels.len(), (SIZE * SIZE) as usize);
                 for p in &img.pixels {
-                    assert!(p.is_finite() && p.min_element() >= 0.0, "{map}: pixel {p:?}");
+                    assert!(
+                        p.is_finite() && p.min_element() >= 0.0,
+                        "{map}: pixel {p:?}"
+                    );
                 }
                 let e = errors(img, &a, &b, &mask);
                 assert!(e.rel_rmse.is_finite() && e.energy.is_finite());

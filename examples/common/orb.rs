@@ -20,9 +20,9 @@ use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf};
 use brdf::frame::Frame;
 use brdf::fresnel::{ConductorFresnel, Fresnel};
 use brdf::glint::{
-    BeckmannMixture, BrushedParams, FlakesParams, Footprint, GlintNdf, MaskingMode,
-    MixtureParams, MixturePatch, NormalMap, NormalRepair, PatchOptions, ScratchedParams,
-    TangentConvention, brushed, bumpy, flakes, naive_brdf, scratched,
+    BeckmannMixture, BrushedParams, FlakesParams, Footprint, GlintNdf, MaskingMode, MixtureParams,
+    MixturePatch, NormalMap, NormalRepair, PatchOptions, ScratchedParams, TangentConvention,
+    brushed, bumpy, flakes, naive_brdf, scratched,
 };
 use brdf::ndf::Ndf;
 use glam::{Vec2, Vec3};
@@ -242,7 +242,7 @@ fn intersect_unit_sphere(o: Vec3, d: Vec3) -> Option<f32> {
     let b = o.dot(d);
     let c = o.length_squared() - 1.0;
     let disc = b * b - c;
-    if !(disc >= 0.0) {
+    if disc.is_nan() || disc < 0.0 {
         return None;
     }
     let t = -b - disc.sqrt();
@@ -408,8 +408,8 @@ fn naive_pixel(
     for j in 0..k {
         for i in 0..k {
             let jitter = Vec2::new(rng.random::<f32>(), rng.random::<f32>());
-            let px = Vec2::new(x as f32, y as f32)
-                + (Vec2::new(i as f32, j as f32) + jitter) / k as f32;
+            let px =
+                Vec2::new(x as f32, y as f32) + (Vec2::new(i as f32, j as f32) + jitter) / k as f32;
             if let Some(sp) = scene.shading(px) {
                 sum += naive_radiance(scene, map, sigma_eps, &sp);
             }
@@ -583,7 +583,11 @@ pub fn exposure_of(img: &Image, mask: &[bool]) -> f32 {
 }
 
 fn srgb(c: f32) -> u8 {
-    let c = if c.is_finite() { c.clamp(0.0, 1.0) } else { 0.0 };
+    let c = if c.is_finite() {
+        c.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let s = if c <= 0.003_130_8 {
         12.92 * c
     } else {
@@ -753,7 +757,11 @@ pub fn render_all(opts: &OrbOptions, map: &NormalMap) -> Res<((Image, Image, f64
     }
 
     let k = (((opts.spp / 2).max(1) as f64).sqrt().round() as u32).max(1);
-    let bar = progress_bar(opts.progress, 2 * rows, &format!("reference, 2 × {} spp", k * k));
+    let bar = progress_bar(
+        opts.progress,
+        2 * rows,
+        &format!("reference, 2 × {} spp", k * k),
+    );
     let t = Instant::now();
     let (a, b) = render_reference_halves(&scene, map, opts.sigma_eps, k, opts.seed, &bar);
     let ref_s = t.elapsed().as_secs_f64();
@@ -790,12 +798,10 @@ pub fn run(opts: &OrbOptions, out: &Path) -> Res<Vec<Artifact>> {
 
     let mut artifacts = Vec::new();
     let mut csv = String::from(
-        "map,method,build_s,render_s,rel_rmse,rel_rmse_denoised,rel_rmse_4x4,energy_error\n",
+        "map,method,build_s,render_s,rel_rmse,rel_rmse_denoised,rel_rmse_4x4,energy_error,\
+         reference_noise\n",
     );
-    let _ = writeln!(
-        csv,
-        "{name},{ref_label},0,{ref_s:.3},{noise:.4},0,,0"
-    );
+    let _ = writeln!(csv, "{name},\"{ref_label}\",0,{ref_s:.3},,,,,{noise:.4}");
     println!(
         "orb: {name} map {}x{} ({map_s:.1} s), tiles {}x{}, image {}², σ_ε {}",
         map.width(),
@@ -822,11 +828,17 @@ pub fn run(opts: &OrbOptions, out: &Path) -> Res<Vec<Artifact>> {
         let e = errors(&m.image, &a, &b, &mask);
         println!(
             "{:<28} {:>8.2} {:>8.2} {:>9.3} {:>9.3} {:>9.3} {:>+9.3}",
-            m.label, m.build_s, m.render_s, e.rel_rmse, e.rel_rmse_denoised, e.rel_rmse_blocks, e.energy
+            m.label,
+            m.build_s,
+            m.render_s,
+            e.rel_rmse,
+            e.rel_rmse_denoised,
+            e.rel_rmse_blocks,
+            e.energy
         );
         let _ = writeln!(
             csv,
-            "{name},{},{:.3},{:.3},{:.4},{:.4},{:.4},{:.4}",
+            "{name},\"{}\",{:.3},{:.3},{:.4},{:.4},{:.4},{:.4},",
             m.label,
             m.build_s,
             m.render_s,
@@ -864,7 +876,10 @@ pub fn run(opts: &OrbOptions, out: &Path) -> Res<Vec<Artifact>> {
         0,
         Artifact::new(
             &ref_path,
-            format!("naive reference, {} spp (relative noise {noise:.3})", 2 * k * k),
+            format!(
+                "naive reference, {} spp (relative noise {noise:.3})",
+                2 * k * k
+            ),
         ),
     );
     let (w, h, buf) = strip(&panels, opts.size)?;
