@@ -3,7 +3,8 @@
 //!
 //! `cargo run --release --example orb -- [--map scratched|brushed|bumpy|flakes|PATH] [--spp N]
 //! [--size PIXELS] [--map-size TEXELS] [--tiles UxV] [--naive-spp N] [--sigma S]
-//! [--cosine patch|geometric] [--out DIR] [--quiet]`
+//! [--cosine patch|geometric] [--out DIR] [--quiet]`, or `-- --quick [--out DIR]` for the gallery's
+//! small strip (scratched 512² map, 160² pixels, 256 spp).
 //!
 //! Writes one PNG per method, a labelled strip and a CSV of times and errors into DIR (default
 //! `target/brdf-out/`), and prints the table.
@@ -52,9 +53,12 @@ fn options() -> Res<OrbOptions> {
 }
 
 fn main() -> Res<()> {
-    let opts = options()?;
     let out = common::out_dir()?;
-    common::orb::run(&opts, &out)?;
+    if has_flag("--quick") {
+        common::orb::run_gallery(&out, true)?;
+    } else {
+        common::orb::run(&options()?, &out)?;
+    }
     Ok(())
 }
 

@@ -908,14 +908,14 @@ pub fn run(opts: &OrbOptions, out: &Path) -> Res<Vec<Artifact>> {
     Ok(artifacts)
 }
 
-/// The gallery's part: a small strip (scratched 512² map, 160² image, 128 spp), well under 60 s.
+/// The gallery's part: a small strip (scratched 512² map, 160² image, 256 spp), well under 60 s.
 pub fn run_gallery(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
     let opts = if quick {
         OrbOptions {
             size: 160,
             map_size: 512,
             tiles: Vec2::new(4.0, 2.0),
-            spp: 128,
+            spp: 256,
             progress: false,
             ..OrbOptions::default()
         }
