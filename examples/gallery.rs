@@ -18,7 +18,7 @@ type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
 fn main() -> Res<()> {
     let out = common::out_dir()?;
     let quick = !common::has_flag("--full");
-    let parts: [(&str, &str, Part); 4] = [
+    let parts: [(&str, &str, Part); 5] = [
         (
             "Analytic core",
             "NDF slices, Smith masking and Fresnel curves.",
@@ -40,6 +40,12 @@ fn main() -> Res<()> {
             "Glints: the Beckmann mixture (Chermain 2019)",
             "The mixture's P-NDF against the ground truth, per map and footprint size.",
             common::mixture_images::run,
+        ),
+        (
+            "Accuracy against speed",
+            "Every glint method on the four procedural maps: distance to the ground truth against \
+             cost, footprint size and view angle, and the white furnace (the compare example).",
+            common::compare::run,
         ),
     ];
     let mut sections = Vec::new();

@@ -5,6 +5,7 @@
 //! `examples/<name>.rs` mains and the `gallery` run the same code.
 #![allow(dead_code)]
 
+pub mod compare;
 pub mod curves;
 pub mod lobes;
 pub mod mixture_images;
@@ -266,8 +267,10 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
                                 PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
                             });
                         if chart.markers {
+                            // A lone point (one method in a scatter-like chart) gets a big marker.
+                            let r = if pts.len() == 1 { 7 } else { 3 };
                             ctx.draw_series(
-                                pts.iter().map(|&p| Circle::new(p, 3, color.filled())),
+                                pts.iter().map(|&p| Circle::new(p, r, color.filled())),
                             )?;
                         }
                     }

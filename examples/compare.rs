@@ -1,0 +1,59 @@
+//! Accuracy against speed of every glint method, on the four procedural maps.
+//!
+//! `cargo run --release --example compare -- [--out DIR] [--quick]`
+//!
+//! Writes `compare_*.csv`, `compare_*.png` and `compare_tables.md` into DIR (default
+//! `target/brdf-out/`) and prints the tables. `--quick`: 1024² maps (≈ minutes on 2 cores); without
+//! it, 2048² maps and 4× the ground-truth samples. See `examples/common/compare.rs` for what is
+//! measured and how.
+
+mod common;
+
+fn main() -> common::Res<()> {
+    let out = common::out_dir()?;
+    for a in common::compare::run(&out, common::has_flag("--quick"))? {
+        println!("{}", a.path.display());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::common::compare::*;
+
+    /// Every code path on tiny inputs: finite measurements, sane ranges, files written.
+    #[test]
+    fn tiny_run_is_finite_and_sane() {
+        let settings = Settings::tiny();
+        let results = measure(&settings, &mut |_| {}).unwrap();
+        assert!(!results.accuracy.is_empty() && !results.view.is_empty());
+        for r in &results.accuracy {
+            // TV lies in [0, 1] (+ rounding); times are positive.
+            assert!((0.0..=1.0 + 1e-6).contains(&r.tv), "{r:?}");
+            assert!(r.patch_s > 0.0 && r.d_s > 0.0 && r.eval_s > 0.0, "{r:?}");
+        }
+        for r in &results.view {
+            assert!(
+                r.v_rel_error.is_finite() && r.furnace_patch.is_finite(),
+                "{r:?}"
+            );
+            // Exact masking conserves energy in the patch measure (Monte Carlo with 64 samples:
+            // a generous 10 % for the estimator's noise).
+            if r.method == "mixture (exact)" {
+                assert!(r.furnace_patch <= 1.1, "{r:?}");
+            }
+        }
+        let out = std::env::temp_dir().join("brdf-compare-test");
+        let (artifacts, md) = report(&results, &settings, &out).unwrap();
+        assert!(md.contains("mixture (exact)"));
+        for a in artifacts {
+            assert!(a.path.exists(), "{}", a.path.display());
+        }
+    }
+
+    #[test]
+    fn pareto_front_keeps_the_non_dominated() {
+        let pts = [(1.0, 0.5), (2.0, 0.6), (3.0, 0.1), (0.5, 0.9)];
+        assert_eq!(pareto(&pts), vec![(0.5, 0.9), (1.0, 0.5), (3.0, 0.1)]);
+    }
+}
