@@ -18,7 +18,7 @@ type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
 fn main() -> Res<()> {
     let out = common::out_dir()?;
     let quick = !common::has_flag("--full");
-    let parts: [(&str, &str, Part); 5] = [
+    let parts: [(&str, &str, Part); 6] = [
         (
             "Analytic core",
             "NDF slices, Smith masking and Fresnel curves.",
@@ -40,6 +40,12 @@ fn main() -> Res<()> {
             "Glints: the Beckmann mixture (Chermain 2019)",
             "The mixture's P-NDF against the ground truth, per map and footprint size.",
             common::mixture_images::run,
+        ),
+        (
+            "Orb renders",
+            "A metallic sphere with a high-definition normal map under a point light (Chermain 2019 \
+             Fig. 1): each glint method beside the naive reference (the orb example, small strip).",
+            common::orb::run_gallery,
         ),
         (
             "Accuracy against speed",
