@@ -184,6 +184,25 @@ impl Effective {
         )
     }
 
+    /// The weights of lobes (i0, j), (i0 + 1, j), … along a row, by the exact recurrence of a
+    /// Gaussian on a lattice: with q(i) the quadratic form at lobe i, q(i + 1) − q(i) is linear in i,
+    /// so e(i + 1) = e(i) r(i) and r(i + 1) = r(i) e^{−Σ⁻¹ₓₓ}: three `exp` per row, two
+    /// multiplications per lobe (relative drift ~1e-16 per step, negligible over a footprint).
+    fn row_weights(&self, i0: i64, j: i64) -> impl Iterator<Item = f64> {
+        let [a, b, _] = self.inv;
+        let dx = i0 as f64 + 0.5 - self.c[0];
+        let dy = j as f64 + 0.5 - self.c[1];
+        let mut e = self.weight(i0, j);
+        let mut r = (-0.5 * (a * (2.0 * dx + 1.0) + 2.0 * b * dy)).exp();
+        let s = (-a).exp();
+        std::iter::repeat_with(move || {
+            let out = e;
+            e *= r;
+            r *= s;
+            out
+        })
+    }
+
     #[inline]
     fn weight(&self, i: i64, j: i64) -> f64 {
         let dx = i as f64 + 0.5 - self.c[0];
@@ -295,9 +314,9 @@ impl<'a> MixturePatch<'a> {
         let (j0, j1) = axes[1].unwrapped_range(eff.c[1], half[1]);
         for j in j0..=j1 {
             let sy = axes[1].slot_of_unwrapped(j);
-            for i in i0..=i1 {
-                let sx = axes[0].slot_of_unwrapped(i);
-                w[sy * lx + sx] += eff.weight(i, j);
+            let row = &mut w[sy * lx..(sy + 1) * lx];
+            for (i, wi) in (i0..=i1).zip(eff.row_weights(i0, j)) {
+                row[axes[0].slot_of_unwrapped(i)] += wi;
             }
         }
         let total: f64 = w.iter().sum();
