@@ -51,6 +51,12 @@ pub const DEFAULT_LOOKUP: BinLookup = BinLookup::Dense;
 /// than 4 texels take their masking lobe from level 2.
 pub const MASKING_FIRST_LEVEL: usize = 2;
 
+/// Largest footprint (texels²) whose patch computes its masking terms from its own bins (one
+/// O(|A|) pass over the footprint's texels at patch construction, then O(bins in A) per direction);
+/// larger footprints use the filtered-moment lobe (O(1)). 4096 texels: measured in docs/results.md
+/// (white furnace with both, cost of the pass).
+pub const EXACT_MASKING_TEXELS: f32 = 4096.0;
+
 /// Build parameters of a [`BinMap`]. `Default` gives the documented `DEFAULT_*` values.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BinMapParams {

@@ -4,8 +4,8 @@
 //! # Reference
 //! \[Atanasov2020\] §2 (D_A^H), §2.1 (sampling), §2.2 (evaluation through 𝓑⁻¹).
 
-use super::BinMap;
-use super::clip::Parallelogram;
+use super::clip::{Overlap, Parallelogram};
+use super::{BinMap, EXACT_MASKING_TEXELS};
 use super::forest::QueryStats;
 use crate::glint::{Footprint, MIN_WIDTH_TEXELS};
 use crate::ndf::{Ndf, SlopeGaussian};
@@ -33,11 +33,18 @@ const SMOOTH_TAIL: f64 = 1e-6;
 /// ∫ D_j cos = 1), over the bins whose centre slope lies within 5.26 σ of h's slope (≤ 10⁻⁶ of each
 /// lobe left out). Cost ∝ (n α)² lookups per evaluation.
 ///
-/// **Masking** (the talk defines none): the Smith terms of the footprint's filtered-moment
-/// Beckmann lobe, [`SlopeGaussian::from_moments`] of the slope moments from the map's moment mip
-/// chain at the footprint centre and radius ½√|A| (σ floored at `sigma_min`): `projected_area`,
-/// `lambda` and `visible_area` are that lobe's, whose first two slope moments match the
-/// footprint's. See docs/binmap.md for why, and the white furnace in tests/binmap.rs.
+/// **Masking** (the talk defines none). For footprints of at most [`EXACT_MASKING_TEXELS`] texels,
+/// Smith terms of the bin-map D itself, from the footprint's bins enumerated once per patch
+/// (O(|A|), through 𝓑): V(w) = ∫⟨w, m⟩⁺ D dm ≈ Σ_j mass_j ⟨w, c_j⟩⁺ / c̄_j (each bin's D is constant,
+/// so the integral is exact with the bin's mean direction in place of its centre c_j), the signed
+/// projected area A(w) = max(Σ_j mass_j ⟨w, c_j⟩ / c̄_j, 0) and Λ = V/A − 1, the same construction as
+/// the mixture's exact terms (\[Chermain2019\] eq. 13-17). Larger footprints use the Smith terms of
+/// the footprint's filtered-moment Beckmann lobe ([`SlopeGaussian::from_moments`] of the map's
+/// moment mip chain at the footprint centre and radius ½√|A|, σ floored at `sigma_min`), whose
+/// first two slope moments approximate the footprint's. See docs/binmap.md and the white furnace in
+/// tests/binmap.rs. The lobe's V is replaced by Scarf's moment bound
+/// ([`BinMapPatch::moment_bound_visible_area`]) and A by its signed projected area, so Λ is
+/// conservative (a Gaussian's V can be below a spiky distribution's with the same moments).
 ///
 /// **Sampling.** [`Ndf::sample_normal`]: a uniform point y of A from u, its texel (wrapped), the
 /// texel's bin through 𝓑, then a uniform direction in that bin (or a draw of the bin's smoothing
@@ -58,6 +65,8 @@ pub struct BinMapPatch<'a> {
     /// Translations bringing each periodic image of the map's tile that meets A onto the map.
     images: Vec<[f64; 2]>,
     lobe: SlopeGaussian,
+    /// Exact masking terms for footprints of at most [`EXACT_MASKING_TEXELS`].
+    exact: Option<ExactMasking>,
     /// Smoothing lobes' slope σ, if any.
     sigma: Option<f64>,
 }
@@ -80,11 +89,14 @@ impl<'a> BinMapPatch<'a> {
             .moments
             .filtered(map.width, map.height, center, radius);
         let lobe = SlopeGaussian::from_moments(moments, map.params.sigma_min);
+        let exact = (para.area() <= EXACT_MASKING_TEXELS as f64)
+            .then(|| ExactMasking::new(map, &para, &images));
         BinMapPatch {
             map,
             para,
             images,
             lobe,
+            exact,
             sigma: alpha.map(|a| a as f64 / std::f64::consts::SQRT_2),
         }
     }
@@ -112,6 +124,35 @@ impl<'a> BinMapPatch<'a> {
     /// map).
     pub fn image_count(&self) -> usize {
         self.images.len()
+    }
+
+    /// Scarf's bound of the visible area from the masking lobe's first two moments:
+    /// V(w) = ½ (ā + √(ā² + s²)) with ā = cos θ − w_xy·μ and s² = w_xyᵀ Σ w_xy, the largest
+    /// E[(w_z − w_xy·ñ)⁺] over every slope distribution of mean μ and covariance Σ (≥ the Gaussian
+    /// lobe's own V). Conservative, so the white furnace stays ≤ 1 whatever the footprint's slope
+    /// distribution when the moments are the footprint's.
+    ///
+    /// # Reference
+    /// Scarf, "A min-max solution of an inventory problem" (1958), the bound
+    /// E[X⁺] ≤ ½(E[X] + √(E[X]² + Var X)).
+    pub fn moment_bound_visible_area(&self, w: Vec3) -> f32 {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let a = self.lobe.signed_projected_area(w) as f64;
+        let c = self.lobe.covariance();
+        let (x, y) = (w.x as f64, w.y as f64);
+        let s2 = (c.x_axis.x as f64 * x * x
+            + 2.0 * c.y_axis.x as f64 * x * y
+            + c.y_axis.y as f64 * y * y)
+            .max(0.0);
+        finite_or_zero(0.5 * (a + (a * a + s2).sqrt()))
+    }
+
+    /// Whether the masking terms are computed from the footprint's bins (|A| ≤
+    /// [`EXACT_MASKING_TEXELS`]) rather than from the masking lobe.
+    pub fn has_exact_masking(&self) -> bool {
+        self.exact.is_some()
     }
 
     /// The masking lobe (the footprint's filtered-moment Beckmann lobe).
@@ -215,7 +256,16 @@ impl<'a> BinMapPatch<'a> {
     /// A direction in the texel's bin (or from its smoothing lobe) from the second pair `v`.
     fn direction_for_bin(&self, bin: usize, v: Vec2) -> Vec3 {
         match self.sigma {
-            None => self.map.bins.sample_in_bin(bin, v),
+            None => {
+                // Rounding of the equal-area map can put a draw on the very edge of the cell into
+                // the neighbouring bin (~1e-6 of draws): those take the bin's centre instead.
+                let m = self.map.bins.sample_in_bin(bin, v);
+                if self.map.bins.bin_of(m) == Some(bin) {
+                    m
+                } else {
+                    self.map.bins.center(bin)
+                }
+            }
             Some(sigma) => {
                 let g = square_to_gaussian_2d(v);
                 let c = self.map.center_slope[bin];
@@ -237,6 +287,77 @@ impl<'a> BinMapPatch<'a> {
             None => self.map.bins.bin_of(m).map_or(0.0, |b| self.bin_d(b)),
             Some(sigma) => self.smoothed_d(m, sigma),
         }
+    }
+}
+
+/// The footprint's bins with their masses, for masking terms computed from the bin-map D itself.
+#[derive(Clone, Debug)]
+struct ExactMasking {
+    /// Per non-empty bin: mass_j · c_j / c̄_j (c_j the bin's centre direction, c̄_j its mean cosine).
+    facets: Vec<Vec3>,
+    /// Σ of `facets`: A(w) = max(w · a, 0).
+    a: Vec3,
+}
+
+impl ExactMasking {
+    /// Enumerates the texels of A (every periodic image), their exact overlaps and bins through 𝓑:
+    /// O(|A|) once per patch.
+    fn new(map: &BinMap, para: &Parallelogram, images: &[[f64; 2]]) -> ExactMasking {
+        let (w, h) = (map.width as i64, map.height as i64);
+        let mut acc: Vec<(u32, f64)> = Vec::new();
+        for &d in images {
+            let p = para.translated(d);
+            let (lo, hi) = p.bounds();
+            let (i0, i1) = ((lo[0].floor() as i64).max(0), (hi[0].ceil() as i64).min(w));
+            let (j0, j1) = ((lo[1].floor() as i64).max(0), (hi[1].ceil() as i64).min(h));
+            for j in j0..j1 {
+                for i in i0..i1 {
+                    let (x, y) = (i as f64, j as f64);
+                    let ov = match p.classify(x, y, x + 1.0, y + 1.0) {
+                        Overlap::Outside => continue,
+                        Overlap::Inside => 1.0,
+                        Overlap::Partial => p.clipped_area(x, y, x + 1.0, y + 1.0),
+                    };
+                    if ov > 0.0 {
+                        acc.push((map.bin_map[(j * w + i) as usize], ov));
+                    }
+                }
+            }
+        }
+        acc.sort_unstable_by_key(|e| e.0);
+        let inv_area = 1.0 / para.area();
+        let mut facets = Vec::new();
+        let mut a = [0.0f64; 3];
+        let mut k = 0;
+        while k < acc.len() {
+            let bin = acc[k].0;
+            let mut mass = 0.0;
+            while k < acc.len() && acc[k].0 == bin {
+                mass += acc[k].1;
+                k += 1;
+            }
+            let c = map.bins.center(bin as usize).to_array();
+            let scale = mass * inv_area / map.mean_cos[bin as usize] as f64;
+            let f: [f64; 3] = std::array::from_fn(|i| c[i] as f64 * scale);
+            for i in 0..3 {
+                a[i] += f[i];
+            }
+            facets.push(Vec3::new(f[0] as f32, f[1] as f32, f[2] as f32));
+        }
+        ExactMasking {
+            facets,
+            a: Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32),
+        }
+    }
+
+    /// V(w) = Σ_j mass_j ⟨w, c_j⟩⁺ / c̄_j.
+    fn visible_area(&self, w: Vec3) -> f32 {
+        let v: f64 = self
+            .facets
+            .iter()
+            .map(|f| (w.dot(*f) as f64).max(0.0))
+            .sum();
+        v as f32
     }
 }
 
@@ -270,19 +391,40 @@ impl Ndf for BinMapPatch<'_> {
         finite_or_zero(self.d_f64(m))
     }
 
-    /// The masking lobe's Smith Λ (type docs).
+    /// Λ(w) = V(w)/A(w) − 1 (exact terms) or the masking lobe's Λ (type docs); `f32::MAX` when
+    /// A(w) ≤ 0 < w_z, 0 for invalid w.
     fn lambda(&self, w: Vec3) -> f32 {
-        self.lobe.lambda(w)
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let a = self.projected_area(w);
+        if a.is_nan() || a <= 0.0 {
+            return f32::MAX;
+        }
+        ((self.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
     }
 
-    /// The masking lobe's projected area A(w) = max(cos θ − w_xy·μ, 0).
+    /// A(w) = max(w · Σ_j mass_j c_j / c̄_j, 0) (exact terms) or the masking lobe's
+    /// max(cos θ − w_xy·μ, 0).
     fn projected_area(&self, w: Vec3) -> f32 {
-        self.lobe.projected_area(w)
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        match &self.exact {
+            Some(e) => w.dot(e.a).max(0.0),
+            None => self.lobe.signed_projected_area(w).max(0.0),
+        }
     }
 
-    /// The masking lobe's visible area V(w) = A(w)(1 + Λ(w)).
+    /// V(w) = Σ_j mass_j ⟨w, c_j⟩⁺ / c̄_j (exact terms) or the masking lobe's V.
     fn visible_area(&self, w: Vec3) -> f32 {
-        self.lobe.visible_area(w)
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        match &self.exact {
+            Some(e) => e.visible_area(w),
+            None => self.moment_bound_visible_area(w),
+        }
     }
 
     /// A point of A from `u`, its texel's bin through 𝓑, a direction in the bin (or the bin's
