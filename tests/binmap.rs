@@ -11,8 +11,9 @@ use brdf::bxdf::Masking;
 use brdf::frame::slope_to_normal;
 use brdf::fresnel::NoFresnel;
 use brdf::glint::{
-    BinLookup, BinMap, BinMapParams, BinMapPatch, Footprint, GlintNdf, HemisphereBins, Kernel,
-    NormalMap, binned_pndf, bumpy, flakes, FlakesParams, scratched, ScratchedParams, tv_distance,
+    BinLookup, BinMap, BinMapParams, BinMapPatch, FlakesParams, Footprint, GlintNdf,
+    HemisphereBins, Kernel, NormalMap, ScratchedParams, binned_pndf, bumpy, flakes, scratched,
+    tv_distance,
 };
 use brdf::ndf::Ndf;
 use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
@@ -81,7 +82,10 @@ fn every_texel_in_exactly_one_bin_list() {
                 total += bm.texels_of_bin(bin).len();
             }
             assert_eq!(total, texels, "{name} n={n}");
-            assert!(seen.iter().all(|&c| c == 1), "{name} n={n}: a texel is missing or repeated");
+            assert!(
+                seen.iter().all(|&c| c == 1),
+                "{name} n={n}: a texel is missing or repeated"
+            );
             // The lists tile the inverse map in bin order.
             let mut next = 0;
             for bin in 0..bm.bins().len() {
@@ -196,9 +200,9 @@ fn axis_aligned_footprints_match_interval_products() {
         let bm = BinMap::build(&map, params(n, leaf, BinLookup::Dense)).unwrap();
         for (c, sx, sy) in [
             (Vec2::new(0.5, 0.5), 3.3, 2.7),
-            (Vec2::new(0.01, 0.98), 7.5, 4.25),    // crosses two borders
-            (Vec2::new(0.3, 0.6), 61.0, 47.5),     // larger than the map
-            (Vec2::new(0.77, 0.2), 0.3, 0.45),     // sub-texel
+            (Vec2::new(0.01, 0.98), 7.5, 4.25), // crosses two borders
+            (Vec2::new(0.3, 0.6), 61.0, 47.5),  // larger than the map
+            (Vec2::new(0.77, 0.2), 0.3, 0.45),  // sub-texel
         ] {
             let fp = Footprint::from_differentials(
                 c,
@@ -263,7 +267,10 @@ fn rotated_footprint_masses_match_point_sampling() {
             // Jittered stratification has at most the binomial variance p(1 − p)/N: 5 standard
             // errors, plus 1e-6 for f32 point coordinates.
             let tol = 5.0 * (p * (1.0 - p) / n).sqrt() + 1e-6;
-            assert!((got - p).abs() <= tol, "{c} bin {bin}: {got} vs {p} ± {tol}");
+            assert!(
+                (got - p).abs() <= tol,
+                "{c} bin {bin}: {got} vs {p} ± {tol}"
+            );
         }
     }
 }
@@ -312,14 +319,20 @@ fn smoothed_d_cos_integrates_to_one() {
     let bm = BinMap::build(&map, params(31, 16, BinLookup::Dense)).unwrap();
     let alpha = 0.15f32;
     let sigma = alpha as f64 / 2f64.sqrt();
-    let patch = bm.patch_smoothed(&Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 64.0, 32, 32), alpha);
+    let patch = bm.patch_smoothed(
+        &Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 64.0, 32, 32),
+        alpha,
+    );
     let step = sigma / 2.0;
     let ext = 2.0;
     let nstep = (2.0 * ext / step) as i64;
     let mut s = 0.0;
     for j in 0..=nstep {
         for i in 0..=nstep {
-            let sl = Vec2::new((-ext + i as f64 * step) as f32, (-ext + j as f64 * step) as f32);
+            let sl = Vec2::new(
+                (-ext + i as f64 * step) as f32,
+                (-ext + j as f64 * step) as f32,
+            );
             let m = slope_to_normal(sl);
             s += patch.d(m) as f64 * (m.z as f64).powi(4);
         }
@@ -360,9 +373,9 @@ fn albedo<N: Ndf>(brdf: &MicrofacetBrdf<N, NoFresnel>, wo: Vec3, n: usize) -> (f
     let (mut sum, mut sum2) = (0.0, 0.0);
     for k in 0..n {
         let u = Vec2::new((k as f32 + rng.random::<f32>()) / n as f32, rng.random());
-        let v = brdf
-            .sample(wo, 0.5, u)
-            .map_or(0.0, |s| (s.f.x * brdf.ndf().projected_area(s.wi) / s.pdf) as f64);
+        let v = brdf.sample(wo, 0.5, u).map_or(0.0, |s| {
+            (s.f.x * brdf.ndf().projected_area(s.wi) / s.pdf) as f64
+        });
         sum += v;
         sum2 += v * v;
     }
@@ -379,7 +392,10 @@ fn white_furnace() {
         let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
         for area in [16.0, 1024.0, 8192.0] {
             let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.61), area, w, h);
-            for (label, patch) in [("bins", bm.patch(&fp)), ("α=0.1", bm.patch_smoothed(&fp, 0.1))] {
+            for (label, patch) in [
+                ("bins", bm.patch(&fp)),
+                ("α=0.1", bm.patch_smoothed(&fp, 0.1)),
+            ] {
                 if label != "bins" && area != 16.0 {
                     continue;
                 }
@@ -397,7 +413,10 @@ fn white_furnace() {
                         row.push(format!("{e:.3}"));
                     }
                 }
-                lines.push(format!("| {name} | {label} | {area} | {} |", row.join(" | ")));
+                lines.push(format!(
+                    "| {name} | {label} | {area} | {} |",
+                    row.join(" | ")
+                ));
             }
         }
     }
@@ -415,7 +434,11 @@ fn chi_square_of_the_bin_sampler() {
     let bm = BinMap::build(&map, params(63, 16, BinLookup::Dense)).unwrap();
     let bins = *bm.bins();
     let alpha = 1.0 - 0.99f64.powf(1.0 / 6.0);
-    for (c, area) in [(Vec2::new(0.43, 0.57), 16.0), (Vec2::new(0.95, 0.02), 300.0), (Vec2::new(0.5, 0.5), 4096.0)] {
+    for (c, area) in [
+        (Vec2::new(0.43, 0.57), 16.0),
+        (Vec2::new(0.95, 0.02), 300.0),
+        (Vec2::new(0.5, 0.5), 4096.0),
+    ] {
         let patch = bm.patch(&Footprint::isotropic_texels(c, area, 64, 64));
         let n = 1_000_000usize;
         let mut counts = vec![0.0f64; bins.len()];
@@ -495,8 +518,20 @@ fn chi_square_of_the_smoothed_sampler() {
 #[test]
 fn bad_input_is_total() {
     let map = bumpy(16, 16, 0.25, 4.0, 1).unwrap();
-    for (n, leaf, sigma) in [(0, 16, 0.01), (8, 16, 0.01), (4097, 16, 0.01), (7, 0, 0.01), (7, 16, f32::NAN), (7, 16, 0.0)] {
-        let p = BinMapParams { bins_per_axis: n, leaf_size: leaf, sigma_min: sigma, ..BinMapParams::default() };
+    for (n, leaf, sigma) in [
+        (0, 16, 0.01),
+        (8, 16, 0.01),
+        (4097, 16, 0.01),
+        (7, 0, 0.01),
+        (7, 16, f32::NAN),
+        (7, 16, 0.0),
+    ] {
+        let p = BinMapParams {
+            bins_per_axis: n,
+            leaf_size: leaf,
+            sigma_min: sigma,
+            ..BinMapParams::default()
+        };
         assert!(BinMap::build(&map, p).is_err(), "{n} {leaf} {sigma}");
     }
     let bm = BinMap::build(&map, params(1, 16, BinLookup::Hash)).unwrap();
@@ -505,8 +540,16 @@ fn bad_input_is_total() {
     let footprints = [
         Footprint::from_differentials(Vec2::new(f32::NAN, 0.5), Vec2::ZERO, Vec2::ZERO),
         Footprint::from_differentials(Vec2::new(0.5, 0.5), Vec2::new(f32::INFINITY, 0.0), Vec2::Y),
-        Footprint::from_differentials(Vec2::new(0.5, 0.5), Vec2::new(1e6, 0.0), Vec2::new(0.0, 1e6)),
-        Footprint::from_differentials(Vec2::new(0.5, 0.5), Vec2::new(1.0, 1.0), Vec2::new(2.0, 2.0)),
+        Footprint::from_differentials(
+            Vec2::new(0.5, 0.5),
+            Vec2::new(1e6, 0.0),
+            Vec2::new(0.0, 1e6),
+        ),
+        Footprint::from_differentials(
+            Vec2::new(0.5, 0.5),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(2.0, 2.0),
+        ),
     ];
     let dirs = [
         Vec3::Z,
@@ -518,18 +561,37 @@ fn bad_input_is_total() {
         support::dir(30.0, 20.0),
     ];
     for fp in &footprints {
-        for patch in [bm.patch(fp), bm.patch_smoothed(fp, 0.2), bm.patch_smoothed(fp, f32::NAN)] {
+        for patch in [
+            bm.patch(fp),
+            bm.patch_smoothed(fp, 0.2),
+            bm.patch_smoothed(fp, f32::NAN),
+        ] {
             let s: f64 = (0..bm.bins().len()).map(|b| patch.bin_mass(b)).sum();
             // Masses of a clamped footprint still sum to 1 (f64 sums: 1e-9).
             assert!((s - 1.0).abs() < 1e-9, "{fp:?}: Σ mass = {s}");
             for &m in &dirs {
-                for v in [patch.d(m), patch.lambda(m), patch.projected_area(m), patch.visible_area(m), patch.pdf_normal(m), patch.pdf_visible(Vec3::Z, m)] {
+                for v in [
+                    patch.d(m),
+                    patch.lambda(m),
+                    patch.projected_area(m),
+                    patch.visible_area(m),
+                    patch.pdf_normal(m),
+                    patch.pdf_visible(Vec3::Z, m),
+                ] {
                     assert!(v.is_finite() && v >= 0.0, "{fp:?} {m}: {v}");
                 }
             }
-            for u in [Vec2::ZERO, Vec2::ONE, Vec2::splat(f32::NAN), Vec2::new(0.3, 0.9)] {
+            for u in [
+                Vec2::ZERO,
+                Vec2::ONE,
+                Vec2::splat(f32::NAN),
+                Vec2::new(0.3, 0.9),
+            ] {
                 let m = patch.sample_normal(u);
-                assert!(m.is_finite() && m.z > 0.0 && (m.length() - 1.0).abs() < 1e-4, "{m}");
+                assert!(
+                    m.is_finite() && m.z > 0.0 && (m.length() - 1.0).abs() < 1e-4,
+                    "{m}"
+                );
             }
         }
     }
@@ -548,12 +610,20 @@ fn accuracy_table() {
     let n = 256;
     let maps = vec![
         ("bumpy", bumpy(n, n, 0.25, 4.0, 1).unwrap()),
-        ("brushed", brushed(n, n, BrushedParams::default(), 2).unwrap()),
-        ("scratched", scratched(n, n, ScratchedParams::default(), 3).unwrap()),
+        (
+            "brushed",
+            brushed(n, n, BrushedParams::default(), 2).unwrap(),
+        ),
+        (
+            "scratched",
+            scratched(n, n, ScratchedParams::default(), 3).unwrap(),
+        ),
         ("flakes", flakes(n, n, FlakesParams::default(), 4).unwrap()),
     ];
     let bins = HemisphereBins::new(64).unwrap();
-    println!("| map | footprint (texels) | TV bins, Gaussian ref. | TV bins, parallelogram ref. | TV α = 0.02, parallelogram ref. | TV mask lobe, Gaussian ref. | reference noise |");
+    println!(
+        "| map | footprint (texels) | TV bins, Gaussian ref. | TV bins, parallelogram ref. | TV α = 0.02, parallelogram ref. | TV mask lobe, Gaussian ref. | reference noise |"
+    );
     println!("|---|---|---|---|---|---|---|");
     for (name, map) in &maps {
         let bm = BinMap::build(map, BinMapParams::default()).unwrap();
@@ -586,7 +656,14 @@ fn build_2048() {
     let map = bumpy(n, n, 0.25, 4.0, 1).unwrap();
     for lookup in [BinLookup::Dense, BinLookup::Hash] {
         let t = std::time::Instant::now();
-        let bm = BinMap::build(&map, BinMapParams { lookup, ..BinMapParams::default() }).unwrap();
+        let bm = BinMap::build(
+            &map,
+            BinMapParams {
+                lookup,
+                ..BinMapParams::default()
+            },
+        )
+        .unwrap();
         let dt = t.elapsed();
         let mem = bm.memory();
         let tex = (n * n) as f64;
@@ -603,10 +680,25 @@ fn build_2048() {
         );
     }
     let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
-    println!("| footprint (texels) | nodes / query | texels tested / query | clipped / query |");
-    println!("|---|---|---|---|");
+    let hashed = BinMap::build(
+        &map,
+        BinMapParams {
+            lookup: BinLookup::Hash,
+            ..BinMapParams::default()
+        },
+    )
+    .unwrap();
+    println!(
+        "| footprint (texels) | nodes / query | texels tested / query | clipped / query | d dense | d hash | patch() |"
+    );
+    println!("|---|---|---|---|---|---|---|");
     for area in [1.0f32, 16.0, 256.0, 4096.0, 65536.0] {
-        let patch = bm.patch(&Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n));
+        let patch = bm.patch(&Footprint::isotropic_texels(
+            Vec2::new(0.43, 0.57),
+            area,
+            n,
+            n,
+        ));
         let mut rng = support::rng(1);
         let (mut nodes, mut texels, mut clipped) = (0, 0, 0);
         let q = 2000;
@@ -617,11 +709,37 @@ fn build_2048() {
             texels += s.texels;
             clipped += s.clipped;
         }
+        // Wall-clock per call (median of 5 passes over 2000 half vectors drawn from the patch).
+        let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
+        let hs: Vec<Vec3> = (0..q)
+            .map(|_| patch.sample_normal(Vec2::new(rng.random(), rng.random())))
+            .collect();
+        let time_d = |p: &BinMapPatch| {
+            let mut t: Vec<f64> = (0..5)
+                .map(|_| {
+                    let t0 = std::time::Instant::now();
+                    let s: f32 = hs.iter().map(|&h| p.d(h)).sum();
+                    std::hint::black_box(s);
+                    t0.elapsed().as_secs_f64() / q as f64
+                })
+                .collect();
+            t.sort_by(f64::total_cmp);
+            t[2]
+        };
+        let (td, th) = (time_d(&patch), time_d(&hashed.patch(&fp)));
+        let t0 = std::time::Instant::now();
+        for _ in 0..20 {
+            std::hint::black_box(bm.patch(&fp).area_texels());
+        }
+        let tp = t0.elapsed().as_secs_f64() / 20.0;
         println!(
-            "| {area} | {:.1} | {:.1} | {:.1} |",
+            "| {area} | {:.1} | {:.1} | {:.1} | {:.2} µs | {:.2} µs | {:.1} µs |",
             nodes as f64 / q as f64,
             texels as f64 / q as f64,
-            clipped as f64 / q as f64
+            clipped as f64 / q as f64,
+            td * 1e6,
+            th * 1e6,
+            tp * 1e6
         );
     }
 }

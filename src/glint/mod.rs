@@ -60,7 +60,11 @@ mod normal_map;
 mod procedural;
 mod reference;
 
-pub use binmap::{BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, DEFAULT_BINS_PER_AXIS, DEFAULT_LEAF_SIZE, DEFAULT_LOOKUP, DEFAULT_MASKING_SIGMA_MIN, EXACT_MASKING_TEXELS, MASKING_FIRST_LEVEL, QueryStats};
+pub use binmap::{
+    BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, DEFAULT_BINS_PER_AXIS,
+    DEFAULT_LEAF_SIZE, DEFAULT_LOOKUP, DEFAULT_MASKING_SIGMA_MIN, EXACT_MASKING_TEXELS,
+    MASKING_FIRST_LEVEL, QueryStats,
+};
 pub use bins::HemisphereBins;
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 pub use mixture::{

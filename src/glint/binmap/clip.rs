@@ -146,8 +146,7 @@ impl Parallelogram {
         }
         let (w, h) = (x1 - x0, y1 - y0);
         // Each half-plane as (axis, bound, keep-below): x ≥ 0, x ≤ w, y ≥ 0, y ≤ h.
-        for (axis, bound, below) in [(0, 0.0, false), (0, w, true), (1, 0.0, false), (1, h, true)]
-        {
+        for (axis, bound, below) in [(0, 0.0, false), (0, w, true), (1, 0.0, false), (1, h, true)] {
             poly = poly.clip(axis, bound, below);
             if poly.len < 3 {
                 return 0.0;
@@ -176,7 +175,13 @@ impl Poly {
 
     /// Keeps the part with coordinate `axis` ≤ bound (`below`) or ≥ bound.
     fn clip(&self, axis: usize, bound: f64, below: bool) -> Poly {
-        let inside = |p: &[f64; 2]| if below { p[axis] <= bound } else { p[axis] >= bound };
+        let inside = |p: &[f64; 2]| {
+            if below {
+                p[axis] <= bound
+            } else {
+                p[axis] >= bound
+            }
+        };
         let mut out = Poly::default();
         for k in 0..self.len {
             let cur = self.v[k];
@@ -225,7 +230,10 @@ mod tests {
                 let expected = ov(0.3, 2.8, i as f64) * ov(-0.4, 0.7, j as f64);
                 let got = p.texel_overlap(i as f64, j as f64);
                 // f64 rounding of a handful of products: 1e-12.
-                assert!((got - expected).abs() < 1e-12, "({i}, {j}): {got} vs {expected}");
+                assert!(
+                    (got - expected).abs() < 1e-12,
+                    "({i}, {j}): {got} vs {expected}"
+                );
             }
         }
     }
@@ -243,7 +251,10 @@ mod tests {
                 2.0 * d * d - 4.0 * (d - 0.5).powi(2)
             };
             let got = p.texel_overlap(0.0, 0.0);
-            assert!((got - expected).abs() < 1e-12, "d = {d}: {got} vs {expected}");
+            assert!(
+                (got - expected).abs() < 1e-12,
+                "d = {d}: {got} vs {expected}"
+            );
         }
     }
 

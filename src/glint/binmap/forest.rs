@@ -48,15 +48,9 @@ impl Region {
     fn children(&self) -> (Region, Region) {
         let (along_x, mid) = self.split();
         if along_x {
-            (
-                Region { x1: mid, ..*self },
-                Region { x0: mid, ..*self },
-            )
+            (Region { x1: mid, ..*self }, Region { x0: mid, ..*self })
         } else {
-            (
-                Region { y1: mid, ..*self },
-                Region { y0: mid, ..*self },
-            )
+            (Region { y1: mid, ..*self }, Region { y0: mid, ..*self })
         }
     }
 }
@@ -83,7 +77,15 @@ pub(crate) fn build_tree(
         y1: height as u32,
     };
     let mut scratch = Vec::with_capacity(list.len());
-    build_node(list, offset, width as u32, region, leaf, nodes, &mut scratch);
+    build_node(
+        list,
+        offset,
+        width as u32,
+        region,
+        leaf,
+        nodes,
+        &mut scratch,
+    );
     root
 }
 
@@ -196,7 +198,11 @@ impl TreeView<'_> {
                 } else {
                     NO_TREE
                 };
-                let right_node = if end - mid > self.leaf { right } else { NO_TREE };
+                let right_node = if end - mid > self.leaf {
+                    right
+                } else {
+                    NO_TREE
+                };
                 self.node_area(p, start, mid, left_node, lr, stats)
                     + self.node_area(p, mid, end, right_node, rr, stats)
             }
@@ -204,7 +210,13 @@ impl TreeView<'_> {
         }
     }
 
-    fn leaf_area(&self, p: &Parallelogram, start: usize, end: usize, stats: &mut QueryStats) -> f64 {
+    fn leaf_area(
+        &self,
+        p: &Parallelogram,
+        start: usize,
+        end: usize,
+        stats: &mut QueryStats,
+    ) -> f64 {
         let mut sum = 0.0;
         for &k in &self.inverse[start..end] {
             let (i, j) = ((k % self.width) as f64, (k / self.width) as f64);

@@ -282,9 +282,9 @@ impl BinMap {
     /// 𝓑⁻¹(j): the texel indices of bin j, in the forest's order (empty for an empty or
     /// out-of-range bin).
     pub fn texels_of_bin(&self, bin: usize) -> &[u32] {
-        self.table.get(bin).map_or(&[], |e| {
-            &self.inverse[e.start as usize..e.end as usize]
-        })
+        self.table
+            .get(bin)
+            .map_or(&[], |e| &self.inverse[e.start as usize..e.end as usize])
     }
 
     /// The whole inverse bin map: the texel lists of bins 0, 1, … concatenated.

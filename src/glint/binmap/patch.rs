@@ -5,8 +5,8 @@
 //! \[Atanasov2020\] §2 (D_A^H), §2.1 (sampling), §2.2 (evaluation through 𝓑⁻¹).
 
 use super::clip::{Overlap, Parallelogram};
-use super::{BinMap, EXACT_MASKING_TEXELS};
 use super::forest::QueryStats;
+use super::{BinMap, EXACT_MASKING_TEXELS};
 use crate::glint::{Footprint, MIN_WIDTH_TEXELS};
 use crate::ndf::{Ndf, SlopeGaussian};
 use crate::warp::square_to_gaussian_2d;
@@ -85,9 +85,7 @@ impl<'a> BinMapPatch<'a> {
         let images = Self::images(&para, map.width as f64, map.height as f64);
         let center = Vec2::new(para.center()[0] as f32, para.center()[1] as f32);
         let radius = 0.5 * (para.area() as f32).sqrt();
-        let moments = map
-            .moments
-            .filtered(map.width, map.height, center, radius);
+        let moments = map.moments.filtered(map.width, map.height, center, radius);
         let lobe = SlopeGaussian::from_moments(moments, map.params.sigma_min);
         let exact = (para.area() <= EXACT_MASKING_TEXELS as f64)
             .then(|| ExactMasking::new(map, &para, &images));
@@ -235,7 +233,10 @@ impl<'a> BinMapPatch<'a> {
         let n = bins.n();
         let u = crate::warp::hemisphere_to_square_equal_area(h);
         let half = (r * n as f64).ceil() as i64 + 1;
-        let (ci, cj) = ((u.x as f64 * n as f64) as i64, (u.y as f64 * n as f64) as i64);
+        let (ci, cj) = (
+            (u.x as f64 * n as f64) as i64,
+            (u.y as f64 * n as f64) as i64,
+        );
         let clampi = |v: i64| v.clamp(0, n as i64 - 1) as usize;
         for j in clampi(cj - half)..=clampi(cj + half) {
             for i in clampi(ci - half)..=clampi(ci + half) {
@@ -364,8 +365,8 @@ impl ExactMasking {
 /// Two further uniform numbers derived from the bits of `u` (SplitMix64 finaliser), for the direction
 /// within the bin: independent of the point in A for every practical purpose, deterministic in `u`.
 fn rehash(u: Vec2) -> Vec2 {
-    let mut z = ((u.x.to_bits() as u64) << 32 | u.y.to_bits() as u64)
-        .wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z =
+        ((u.x.to_bits() as u64) << 32 | u.y.to_bits() as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
     let mut next = || {
         z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut x = z;
