@@ -6,7 +6,7 @@
 //! geometry, so rounding in areas is ~1e-12 texel² per texel.
 //!
 //! # Reference
-//! \[Atanasov2020\] §2 (D_A^H sums |A ∩ T_k|); the clipping is Sutherland and Hodgman's re-entrant
+//! \[Atanasov2020\] §2 (D_A^H sums |A ∩ T_k|); the clipping is \[SutherlandHodgman1974\] re-entrant
 //! polygon clipping (1974), specialised to a convex quadrilateral and a rectangle.
 
 /// How an axis-aligned rectangle lies relative to the parallelogram.

@@ -145,7 +145,7 @@ fn invalid(name: &'static str, value: f64, reason: &'static str) -> Error {
 
 fn check_params(params: &BinMapParams) -> Result<HemisphereBins> {
     let n = params.bins_per_axis;
-    if n % 2 == 0 {
+    if n.is_multiple_of(2) {
         return Err(invalid(
             "bins_per_axis",
             n as f64,

@@ -131,7 +131,7 @@ impl<'a> BinMapPatch<'a> {
     /// distribution when the moments are the footprint's.
     ///
     /// # Reference
-    /// Scarf, "A min-max solution of an inventory problem" (1958), the bound
+    /// \[Scarf1958\], the bound
     /// E[X⁺] ≤ ½(E[X] + √(E[X]² + Var X)).
     pub fn moment_bound_visible_area(&self, w: Vec3) -> f32 {
         if !(w.z > 0.0 && w.is_finite()) {
