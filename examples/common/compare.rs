@@ -21,9 +21,9 @@ use super::{Artifact, Chart, Res, Scale, Series, line_chart};
 use brdf::bxdf::{Bxdf, Masking};
 use brdf::fresnel::NoFresnel;
 use brdf::glint::{
-    BeckmannMixture, BinnedPndf, BrushedParams, DEFAULT_LOD_LOBES, FlakesParams, Footprint,
-    HemisphereBins, Kernel, MaskingMode, MixtureParams, NormalMap, PatchOptions, ScratchedParams,
-    binned_pndf, brushed, bumpy, flakes, scratched, tv_distance,
+    BeckmannMixture, BinMap, BinMapParams, BinnedPndf, BrushedParams, DEFAULT_LOD_LOBES,
+    FlakesParams, Footprint, HemisphereBins, Kernel, MaskingMode, MixtureParams, NormalMap,
+    PatchOptions, ScratchedParams, binned_pndf, brushed, bumpy, flakes, scratched, tv_distance,
 };
 use brdf::ndf::Ndf;
 use brdf::{MicrofacetBrdf, Vec2, Vec3};
@@ -40,6 +40,12 @@ pub trait Method: Sync {
     fn label(&self) -> String;
     /// Bytes held per texel of the map (the method's own structures).
     fn bytes_per_texel(&self) -> f64;
+    /// Model evaluations per ground-truth bin for the total variation (`tv_distance`'s
+    /// `sub_samples_per_bin`, a k × k midpoint rule). Default: 4 × 4 up to 256 texels, where patches
+    /// are spikier than a bin (lobes of σ_ε = 0.01 against bins ~0.04 rad wide), 2 × 2 above.
+    fn tv_sub(&self, area: f32) -> usize {
+        if area <= 256.0 { 16 } else { 4 }
+    }
     /// Calls `f` with the footprint's patch.
     fn with_patch(&self, footprint: &Footprint, f: &mut dyn FnMut(&(dyn Ndf + Sync)));
     /// Calls `f` with the footprint's BRDF (F = 1). Default: `MicrofacetBrdf` on the patch with
@@ -116,12 +122,69 @@ fn mixture_methods(map: &NormalMap, settings: &Settings) -> Res<Vec<Box<dyn Meth
     Ok(methods)
 }
 
+/// The inverse bin map of \[Atanasov2020\] at one bin count, optionally smoothed by a Beckmann lobe.
+struct BinMapMethod {
+    map: Arc<BinMap>,
+    /// Beckmann α of the smoothed variant (`None`: one-bin resolution, the talk's model).
+    smoothing: Option<f32>,
+}
+
+impl Method for BinMapMethod {
+    fn label(&self) -> String {
+        let n = self.map.params().bins_per_axis;
+        match self.smoothing {
+            None => format!("bin map (B = {n}²)"),
+            Some(a) => format!("bin map (B = {n}², smoothed α = {a})"),
+        }
+    }
+    fn bytes_per_texel(&self) -> f64 {
+        self.map.memory().total() as f64 / (self.map.width() * self.map.height()) as f64
+    }
+    /// 8 × 8: the map's D is piecewise constant on its own bins, which do not align with the
+    /// ground truth's, so each ground-truth bin needs enough points to see the edges (cheap: `d` is
+    /// ~1 µs whatever the footprint).
+    fn tv_sub(&self, _: f32) -> usize {
+        64
+    }
+    fn with_patch(&self, footprint: &Footprint, f: &mut dyn FnMut(&(dyn Ndf + Sync))) {
+        match self.smoothing {
+            None => f(&self.map.patch(footprint)),
+            Some(a) => f(&self.map.patch_smoothed(footprint, a)),
+        }
+    }
+}
+
+/// The bin map at B = 63², 127² (the default) and 255², and the default smoothed by α = 0.02.
+fn binmap_methods(map: &NormalMap, _: &Settings) -> Res<Vec<Box<dyn Method>>> {
+    let mut methods: Vec<Box<dyn Method>> = Vec::new();
+    for n in [63, 127, 255] {
+        let params = BinMapParams {
+            bins_per_axis: n,
+            ..BinMapParams::default()
+        };
+        let bm = Arc::new(BinMap::build(map, params)?);
+        methods.push(Box::new(BinMapMethod {
+            map: bm.clone(),
+            smoothing: None,
+        }));
+        if n == 127 {
+            methods.push(Box::new(BinMapMethod {
+                map: bm,
+                smoothing: Some(0.02),
+            }));
+        }
+    }
+    Ok(methods)
+}
+
 /// Every method family compared, with a name for the build-time table.
 ///
-/// The position-normal baseline (\[Yan2016\]) and the inverse bin map (\[Atanasov2020\]) join this
-/// list when they land (one line each).
+/// The position-normal baseline (\[Yan2016\]) joins this list when it lands (one line).
 pub fn builders() -> Vec<(&'static str, Builder)> {
-    vec![("Beckmann mixture", mixture_methods as Builder)]
+    vec![
+        ("Beckmann mixture", mixture_methods as Builder),
+        ("inverse bin map", binmap_methods as Builder),
+    ]
 }
 
 /// The four procedural maps at `size`² (same parameters and seeds as the gallery).
@@ -152,6 +215,10 @@ pub struct Settings {
     pub view_area: f32,
     /// Importance samples per furnace value.
     pub furnace_samples: usize,
+    /// Cap on the model evaluations per ground-truth bin ([`Method::tv_sub`]).
+    pub max_sub: usize,
+    /// Footprint centres averaged over (1 to 3, from [`CENTERS`]).
+    pub centers: usize,
 }
 
 impl Settings {
@@ -169,6 +236,8 @@ impl Settings {
             thetas: vec![0.0, 30.0, 60.0, 75.0, 85.0, 89.0],
             view_area: 256.0,
             furnace_samples: if quick { 500 } else { 2000 },
+            max_sub: 64,
+            centers: 3,
         }
     }
 
@@ -181,6 +250,8 @@ impl Settings {
             thetas: vec![0.0, 85.0],
             view_area: 16.0,
             furnace_samples: 64,
+            max_sub: 64,
+            centers: 1,
         }
     }
 }
@@ -318,6 +389,7 @@ pub fn measure(settings: &Settings, progress: &mut dyn FnMut(&str)) -> Res<Resul
         for &area in &settings.areas {
             let per_centre: Vec<(Footprint, BinnedPndf)> = CENTERS
                 .iter()
+                .take(settings.centers.clamp(1, CENTERS.len()))
                 .enumerate()
                 .map(|(k, c)| {
                     let fp = Footprint::isotropic_texels(Vec2::new(c[0], c[1]), area, n, n);
@@ -366,7 +438,13 @@ pub fn measure(settings: &Settings, progress: &mut dyn FnMut(&str)) -> Res<Resul
                     let mut tv = 0.0;
                     let mut noise = 0.0;
                     for (fp, reference) in per_centre {
-                        method.with_patch(fp, &mut |p| tv += tv_distance(&p, reference, 1));
+                        method.with_patch(fp, &mut |p| {
+                            tv += tv_distance(
+                                &p,
+                                reference,
+                                method.tv_sub(*area).min(settings.max_sub),
+                            )
+                        });
                         noise += reference.tv_error();
                     }
                     let k = per_centre.len() as f64;

@@ -49,6 +49,7 @@
 //! [`HemisphereBins`], with ∫ D cos θ dω = 1 (D_P(m) = ∫ δ(ω_n(u) − m) k_P(u) du / cos θ_m);
 //! [`tv_distance`] compares a model with it; [`naive_brdf`] is the per-position shading reference.
 
+mod binmap;
 mod bins;
 mod footprint;
 #[cfg(feature = "image")]
@@ -59,6 +60,11 @@ mod normal_map;
 mod procedural;
 mod reference;
 
+pub use binmap::{
+    BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, DEFAULT_BINS_PER_AXIS,
+    DEFAULT_LEAF_SIZE, DEFAULT_LOOKUP, DEFAULT_MASKING_SIGMA_MIN, EXACT_MASKING_TEXELS,
+    MASKING_FIRST_LEVEL, QueryStats,
+};
 pub use bins::HemisphereBins;
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 pub use mixture::{

@@ -19,6 +19,8 @@ pub(crate) struct MomentLevel {
 #[derive(Clone, Debug)]
 pub(crate) struct MomentPyramid {
     levels: Vec<MomentLevel>,
+    /// Index of `levels[0]` in the full chain (0 unless built by [`MomentPyramid::coarse_from`]).
+    first: usize,
 }
 
 /// For a reduction of `n` texels to `m` (m ≤ n) along one axis: for each output texel, the input
@@ -70,7 +72,22 @@ impl MomentPyramid {
             let next = downsample(prev, w, h);
             levels.push(next);
         }
-        MomentPyramid { levels }
+        MomentPyramid { levels, first: 0 }
+    }
+
+    /// A copy holding only levels `first..` of this chain (for models that keep coarse moments
+    /// only); its lookups use level `first` for every finer level of detail.
+    pub fn coarse_from(&self, first: usize) -> MomentPyramid {
+        let first = first.min(self.levels.len() - 1);
+        MomentPyramid {
+            levels: self.levels[first..].to_vec(),
+            first: self.first + first,
+        }
+    }
+
+    /// Bytes held by the moments (20 per level texel).
+    pub fn bytes(&self) -> usize {
+        self.levels.iter().map(|l| 20 * l.data.len()).sum()
     }
 
     /// Level `l`, if it exists.
@@ -81,13 +98,14 @@ impl MomentPyramid {
     /// Trilinear lookup (see `NormalMap::filtered_moments` for the definition).
     pub fn filtered(&self, width: usize, height: usize, center: Vec2, radius: f32) -> [f32; 5] {
         let center = Vec2::select(center.is_finite_mask(), center, Vec2::ZERO);
-        let top = (self.levels.len() - 1) as f32;
-        // NaN and non-positive radii select level 0; +∞ selects the top level.
+        let first = self.first as f32;
+        let top = (self.first + self.levels.len() - 1) as f32;
+        // NaN and non-positive radii select level 0 (the finest kept); +∞ selects the top level.
         let lod = if radius > 0.0 {
-            (2.0 * radius).log2().clamp(0.0, top)
+            (2.0 * radius).log2().clamp(first, top)
         } else {
-            0.0
-        };
+            first
+        } - first;
         let l0 = lod.floor();
         let t = (lod - l0) as f64;
         let l0 = l0 as usize;

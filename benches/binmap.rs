@@ -1,0 +1,97 @@
+//! Cost of the inverse bin map (Atanasov 2020): build at 512² and 2048², patch construction, and
+//! `d(h)` against the footprint size from 1 to 65 536 texels (the "roughly flat" claim), with the
+//! dense and the hashed bin lookup.
+//!
+//! Inputs (maps, bin maps, half vectors) are generated before timing. Half vectors are drawn from
+//! each patch's own sampler (so they hit occupied bins, the expensive case) and 1024 are evaluated
+//! per iteration: divide the time by 1024.
+//!
+//! Run: `cargo bench --bench binmap -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+
+use brdf::glint::{BinLookup, BinMap, BinMapParams, Footprint, bumpy};
+use brdf::ndf::Ndf;
+use brdf::{Vec2, Vec3};
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use std::hint::black_box;
+
+const SIZE: usize = 2048;
+const AREAS: [f32; 9] = [
+    1.0, 4.0, 16.0, 64.0, 256.0, 1024.0, 4096.0, 16384.0, 65536.0,
+];
+
+/// Deterministic numbers in [0, 1)² (R2 sequence).
+fn r2(k: usize) -> Vec2 {
+    Vec2::new(
+        (0.5 + k as f64 * 0.754_877_666_246_692_7).fract() as f32,
+        (0.5 + k as f64 * 0.569_840_290_998_053_2).fract() as f32,
+    )
+}
+
+fn build(c: &mut Criterion) {
+    let mut g = c.benchmark_group("binmap_build");
+    for size in [512usize, SIZE] {
+        let map = bumpy(size, size, 0.25, 4.0, 1).unwrap();
+        g.throughput(Throughput::Elements((size * size) as u64));
+        g.bench_with_input(BenchmarkId::from_parameter(size), &map, |b, map| {
+            b.iter(|| BinMap::build(black_box(map), BinMapParams::default()).unwrap())
+        });
+    }
+    g.finish();
+}
+
+fn eval(c: &mut Criterion) {
+    let map = bumpy(SIZE, SIZE, 0.25, 4.0, 1).unwrap();
+    for lookup in [BinLookup::Dense, BinLookup::Hash] {
+        let bm = BinMap::build(
+            &map,
+            BinMapParams {
+                lookup,
+                ..BinMapParams::default()
+            },
+        )
+        .unwrap();
+        let mut g = c.benchmark_group(format!("binmap_d_2048_{lookup:?}"));
+        g.throughput(Throughput::Elements(1024));
+        for area in AREAS {
+            let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, SIZE, SIZE);
+            let patch = bm.patch(&fp);
+            let hs: Vec<Vec3> = (0..1024).map(|k| patch.sample_normal(r2(k))).collect();
+            g.bench_with_input(BenchmarkId::from_parameter(area), &hs, |b, hs| {
+                b.iter(|| hs.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
+            });
+        }
+        g.finish();
+    }
+}
+
+fn patch_construction(c: &mut Criterion) {
+    let map = bumpy(SIZE, SIZE, 0.25, 4.0, 1).unwrap();
+    let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
+    let mut g = c.benchmark_group("binmap_patch_2048");
+    for area in AREAS {
+        let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, SIZE, SIZE);
+        g.bench_with_input(BenchmarkId::from_parameter(area), &fp, |b, fp| {
+            b.iter(|| bm.patch(black_box(fp)).area_texels())
+        });
+    }
+    g.finish();
+}
+
+fn smoothed(c: &mut Criterion) {
+    let map = bumpy(SIZE, SIZE, 0.25, 4.0, 1).unwrap();
+    let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
+    let mut g = c.benchmark_group("binmap_smoothed_d_2048_256texels");
+    g.throughput(Throughput::Elements(1024));
+    let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), 256.0, SIZE, SIZE);
+    for alpha in [0.01f32, 0.02, 0.05] {
+        let patch = bm.patch_smoothed(&fp, alpha);
+        let hs: Vec<Vec3> = (0..1024).map(|k| patch.sample_normal(r2(k))).collect();
+        g.bench_with_input(BenchmarkId::from_parameter(alpha), &hs, |b, hs| {
+            b.iter(|| hs.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, build, eval, patch_construction, smoothed);
+criterion_main!(benches);

@@ -1,0 +1,283 @@
+//! The footprint parallelogram in texel units and its exact overlap with axis-aligned rectangles:
+//! a separating-axis classification (inside / outside / partial) for kd-tree nodes and texels, and
+//! the exact area |A ∩ T| of a texel square by polygon clipping.
+//!
+//! All in `f64`: texel coordinates of a 2048² map need 11 bits, leaving ~40 bits for the fractional
+//! geometry, so rounding in areas is ~1e-12 texel² per texel.
+//!
+//! # Reference
+//! \[Atanasov2020\] §2 (D_A^H sums |A ∩ T_k|); the clipping is \[SutherlandHodgman1974\] re-entrant
+//! polygon clipping (1974), specialised to a convex quadrilateral and a rectangle.
+
+/// How an axis-aligned rectangle lies relative to the parallelogram.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Overlap {
+    /// No common interior point.
+    Outside,
+    /// Contained in the parallelogram.
+    Inside,
+    /// Neither: the boundary crosses it.
+    Partial,
+}
+
+/// The parallelogram {c + s a + t b : s, t ∈ [−½, ½]} in texel units, with the affine map
+/// p ↦ (s, t) precomputed.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Parallelogram {
+    c: [f64; 2],
+    a: [f64; 2],
+    b: [f64; 2],
+    /// Rows of M⁻¹ with M = [a b]: s = gs·(p − c), t = gt·(p − c).
+    gs: [f64; 2],
+    gt: [f64; 2],
+    /// Half extents of the axis-aligned bounding box: (|a_x| + |b_x|)/2, (|a_y| + |b_y|)/2.
+    half_box: [f64; 2],
+    area: f64,
+}
+
+impl Parallelogram {
+    /// From centre and edges; `None` if the edges are not finite or span (numerically) no area.
+    pub(crate) fn new(c: [f64; 2], a: [f64; 2], b: [f64; 2]) -> Option<Parallelogram> {
+        let det = a[0] * b[1] - a[1] * b[0];
+        let scale = (a[0].abs() + a[1].abs()) * (b[0].abs() + b[1].abs());
+        if !(det.is_finite() && c.iter().all(|v| v.is_finite()) && det.abs() > 1e-12 * scale) {
+            return None;
+        }
+        let gs = [b[1] / det, -b[0] / det];
+        let gt = [-a[1] / det, a[0] / det];
+        Some(Parallelogram {
+            c,
+            a,
+            b,
+            gs,
+            gt,
+            half_box: [
+                0.5 * (a[0].abs() + b[0].abs()),
+                0.5 * (a[1].abs() + b[1].abs()),
+            ],
+            area: det.abs(),
+        })
+    }
+
+    /// Area |det[a b]| in texels².
+    #[inline]
+    pub(crate) fn area(&self) -> f64 {
+        self.area
+    }
+
+    /// The centre.
+    #[inline]
+    pub(crate) fn center(&self) -> [f64; 2] {
+        self.c
+    }
+
+    /// The axis-aligned bounding box (min, max).
+    #[inline]
+    pub(crate) fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        (
+            [self.c[0] - self.half_box[0], self.c[1] - self.half_box[1]],
+            [self.c[0] + self.half_box[0], self.c[1] + self.half_box[1]],
+        )
+    }
+
+    /// The same parallelogram translated by `d`.
+    #[inline]
+    pub(crate) fn translated(&self, d: [f64; 2]) -> Parallelogram {
+        Parallelogram {
+            c: [self.c[0] + d[0], self.c[1] + d[1]],
+            ..*self
+        }
+    }
+
+    /// The point c + s a + t b.
+    #[inline]
+    pub(crate) fn point(&self, s: f64, t: f64) -> [f64; 2] {
+        [
+            self.c[0] + s * self.a[0] + t * self.b[0],
+            self.c[1] + s * self.a[1] + t * self.b[1],
+        ]
+    }
+
+    /// Classifies the rectangle [x0, x1] × [y0, y1] by the separating-axis theorem on the four edge
+    /// normals (x, y and the parallelogram's two): exact for convex polygons. Touching along an edge
+    /// or a corner counts as `Outside` (no common area).
+    #[inline]
+    pub(crate) fn classify(&self, x0: f64, y0: f64, x1: f64, y1: f64) -> Overlap {
+        let (hx, hy) = (0.5 * (x1 - x0), 0.5 * (y1 - y0));
+        let (dx, dy) = (0.5 * (x0 + x1) - self.c[0], 0.5 * (y0 + y1) - self.c[1]);
+        // Axes x and y: bounding boxes.
+        if dx.abs() >= hx + self.half_box[0] || dy.abs() >= hy + self.half_box[1] {
+            return Overlap::Outside;
+        }
+        // Axes of the parallelogram: the range of s (t) over the rectangle against [−½, ½].
+        let s = self.gs[0] * dx + self.gs[1] * dy;
+        let rs = self.gs[0].abs() * hx + self.gs[1].abs() * hy;
+        let t = self.gt[0] * dx + self.gt[1] * dy;
+        let rt = self.gt[0].abs() * hx + self.gt[1].abs() * hy;
+        if s.abs() >= 0.5 + rs || t.abs() >= 0.5 + rt {
+            return Overlap::Outside;
+        }
+        if s.abs() + rs <= 0.5 && t.abs() + rt <= 0.5 {
+            Overlap::Inside
+        } else {
+            Overlap::Partial
+        }
+    }
+
+    /// |P ∩ [x0, x0 + 1] × [y0, y0 + 1]|: the exact overlap area of the unit texel square whose lower
+    /// corner is (x0, y0), in texels² ∈ [0, 1].
+    #[cfg(test)]
+    pub(crate) fn texel_overlap(&self, x0: f64, y0: f64) -> f64 {
+        match self.classify(x0, y0, x0 + 1.0, y0 + 1.0) {
+            Overlap::Outside => 0.0,
+            Overlap::Inside => 1.0,
+            Overlap::Partial => self.clipped_area(x0, y0, x0 + 1.0, y0 + 1.0),
+        }
+    }
+
+    /// Area of P ∩ [x0, x1] × [y0, y1] by clipping P's quadrilateral against the rectangle's four
+    /// half-planes (Sutherland–Hodgman: a convex polygon stays convex, ≤ 8 vertices) and the shoelace
+    /// formula. Coordinates are taken relative to the rectangle's corner to keep them small.
+    pub(crate) fn clipped_area(&self, x0: f64, y0: f64, x1: f64, y1: f64) -> f64 {
+        let mut poly = Poly::default();
+        for (s, t) in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
+            let p = self.point(s, t);
+            poly.push([p[0] - x0, p[1] - y0]);
+        }
+        let (w, h) = (x1 - x0, y1 - y0);
+        // Each half-plane as (axis, bound, keep-below): x ≥ 0, x ≤ w, y ≥ 0, y ≤ h.
+        for (axis, bound, below) in [(0, 0.0, false), (0, w, true), (1, 0.0, false), (1, h, true)] {
+            poly = poly.clip(axis, bound, below);
+            if poly.len < 3 {
+                return 0.0;
+            }
+        }
+        poly.area().clamp(0.0, w * h)
+    }
+}
+
+/// A convex polygon of at most 8 vertices (a quadrilateral clipped by four half-planes gains at most
+/// one vertex per half-plane).
+#[derive(Clone, Copy, Default)]
+struct Poly {
+    v: [[f64; 2]; 8],
+    len: usize,
+}
+
+impl Poly {
+    #[inline]
+    fn push(&mut self, p: [f64; 2]) {
+        if self.len < self.v.len() {
+            self.v[self.len] = p;
+            self.len += 1;
+        }
+    }
+
+    /// Keeps the part with coordinate `axis` ≤ bound (`below`) or ≥ bound.
+    fn clip(&self, axis: usize, bound: f64, below: bool) -> Poly {
+        let inside = |p: &[f64; 2]| {
+            if below {
+                p[axis] <= bound
+            } else {
+                p[axis] >= bound
+            }
+        };
+        let mut out = Poly::default();
+        for k in 0..self.len {
+            let cur = self.v[k];
+            let prev = self.v[(k + self.len - 1) % self.len];
+            let (ci, pi) = (inside(&cur), inside(&prev));
+            if ci != pi {
+                // The edge crosses the line: its intersection point.
+                let f = (bound - prev[axis]) / (cur[axis] - prev[axis]);
+                let mut x = [
+                    prev[0] + f * (cur[0] - prev[0]),
+                    prev[1] + f * (cur[1] - prev[1]),
+                ];
+                x[axis] = bound;
+                out.push(x);
+            }
+            if ci {
+                out.push(cur);
+            }
+        }
+        out
+    }
+
+    /// Shoelace area (absolute value).
+    fn area(&self) -> f64 {
+        let mut twice = 0.0;
+        for k in 0..self.len {
+            let (p, q) = (self.v[k], self.v[(k + 1) % self.len]);
+            twice += p[0] * q[1] - p[1] * q[0];
+        }
+        0.5 * twice.abs()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axis_aligned_rectangle_overlaps_are_products() {
+        // A rectangle [0.3, 2.8] × [−0.4, 0.7]: the overlap with a texel is the product of the
+        // interval overlaps.
+        let p = Parallelogram::new([1.55, 0.15], [2.5, 0.0], [0.0, 1.1]).unwrap();
+        let ov = |a0: f64, a1: f64, b0: f64| (a1.min(b0 + 1.0) - a0.max(b0)).max(0.0);
+        for j in -2..3 {
+            for i in -1..4 {
+                let expected = ov(0.3, 2.8, i as f64) * ov(-0.4, 0.7, j as f64);
+                let got = p.texel_overlap(i as f64, j as f64);
+                // f64 rounding of a handful of products: 1e-12.
+                assert!(
+                    (got - expected).abs() < 1e-12,
+                    "({i}, {j}): {got} vs {expected}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn diamond_in_a_texel() {
+        // A square rotated by 45° centred on the texel centre, half-diagonal d: for d ≤ ½ it lies
+        // inside (area 2d²); for ½ < d < 1 the four corners sticking out are triangles of area
+        // (d − ½)², so the overlap is 2d² − 4(d − ½)².
+        for d in [0.2f64, 0.5, 0.6, 0.9] {
+            let p = Parallelogram::new([0.5, 0.5], [d, d], [-d, d]).unwrap();
+            let expected = if d <= 0.5 {
+                2.0 * d * d
+            } else {
+                2.0 * d * d - 4.0 * (d - 0.5).powi(2)
+            };
+            let got = p.texel_overlap(0.0, 0.0);
+            assert!(
+                (got - expected).abs() < 1e-12,
+                "d = {d}: {got} vs {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn classification_agrees_with_clipping() {
+        let p = Parallelogram::new([0.3, -0.2], [3.1, 1.2], [-0.7, 2.3]).unwrap();
+        for j in -4..4 {
+            for i in -4..4 {
+                let (x, y) = (i as f64, j as f64);
+                let area = p.clipped_area(x, y, x + 1.0, y + 1.0);
+                match p.classify(x, y, x + 1.0, y + 1.0) {
+                    Overlap::Outside => assert!(area < 1e-12, "{i} {j}: {area}"),
+                    Overlap::Inside => assert!((area - 1.0).abs() < 1e-12, "{i} {j}: {area}"),
+                    Overlap::Partial => assert!(area > -1e-12 && area < 1.0 + 1e-12),
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn degenerate_edges_are_rejected() {
+        assert!(Parallelogram::new([0.0, 0.0], [1.0, 1.0], [2.0, 2.0]).is_none());
+        assert!(Parallelogram::new([0.0, 0.0], [f64::NAN, 1.0], [0.0, 1.0]).is_none());
+        assert!(Parallelogram::new([0.0, 0.0], [0.0, 0.0], [0.0, 1.0]).is_none());
+    }
+}

@@ -1,0 +1,367 @@
+//! The inverse bin map of \[Atanasov2020\]: a normal map quantised into equal-solid-angle direction
+//! bins, the inverse map bin → texels sorted into a forest of 2D kd-trees, and the P-NDF of a
+//! parallelogram footprint with constant filtering in texture and half-vector space.
+//!
+//! - [`BinMap::build`] assigns every texel the bin of its (texel-centre) normal (the bin map 𝓑),
+//!   counting-sorts the texels by bin into one array (the inverse bin map 𝓑⁻¹), builds one kd-tree per
+//!   list longer than the leaf size L, packed into one `u32` array, and a lookup bin → list
+//!   ([`BinLookup`]: dense offsets or a hash table of the non-empty bins).
+//! - [`BinMap::patch`] turns a [`Footprint`] into a [`BinMapPatch`], an [`Ndf`](crate::ndf::Ndf) whose
+//!   D(h) = mass_j / (|H| · c̄_j) for the bin j ∋ h, where mass_j = Σ_k I_{H_j}(t_k) |A ∩ T_k| / |A| is
+//!   found through the bin's tree (whole nodes inside A count at once, boundary texels get their exact
+//!   clipped area) and c̄_j is the bin's mean cosine. [`BinMap::patch_smoothed`] spreads every bin's
+//!   mass with a Beckmann lobe.
+//!
+//! The conventions (mean cosine, periodic images, masking lobe, samplers) and the measurements are in
+//! docs/binmap.md.
+
+mod clip;
+mod forest;
+mod lookup;
+mod patch;
+
+pub use forest::QueryStats;
+pub use lookup::BinLookup;
+pub use patch::BinMapPatch;
+
+use super::moments::MomentPyramid;
+use crate::error::{Error, Result};
+use crate::frame::{normal_to_slope, slope_to_normal};
+use crate::glint::{Footprint, GlintNdf, HemisphereBins, NormalMap};
+use forest::{NO_TREE, TreeView};
+use glam::Vec2;
+use lookup::Table;
+
+/// Default bins per axis n (B = n² = 16129 bins of 3.9·10⁻⁴ sr, about 1.1° across), the talk's
+/// car-paint setting (127²).
+pub const DEFAULT_BINS_PER_AXIS: usize = 127;
+
+/// Default maximum leaf size L of the kd-trees: lists of at most L texels are scanned linearly, and
+/// only longer lists get a tree (16, as in the talk).
+pub const DEFAULT_LEAF_SIZE: usize = 16;
+
+/// Default floor σ_ε of the masking lobe's slope standard deviation (see [`BinMapParams::sigma_min`]).
+pub const DEFAULT_MASKING_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
+
+/// Default lookup: measured faster than the hash table at 2048² (docs/results.md).
+pub const DEFAULT_LOOKUP: BinLookup = BinLookup::Dense;
+
+/// The finest level of the slope-moment mip chain kept for the masking lobe: level 2 (4 × 4 texels
+/// per moment texel), 20 B / 16 texels ≈ 1.7 B per texel for the whole chain. Footprints narrower
+/// than 4 texels take their masking lobe from level 2.
+pub const MASKING_FIRST_LEVEL: usize = 2;
+
+/// Largest footprint (texels²) whose patch computes its masking terms from its own bins (one
+/// O(|A|) pass over the footprint's texels at patch construction, then O(bins in A) per direction);
+/// larger footprints use the filtered-moment lobe (O(1)). 4096 texels: measured in docs/results.md
+/// (white furnace with both, cost of the pass).
+pub const EXACT_MASKING_TEXELS: f32 = 4096.0;
+
+/// Build parameters of a [`BinMap`]. `Default` gives the documented `DEFAULT_*` values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BinMapParams {
+    /// Bins per axis n, odd, 1 ≤ n ≤ [`HemisphereBins::MAX_N`]: B = n² bins of 2π/n² sr each, the
+    /// pole at the centre of the middle bin.
+    pub bins_per_axis: usize,
+    /// Maximum leaf size L (≥ 1).
+    pub leaf_size: usize,
+    /// Dense or hashed bin lookup.
+    pub lookup: BinLookup,
+    /// Floor σ_ε (> 0) of the slope standard deviation of the masking lobe (the footprint's
+    /// filtered-moment Beckmann lobe, see [`BinMapPatch`]).
+    pub sigma_min: f32,
+}
+
+impl Default for BinMapParams {
+    fn default() -> Self {
+        BinMapParams {
+            bins_per_axis: DEFAULT_BINS_PER_AXIS,
+            leaf_size: DEFAULT_LEAF_SIZE,
+            lookup: DEFAULT_LOOKUP,
+            sigma_min: DEFAULT_MASKING_SIGMA_MIN,
+        }
+    }
+}
+
+/// Bytes held by a [`BinMap`], per part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BinMapMemory {
+    /// The bin map 𝓑: one `u32` per texel.
+    pub bin_map: usize,
+    /// The inverse bin map 𝓑⁻¹: one `u32` per texel.
+    pub inverse: usize,
+    /// The packed forest: two `u32` per internal node.
+    pub forest: usize,
+    /// The bin lookup (dense offsets and roots, or the hash table).
+    pub lookup: usize,
+    /// Per-bin tables: mean cosine and centre slope (12 bytes per bin).
+    pub bin_tables: usize,
+    /// The coarse slope-moment mip chain of the masking lobe.
+    pub moments: usize,
+}
+
+impl BinMapMemory {
+    /// The sum of the parts.
+    pub fn total(&self) -> usize {
+        self.bin_map + self.inverse + self.forest + self.lookup + self.bin_tables + self.moments
+    }
+}
+
+/// The inverse bin map of a normal map, with its kd-tree forest.
+///
+/// D_A^H(h) = (1/(|H| |A|)) Σ_k I_H(t_k) |A ∩ T_k| (\[Atanasov2020\] §2), the fraction of the
+/// footprint A covered by texels whose normal t_k lies in the bin H ∋ h, per unit solid angle; the
+/// patches divide it by the bin's mean cosine so that ∫ D cos θ dω = 1 (docs/binmap.md).
+///
+/// Stored: 𝓑 and 𝓑⁻¹ (4 + 4 bytes per texel), the forest (two `u32` per internal node), the lookup,
+/// per-bin mean cosines and centre slopes, and the slope-moment mip chain from level
+/// [`MASKING_FIRST_LEVEL`] for the masking lobe (≈ 1.7 bytes per texel). The normal map itself is not
+/// kept. See [`BinMap::memory`].
+///
+/// # Reference
+/// \[Atanasov2020\] §2 (bins, D_A^H), §2.1 (sampling through 𝓑), §2.2-2.3 (𝓑⁻¹, hash map, forest).
+#[derive(Clone, Debug)]
+pub struct BinMap {
+    width: usize,
+    height: usize,
+    bins: HemisphereBins,
+    params: BinMapParams,
+    bin_map: Vec<u32>,
+    inverse: Vec<u32>,
+    nodes: Vec<u32>,
+    table: Table,
+    mean_cos: Vec<f32>,
+    center_slope: Vec<Vec2>,
+    moments: MomentPyramid,
+}
+
+fn invalid(name: &'static str, value: f64, reason: &'static str) -> Error {
+    Error::InvalidParameter {
+        name,
+        value,
+        reason,
+    }
+}
+
+fn check_params(params: &BinMapParams) -> Result<HemisphereBins> {
+    let n = params.bins_per_axis;
+    if n.is_multiple_of(2) {
+        return Err(invalid(
+            "bins_per_axis",
+            n as f64,
+            "must be odd (and in 1..=4096) so that the pole is the centre of a bin",
+        ));
+    }
+    let bins = HemisphereBins::new(n).map_err(|_| {
+        invalid(
+            "bins_per_axis",
+            n as f64,
+            "must be odd and in 1..=4096 (at least one bin)",
+        )
+    })?;
+    if params.leaf_size == 0 {
+        return Err(invalid("leaf_size", 0.0, "must be at least 1"));
+    }
+    if !(params.sigma_min.is_finite() && params.sigma_min > 0.0) {
+        return Err(invalid(
+            "sigma_min",
+            params.sigma_min as f64,
+            "must be finite and positive",
+        ));
+    }
+    Ok(bins)
+}
+
+impl BinMap {
+    /// Builds the bin map, the inverse bin map, its forest and lookup from a normal map.
+    ///
+    /// 𝓑(k) = the bin of texel k's normal normalize(−x̃, −ỹ, 1) (the texel-centre normal: the
+    /// talk's piecewise-constant map, each texel a flat facet); 𝓑⁻¹ by counting sort (texels in
+    /// row-major order within a bin before the trees reorder them); one kd-tree per list longer than
+    /// `leaf_size`. Cost O(texels · log) single-threaded, plus the moment chain.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `bins_per_axis` (even, 0 or > 4096), `leaf_size` (0) or
+    /// `sigma_min` (non-finite or ≤ 0); [`Error::InvalidSize`] for maps of 2³² texels or more (texel
+    /// indices are `u32`).
+    pub fn build(map: &NormalMap, params: BinMapParams) -> Result<BinMap> {
+        let bins = check_params(&params)?;
+        let (width, height) = (map.width(), map.height());
+        let texels = width * height;
+        if texels >= u32::MAX as usize {
+            return Err(Error::InvalidSize {
+                width,
+                height,
+                reason: "the bin map needs fewer than 2^32 texels",
+            });
+        }
+        let nb = bins.len();
+        // 𝓑: every stored slope is finite with z > 0, so `bin_of` succeeds; the pole bin guards it.
+        let pole = bins.bin_of(glam::Vec3::Z).unwrap_or(0);
+        let bin_map: Vec<u32> = map
+            .slopes()
+            .iter()
+            .map(|&s| bins.bin_of(slope_to_normal(s)).unwrap_or(pole) as u32)
+            .collect();
+        // 𝓑⁻¹ by counting sort.
+        let mut offsets = vec![0u32; nb + 1];
+        for &b in &bin_map {
+            offsets[b as usize + 1] += 1;
+        }
+        for b in 0..nb {
+            offsets[b + 1] += offsets[b];
+        }
+        let mut cursor: Vec<u32> = offsets[..nb].to_vec();
+        let mut inverse = vec![0u32; texels];
+        for (k, &b) in bin_map.iter().enumerate() {
+            inverse[cursor[b as usize] as usize] = k as u32;
+            cursor[b as usize] += 1;
+        }
+        // The forest.
+        let mut nodes = Vec::new();
+        let mut roots = vec![NO_TREE; nb];
+        for b in 0..nb {
+            let (s, e) = (offsets[b] as usize, offsets[b + 1] as usize);
+            if e - s > params.leaf_size {
+                roots[b] = forest::build_tree(
+                    &mut inverse[s..e],
+                    s,
+                    width,
+                    height,
+                    params.leaf_size,
+                    &mut nodes,
+                );
+            }
+        }
+        let table = Table::new(params.lookup, offsets, roots);
+        let mean_cos = (0..nb).map(|b| bins.mean_cos(b) as f32).collect();
+        let center_slope = (0..nb)
+            .map(|b| normal_to_slope(bins.center(b)).unwrap_or(Vec2::ZERO))
+            .collect();
+        let moments = map.pyramid().coarse_from(MASKING_FIRST_LEVEL);
+        Ok(BinMap {
+            width,
+            height,
+            bins,
+            params,
+            bin_map,
+            inverse,
+            nodes,
+            table,
+            mean_cos,
+            center_slope,
+            moments,
+        })
+    }
+
+    /// Map width in texels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Map height in texels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The direction bins.
+    pub fn bins(&self) -> &HemisphereBins {
+        &self.bins
+    }
+
+    /// The build parameters.
+    pub fn params(&self) -> &BinMapParams {
+        &self.params
+    }
+
+    /// 𝓑(k): the bin of texel k = j · width + i (row major); `None` out of range.
+    pub fn bin_of_texel(&self, k: usize) -> Option<usize> {
+        self.bin_map.get(k).map(|&b| b as usize)
+    }
+
+    /// 𝓑⁻¹(j): the texel indices of bin j, in the forest's order (empty for an empty or
+    /// out-of-range bin).
+    pub fn texels_of_bin(&self, bin: usize) -> &[u32] {
+        self.table
+            .get(bin)
+            .map_or(&[], |e| &self.inverse[e.start as usize..e.end as usize])
+    }
+
+    /// The whole inverse bin map: the texel lists of bins 0, 1, … concatenated.
+    pub fn inverse_bin_map(&self) -> &[u32] {
+        &self.inverse
+    }
+
+    /// The range [start, end) of bin j's list in [`BinMap::inverse_bin_map`] and its tree root in
+    /// [`BinMap::forest`] (`None` for lists of at most L texels); `None` for an empty bin.
+    pub fn bin_range(&self, bin: usize) -> Option<(usize, usize, Option<usize>)> {
+        self.table.get(bin).map(|e| {
+            (
+                e.start as usize,
+                e.end as usize,
+                (e.root != NO_TREE).then_some(e.root as usize),
+            )
+        })
+    }
+
+    /// The packed forest topology (see the layout in docs/binmap.md): per internal node, in pre-order,
+    /// the index in the inverse map where its right child's range starts and the array index of its
+    /// right child; a left child that is internal follows its parent.
+    pub fn forest(&self) -> &[u32] {
+        &self.nodes
+    }
+
+    /// Mean cosine c̄_j = (1/|H|) ∫_{H_j} cos θ dω of bin j (f32; 0 out of range).
+    pub fn mean_cos(&self, bin: usize) -> f32 {
+        self.mean_cos.get(bin).copied().unwrap_or(0.0)
+    }
+
+    /// Bytes held, per part.
+    pub fn memory(&self) -> BinMapMemory {
+        BinMapMemory {
+            bin_map: 4 * self.bin_map.len(),
+            inverse: 4 * self.inverse.len(),
+            forest: 4 * self.nodes.len(),
+            lookup: self.table.bytes(),
+            bin_tables: 4 * self.mean_cos.len() + 8 * self.center_slope.len(),
+            moments: self.moments.bytes(),
+        }
+    }
+
+    /// The patch of a footprint, with the bin-resolution P-NDF ([`BinMapPatch`]).
+    pub fn patch(&self, footprint: &Footprint) -> BinMapPatch<'_> {
+        BinMapPatch::new(self, footprint, None)
+    }
+
+    /// The patch of a footprint whose every bin's mass is spread by a Beckmann lobe of roughness
+    /// `alpha` (slope σ = α/√2) centred on the bin's centre direction:
+    /// D(h) = Σ_j mass_j D_j(h) (see [`BinMapPatch`]). A non-finite or non-positive `alpha` gives
+    /// the unsmoothed patch; α is raised to at least [`crate::ndf::MIN_ALPHA`].
+    ///
+    /// # Reference
+    /// The smoothing follows the idea of the authors' later full paper (a Beckmann lobe per bin);
+    /// \[Atanasov2020\] itself has one-bin angular resolution.
+    pub fn patch_smoothed(&self, footprint: &Footprint, alpha: f32) -> BinMapPatch<'_> {
+        let alpha = (alpha.is_finite() && alpha > 0.0).then(|| alpha.max(crate::ndf::MIN_ALPHA));
+        BinMapPatch::new(self, footprint, alpha)
+    }
+
+    fn tree_view(&self) -> TreeView<'_> {
+        TreeView {
+            inverse: &self.inverse,
+            nodes: &self.nodes,
+            width: self.width as u32,
+            height: self.height as u32,
+            leaf: self.params.leaf_size,
+        }
+    }
+}
+
+impl GlintNdf for BinMap {
+    type Patch<'a> = BinMapPatch<'a>;
+
+    /// [`BinMap::patch`].
+    fn patch(&self, footprint: &Footprint) -> BinMapPatch<'_> {
+        BinMap::patch(self, footprint)
+    }
+}
