@@ -50,6 +50,7 @@
 //! [`tv_distance`] compares a model with it; [`naive_brdf`] is the per-position shading reference.
 
 mod bins;
+mod flakes;
 mod footprint;
 #[cfg(feature = "image")]
 mod image_io;
@@ -60,6 +61,10 @@ mod procedural;
 mod reference;
 
 pub use bins::HemisphereBins;
+pub use flakes::{
+    DEFAULT_MASKING_ALPHA, PositionNormalBrdf, PositionNormalMap, PositionNormalMemory,
+    PositionNormalParams, PositionNormalPatch,
+};
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 pub use mixture::{
     BeckmannMixture, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES, DEFAULT_MASKING, DEFAULT_SAMPLES,
