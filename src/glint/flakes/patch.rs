@@ -133,7 +133,10 @@ impl Geometry {
             self.k[0] * d[0] + self.k[1] * d[1],
             self.k[1] * d[0] + self.k[2] * d[1],
         ];
-        let mean = [sx + jxu * du[0] + jxv * du[1], sy + jyu * du[0] + jyv * du[1]];
+        let mean = [
+            sx + jxu * du[0] + jxv * du[1],
+            sy + jyu * du[0] + jyv * du[1],
+        ];
         let [u0, u1, u2] = self.sigma_u;
         // Rows of J Σ_u.
         let (ax, ay) = (jxu * u0 + jxv * u1, jxu * u1 + jxv * u2);
@@ -301,10 +304,7 @@ impl<'a> PositionNormalPatch<'a> {
     /// The normalised weights W_i and slope Gaussians N(μ_i, C_i) of the kept elements.
     pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
         let s = self.slots();
-        s.weights
-            .iter()
-            .zip(&s.lobes)
-            .map(|(&w, &l)| (w as f32, l))
+        s.weights.iter().zip(&s.lobes).map(|(&w, &l)| (w as f32, l))
     }
 
     fn slots(&self) -> &Slots {
@@ -565,7 +565,13 @@ mod tests {
 
     #[test]
     fn segments_cover_the_range_once() {
-        for &(lo, hi, n) in &[(-3i64, 4i64, 4usize), (0, 3, 4), (5, 5, 4), (-9, 9, 3), (2, 2, 1)] {
+        for &(lo, hi, n) in &[
+            (-3i64, 4i64, 4usize),
+            (0, 3, 4),
+            (5, 5, 4),
+            (-9, 9, 3),
+            (2, 2, 1),
+        ] {
             let mut seen = Vec::new();
             for (a, b, off) in segments([lo, hi], n) {
                 assert!(a <= b && b < n);
