@@ -22,8 +22,9 @@ use brdf::bxdf::{Bxdf, Masking};
 use brdf::fresnel::NoFresnel;
 use brdf::glint::{
     BeckmannMixture, BinMap, BinMapParams, BinnedPndf, BrushedParams, DEFAULT_LOD_LOBES,
-    FlakesParams, Footprint, HemisphereBins, Kernel, MaskingMode, MixtureParams, NormalMap,
-    PatchOptions, ScratchedParams, binned_pndf, brushed, bumpy, flakes, scratched, tv_distance,
+    FlakesParams, Footprint, GlintNdf, HemisphereBins, Kernel, MaskingMode, MixtureParams,
+    NormalMap, PatchOptions, PositionNormalBrdf, PositionNormalMap, PositionNormalParams,
+    ScratchedParams, binned_pndf, brushed, bumpy, flakes, scratched, tv_distance,
 };
 use brdf::ndf::Ndf;
 use brdf::{MicrofacetBrdf, Vec2, Vec3};
@@ -177,13 +178,54 @@ fn binmap_methods(map: &NormalMap, _: &Settings) -> Res<Vec<Box<dyn Method>>> {
     Ok(methods)
 }
 
+/// The position-normal distributions of \[Yan2016\] (the baseline) at one sampling rate, with the BRDF
+/// as published (a footprint-independent Smith term, cosines in the denominator).
+struct PositionNormalMethod {
+    map: Arc<PositionNormalMap>,
+}
+
+impl Method for PositionNormalMethod {
+    fn label(&self) -> String {
+        format!("position-normal (rate {})", self.map.params().sampling_rate)
+    }
+    fn bytes_per_texel(&self) -> f64 {
+        let m = self.map.memory();
+        let (w, h) = self.map.map_size();
+        (m.element_bytes + m.hierarchy_bytes) as f64 / (w * h) as f64
+    }
+    fn with_patch(&self, footprint: &Footprint, f: &mut dyn FnMut(&(dyn Ndf + Sync))) {
+        f(&self.map.patch(footprint))
+    }
+    fn with_brdf(&self, footprint: &Footprint, f: &mut dyn FnMut(&(dyn Bxdf + Sync))) {
+        f(&PositionNormalBrdf::new(
+            self.map.patch(footprint),
+            NoFresnel,
+        ))
+    }
+}
+
+/// The position-normal baseline at its default rate (1 element per texel) and at rate 2.
+fn position_normal_methods(map: &NormalMap, _: &Settings) -> Res<Vec<Box<dyn Method>>> {
+    let mut methods: Vec<Box<dyn Method>> = Vec::new();
+    for rate in [1, 2] {
+        let params = PositionNormalParams {
+            sampling_rate: rate,
+            ..PositionNormalParams::default()
+        };
+        methods.push(Box::new(PositionNormalMethod {
+            map: Arc::new(PositionNormalMap::build(map, params)?),
+        }));
+    }
+    Ok(methods)
+}
+
 /// Every method family compared, with a name for the build-time table.
 ///
-/// The position-normal baseline (\[Yan2016\]) joins this list when it lands (one line).
 pub fn builders() -> Vec<(&'static str, Builder)> {
     vec![
         ("Beckmann mixture", mixture_methods as Builder),
         ("inverse bin map", binmap_methods as Builder),
+        ("position-normal", position_normal_methods as Builder),
     ]
 }
 

@@ -51,6 +51,7 @@
 
 mod binmap;
 mod bins;
+mod flakes;
 mod footprint;
 #[cfg(feature = "image")]
 mod image_io;
@@ -66,6 +67,10 @@ pub use binmap::{
     MASKING_FIRST_LEVEL, QueryStats,
 };
 pub use bins::HemisphereBins;
+pub use flakes::{
+    DEFAULT_MASKING_ALPHA, PositionNormalBrdf, PositionNormalMap, PositionNormalMemory,
+    PositionNormalParams, PositionNormalPatch,
+};
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 pub use mixture::{
     BeckmannMixture, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES, DEFAULT_MASKING, DEFAULT_SAMPLES,

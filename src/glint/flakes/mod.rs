@@ -1,0 +1,268 @@
+//! The position-normal distribution of \[Yan2016\]: one 4D Gaussian "element" in (position, slope) per
+//! sample of a normal map, a Gaussian ray footprint, and the closed-form P-NDF of their product,
+//! summed through a bounding-box hierarchy. The baseline that \[Chermain2019\] and \[Atanasov2020\]
+//! compare against.
+//!
+//! - [`PositionNormalMap::build`] linearises the slope field of the interpolated normal map at each
+//!   element centre (slope ñ_i and Jacobian J_i = ∂ñ/∂u by central differences) and stores them
+//!   (6 `f32` per element), with an implicit quadtree of footprint-independent slope boxes.
+//! - [`PositionNormalMap::patch`] turns a [`Footprint`] into a [`PositionNormalPatch`], an
+//!   [`Ndf`](crate::ndf::Ndf) whose D_P is the closed-form integral over positions of footprint ×
+//!   element, normalised by the total footprint weight (∫ D_P cos θ dω = 1).
+//! - [`PositionNormalBrdf`] is the BRDF as published, f = F G D_P / (4 cos θo cos θi) with the Smith G
+//!   of a fixed Beckmann lobe, kept so that its energy error can be measured.
+//!
+//! The derivation, the deviations from the paper and the defaults with their sources are in
+//! docs/position_normal.md.
+
+mod brdf;
+mod build;
+mod patch;
+mod tree;
+
+pub use brdf::{DEFAULT_MASKING_ALPHA, PositionNormalBrdf};
+pub use patch::PositionNormalPatch;
+
+use crate::error::{Error, Result, positive};
+use crate::glint::{Footprint, GlintNdf, NormalMap};
+use glam::{Mat2, Vec2};
+use tree::SlopeTree;
+
+/// σ_h / h = 1/√(8 ln 2) (see [`PositionNormalMap::SIGMA_H_PER_SPACING`]).
+pub(crate) const SIGMA_H_PER_SPACING: f64 = 0.424_660_900_144_009_5;
+
+/// Build parameters of a [`PositionNormalMap`]. `Default` gives the documented associated
+/// `DEFAULT_*` values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PositionNormalParams {
+    /// Elements per texel side (≥ 1): the element spacing is h = 1 / rate texels.
+    pub sampling_rate: usize,
+    /// Intrinsic roughness σ_r: slope standard deviation of each element (in [10⁻⁴, 1]).
+    pub sigma_r: f32,
+    /// Truncation of the position weights, in σ (≥ 2, finite).
+    pub weight_sigmas: f32,
+    /// Truncation of the element slope densities, in σ per axis (> 0).
+    pub slope_sigmas: f32,
+    /// Footprint cap in texels: `weight_sigmas` · σ_footprint ≤ this (> 0; `f32::INFINITY` disables).
+    pub max_query_texels: f32,
+}
+
+impl PositionNormalParams {
+    /// Default sampling rate: one element per texel side, centred on the texel centres
+    /// (\[Yan2016\] §4; \[Atanasov2020\] Fig. 1 compares against "one Gaussian element per texel").
+    pub const DEFAULT_SAMPLING_RATE: usize = 1;
+
+    /// Default intrinsic roughness σ_r = 0.005, the slope standard deviation of every element around its
+    /// linearised slope (\[Atanasov2020\] Fig. 1 caption: Yan 2016 rendered with one element per texel
+    /// and σ_r = 0.005).
+    pub const DEFAULT_SIGMA_R: f32 = 0.005;
+
+    /// Default truncation of the position weights, in standard deviations: elements whose centre lies
+    /// outside the ellipse of Mahalanobis radius 3 of the Gaussian footprint ∗ element kernel are left
+    /// out (the released code truncates elements and footprints at 3 σ).
+    pub const DEFAULT_WEIGHT_SIGMAS: f32 = 3.0;
+
+    /// Default truncation of an element's slope density, in standard deviations per axis: 4 (the
+    /// released code's normal truncation). D_P ignores an element outside its slope box, so D_P
+    /// integrates to at least 1 − 4 Q(4) ≈ 1 − 1.3·10⁻⁴ (Q the normal tail).
+    pub const DEFAULT_SLOPE_SIGMAS: f32 = 4.0;
+
+    /// Default cap on the footprint: its standard deviation along each principal axis is clamped so that
+    /// `weight_sigmas` · σ ≤ 128 texels (the released code's maximum query range, which bounds the
+    /// per-patch work of a method that has no level of detail).
+    pub const DEFAULT_MAX_QUERY_TEXELS: f32 = 128.0;
+}
+
+impl Default for PositionNormalParams {
+    fn default() -> Self {
+        PositionNormalParams {
+            sampling_rate: Self::DEFAULT_SAMPLING_RATE,
+            sigma_r: Self::DEFAULT_SIGMA_R,
+            weight_sigmas: Self::DEFAULT_WEIGHT_SIGMAS,
+            slope_sigmas: Self::DEFAULT_SLOPE_SIGMAS,
+            max_query_texels: Self::DEFAULT_MAX_QUERY_TEXELS,
+        }
+    }
+}
+
+impl PositionNormalParams {
+    fn validate(&self) -> Result<()> {
+        if self.sampling_rate == 0 || self.sampling_rate > 64 {
+            return Err(Error::InvalidParameter {
+                name: "sampling_rate",
+                value: self.sampling_rate as f64,
+                reason: "must be in 1..=64 elements per texel side",
+            });
+        }
+        if !(self.sigma_r >= 1e-4 && self.sigma_r <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "sigma_r",
+                value: self.sigma_r as f64,
+                reason: "must be in [1e-4, 1] (a slope standard deviation; below 1e-4 the element \
+                         densities leave the f32 range)",
+            });
+        }
+        if !(self.weight_sigmas >= 2.0 && self.weight_sigmas.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "weight_sigmas",
+                value: self.weight_sigmas as f64,
+                reason: "must be finite and >= 2 (so that the element nearest to any footprint \
+                         centre, at Mahalanobis distance <= 1.67, is always kept)",
+            });
+        }
+        positive("slope_sigmas", self.slope_sigmas)?;
+        if self.max_query_texels.is_nan() || self.max_query_texels <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "max_query_texels",
+                value: self.max_query_texels as f64,
+                reason: "must be > 0 (infinity disables the cap)",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Memory held by a [`PositionNormalMap`], in bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PositionNormalMemory {
+    /// Number of elements.
+    pub elements: usize,
+    /// The elements' slopes and Jacobians (24 bytes each: 6 `f32`).
+    pub element_bytes: usize,
+    /// The slope-box quadtree (levels ≥ 1, 16 bytes per node).
+    pub hierarchy_bytes: usize,
+}
+
+/// The position-normal glint representation of a normal map (\[Yan2016\]).
+///
+/// The map's slope field ñ(u) (of the bilinearly interpolated normals, [`NormalMap::slope_at_texel`])
+/// is covered by elements on a grid of spacing h = 1/`sampling_rate` texels, centred at
+/// u_i = (i + ½) h. Element i is the 4D Gaussian
+///
+/// G_i(u, ñ) = h² N(u; u_i, σ_h² I) · N(ñ; ñ_i + J_i (u − u_i), σ_r² I),
+///
+/// the linearisation of the slope field at u_i (ñ_i = ñ(u_i), J_i = ∂ñ/∂u by central differences of
+/// step h/2) blurred by the intrinsic roughness σ_r, with σ_h = h/√(8 ln 2). Stored per element: ñ_i
+/// and J_i, 6 `f32` (24 bytes; the paper stores 12 floats, a public adaptation 11: position, normal,
+/// per-axis σ, area and J); positions, σ_h, σ_r and the area h² are implicit in the regular grid.
+/// Plus a quadtree of slope boxes (16 bytes per node above the elements, ~5.3 bytes per element).
+///
+/// # Reference
+/// \[Yan2016\] §4 (elements), §5 (P-NDF of a Gaussian footprint, hierarchy).
+#[derive(Clone, Debug)]
+pub struct PositionNormalMap {
+    width: usize,
+    height: usize,
+    grid: [usize; 2],
+    /// Element spacing h in texels.
+    spacing: f64,
+    /// Per element: [ñx, ñy, ∂ñx/∂u, ∂ñx/∂v, ∂ñy/∂u, ∂ñy/∂v] (texel units).
+    elements: Vec<[f32; 6]>,
+    tree: SlopeTree,
+    params: PositionNormalParams,
+}
+
+impl PositionNormalMap {
+    /// The positional standard deviation of an element in units of the element spacing h:
+    /// σ_h = h / √(8 ln 2) ≈ 0.4247 h, so that the Gaussian's full width at half maximum is h
+    /// (\[Yan2016\] §4).
+    pub const SIGMA_H_PER_SPACING: f64 = SIGMA_H_PER_SPACING;
+
+    /// Builds the elements of `map` (parallel, deterministic whatever the thread count).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the invalid field of `params` (`sampling_rate`, `sigma_r`,
+    /// `weight_sigmas`, `slope_sigmas`, `max_query_texels`); [`Error::InvalidSize`] if the element grid
+    /// would exceed 2³¹ elements.
+    pub fn build(map: &NormalMap, params: PositionNormalParams) -> Result<Self> {
+        params.validate()?;
+        let (width, height) = (map.width(), map.height());
+        let r = params.sampling_rate;
+        let (nx, ny) = (width.saturating_mul(r), height.saturating_mul(r));
+        if nx.checked_mul(ny).is_none_or(|n| n > (1usize << 31)) {
+            return Err(Error::InvalidSize {
+                width: nx,
+                height: ny,
+                reason: "the element grid (map size × sampling rate) exceeds 2^31 elements",
+            });
+        }
+        let spacing = 1.0 / r as f64;
+        let elements = build::elements(map, [nx, ny], spacing);
+        let sigma_h = SIGMA_H_PER_SPACING * spacing;
+        let leaf: Vec<[f32; 4]> = elements
+            .iter()
+            .map(|e| build::slope_box(e, sigma_h, &params))
+            .collect();
+        let tree = SlopeTree::build(nx, ny, &leaf);
+        Ok(PositionNormalMap {
+            width,
+            height,
+            grid: [nx, ny],
+            spacing,
+            elements,
+            tree,
+            params,
+        })
+    }
+
+    /// The parameters the representation was built with.
+    pub fn params(&self) -> &PositionNormalParams {
+        &self.params
+    }
+
+    /// The map size (width, height) in texels.
+    pub fn map_size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// The element grid (nx, ny) = (width, height) × sampling rate.
+    pub fn grid(&self) -> (usize, usize) {
+        (self.grid[0], self.grid[1])
+    }
+
+    /// The element spacing h in texels (1 / sampling rate).
+    pub fn spacing(&self) -> f32 {
+        self.spacing as f32
+    }
+
+    /// The positional standard deviation σ_h = h / √(8 ln 2) in texels.
+    ///
+    /// # Reference
+    /// \[Yan2016\] §4.
+    pub fn sigma_h(&self) -> f32 {
+        (SIGMA_H_PER_SPACING * self.spacing) as f32
+    }
+
+    /// Element (i, j) of the grid (wrapping): its centre u_i in texels, its slope ñ_i and its Jacobian
+    /// J_i = ∂ñ/∂u (per texel; columns ∂/∂u and ∂/∂v).
+    pub fn element(&self, i: i64, j: i64) -> (Vec2, Vec2, Mat2) {
+        let (nx, ny) = (self.grid[0] as i64, self.grid[1] as i64);
+        let (iw, jw) = (i.rem_euclid(nx), j.rem_euclid(ny));
+        let e = self.elements[(jw * nx + iw) as usize];
+        let h = self.spacing;
+        let centre = Vec2::new(
+            ((iw as f64 + 0.5) * h) as f32,
+            ((jw as f64 + 0.5) * h) as f32,
+        );
+        let jac = Mat2::from_cols(Vec2::new(e[2], e[4]), Vec2::new(e[3], e[5]));
+        (centre, Vec2::new(e[0], e[1]), jac)
+    }
+
+    /// Bytes held by the elements and the hierarchy.
+    pub fn memory(&self) -> PositionNormalMemory {
+        PositionNormalMemory {
+            elements: self.elements.len(),
+            element_bytes: self.elements.len() * 24,
+            hierarchy_bytes: self.tree.bytes(),
+        }
+    }
+}
+
+impl GlintNdf for PositionNormalMap {
+    type Patch<'a> = PositionNormalPatch<'a>;
+
+    /// The position-normal P-NDF of a footprint ([`PositionNormalPatch::new`]).
+    fn patch(&self, footprint: &Footprint) -> PositionNormalPatch<'_> {
+        PositionNormalPatch::new(self, footprint)
+    }
+}

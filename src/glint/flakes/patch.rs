@@ -1,0 +1,593 @@
+//! The patch of a footprint: the closed-form position-normal P-NDF of \[Yan2016\] §5, evaluated
+//! through the slope-box quadtree, its moments lobe for the masking terms, and exact samplers.
+//!
+//! Per-footprint work (done once in [`PositionNormalPatch::new`]): the footprint in element units
+//! (clamped to the query cap), the effective position Gaussian Σ_eff = Σ_P + σ_h² I, the conditional
+//! position covariance Σ_u = (Σ_P⁻¹ + σ_h⁻² I)⁻¹ = σ_h² I − σ_h⁴ Σ_eff⁻¹, the rectangle of elements
+//! that can be within `weight_sigmas` of the footprint, their total weight and the P-NDF's first and
+//! second slope moments. The per-element lobes used by the samplers are built on first use.
+
+use super::build::slope_box;
+use super::tree::contains;
+use super::{PositionNormalMap, SIGMA_H_PER_SPACING};
+use crate::frame::normal_to_slope;
+use crate::glint::Footprint;
+use crate::ndf::{Ndf, SlopeGaussian};
+use glam::{Mat2, Vec2, Vec3};
+use std::sync::OnceLock;
+
+const TWO_PI: f64 = std::f64::consts::TAU;
+
+/// Per-footprint constants, positions in element units (element i has its centre at i + ½).
+#[derive(Clone, Copy, Debug)]
+struct Geometry {
+    /// Footprint centre.
+    c: [f64; 2],
+    /// Σ_eff⁻¹ = (Σ_P + σ_h² I)⁻¹ as (xx, xy, yy).
+    inv_eff: [f64; 3],
+    /// K = h σ_h² Σ_eff⁻¹: maps c − u_i (element units) to μ_u − u_i in texels.
+    k: [f64; 3],
+    /// Σ_u in texels²: h² (σ_h² I − σ_h⁴ Σ_eff⁻¹).
+    sigma_u: [f64; 3],
+    /// σ_r².
+    var_r: f64,
+    /// k_w².
+    kw2: f64,
+    /// Half-widths of the rectangle of candidate elements, k_w √Σ_eff,kk.
+    half: [f64; 2],
+}
+
+/// Symmetric 2 × 2 eigen decomposition: eigenvalues (λ1 ≥ λ2) and the unit eigenvector of λ1.
+fn eigen(c: [f64; 3]) -> ([f64; 2], [f64; 2]) {
+    let [a, b, d] = c;
+    let half_tr = 0.5 * (a + d);
+    let r = (0.25 * (a - d) * (a - d) + b * b).sqrt();
+    let (l1, l2) = (half_tr + r, half_tr - r);
+    let e = if b.abs() > 1e-300 {
+        let (x, y) = (l1 - d, b);
+        let n = (x * x + y * y).sqrt();
+        [x / n, y / n]
+    } else if a >= d {
+        [1.0, 0.0]
+    } else {
+        [0.0, 1.0]
+    };
+    ([l1, l2], e)
+}
+
+/// The covariance with eigenvalues clamped to at most `max_var` (same eigenvectors).
+fn clamp_covariance(c: [f64; 3], max_var: f64) -> [f64; 3] {
+    let ([l1, l2], e) = eigen(c);
+    if l1 <= max_var {
+        return c;
+    }
+    let (l1, l2) = (l1.min(max_var), l2.clamp(0.0, max_var));
+    let f = [-e[1], e[0]];
+    [
+        l1 * e[0] * e[0] + l2 * f[0] * f[0],
+        l1 * e[0] * e[1] + l2 * f[0] * f[1],
+        l1 * e[1] * e[1] + l2 * f[1] * f[1],
+    ]
+}
+
+impl Geometry {
+    fn new(map: &PositionNormalMap, footprint: &Footprint) -> Geometry {
+        let p = &map.params;
+        let (c, s) = footprint.gaussian_texels(map.width, map.height);
+        let cov = [s.x_axis.x as f64, s.y_axis.x as f64, s.y_axis.y as f64];
+        let kw = p.weight_sigmas as f64;
+        let cap = p.max_query_texels as f64 / kw;
+        let cov = clamp_covariance(cov, cap * cap);
+        let h = map.spacing;
+        let (h2, sh) = (h * h, SIGMA_H_PER_SPACING);
+        let sh2 = sh * sh;
+        let (a, b, d) = (cov[0] / h2 + sh2, cov[1] / h2, cov[2] / h2 + sh2);
+        let det = a * d - b * b;
+        // det ≥ σ_h⁴ > 0: Σ_P is positive semi-definite and σ_h² I is added.
+        let inv = [d / det, -b / det, a / det];
+        Geometry {
+            c: [c.x as f64 / h, c.y as f64 / h],
+            inv_eff: inv,
+            k: [h * sh2 * inv[0], h * sh2 * inv[1], h * sh2 * inv[2]],
+            sigma_u: [
+                h2 * (sh2 - sh2 * sh2 * inv[0]).max(0.0),
+                -h2 * sh2 * sh2 * inv[1],
+                h2 * (sh2 - sh2 * sh2 * inv[2]).max(0.0),
+            ],
+            var_r: (p.sigma_r as f64).powi(2),
+            kw2: kw * kw,
+            half: [kw * a.sqrt(), kw * d.sqrt()],
+        }
+    }
+
+    /// The unwrapped element index range [lo, hi] of one axis.
+    fn range(&self, axis: usize) -> [i64; 2] {
+        let (c, half) = (self.c[axis], self.half[axis]);
+        let lo = (c - 0.5 - half).ceil();
+        let hi = (c - 0.5 + half).floor();
+        if hi >= lo {
+            [lo as i64, hi as i64]
+        } else {
+            let n = (c - 0.5).round() as i64;
+            [n, n]
+        }
+    }
+
+    /// The position weight of unwrapped element (i, j): exp(−½ dᵀ Σ_eff⁻¹ d), d = c − u_i, or
+    /// `None` outside the truncation ellipse. Also returns d.
+    #[inline]
+    fn weight(&self, i: i64, j: i64) -> Option<(f64, [f64; 2])> {
+        let d = [self.c[0] - (i as f64 + 0.5), self.c[1] - (j as f64 + 0.5)];
+        let q = self.inv_eff[0] * d[0] * d[0]
+            + 2.0 * self.inv_eff[1] * d[0] * d[1]
+            + self.inv_eff[2] * d[1] * d[1];
+        (q <= self.kw2).then(|| ((-0.5 * q).exp(), d))
+    }
+
+    /// The element's slope Gaussian under the footprint: mean ñ_i + J K d and covariance
+    /// J Σ_u Jᵀ + σ_r² I (as (xx, xy, yy)).
+    #[inline]
+    fn lobe(&self, e: &[f32; 6], d: [f64; 2]) -> ([f64; 2], [f64; 3]) {
+        let [sx, sy, jxu, jxv, jyu, jyv] = e.map(f64::from);
+        let du = [
+            self.k[0] * d[0] + self.k[1] * d[1],
+            self.k[1] * d[0] + self.k[2] * d[1],
+        ];
+        let mean = [
+            sx + jxu * du[0] + jxv * du[1],
+            sy + jyu * du[0] + jyv * du[1],
+        ];
+        let [u0, u1, u2] = self.sigma_u;
+        // Rows of J Σ_u.
+        let (ax, ay) = (jxu * u0 + jxv * u1, jxu * u1 + jxv * u2);
+        let (bx, by) = (jyu * u0 + jyv * u1, jyu * u1 + jyv * u2);
+        let cov = [
+            ax * jxu + ay * jxv + self.var_r,
+            ax * jyu + ay * jyv,
+            bx * jyu + by * jyv + self.var_r,
+        ];
+        (mean, cov)
+    }
+}
+
+/// The 2D Gaussian density N(s; mean, cov) in `f64` (0 for a degenerate covariance).
+#[inline]
+fn gaussian(s: [f64; 2], mean: [f64; 2], cov: [f64; 3]) -> f64 {
+    let det = cov[0] * cov[2] - cov[1] * cov[1];
+    if det.is_nan() || det <= 0.0 {
+        return 0.0;
+    }
+    let (dx, dy) = (s[0] - mean[0], s[1] - mean[1]);
+    let q = (cov[2] * dx * dx - 2.0 * cov[1] * dx * dy + cov[0] * dy * dy) / det;
+    (-0.5 * q).exp() / (TWO_PI * det.sqrt())
+}
+
+/// Segments of one axis: wrapped index ranges [lo, hi] (inclusive) with the offset that unwraps them.
+fn segments(range: [i64; 2], n: usize) -> impl Iterator<Item = (usize, usize, i64)> {
+    let n = n as i64;
+    let [lo, hi] = range;
+    (lo.div_euclid(n)..=hi.div_euclid(n)).map(move |k| {
+        let a = (lo - k * n).max(0);
+        let b = (hi - k * n).min(n - 1);
+        (a as usize, b as usize, k * n)
+    })
+}
+
+/// The per-element lobes of a patch, for the samplers and the untruncated densities.
+#[derive(Clone, Debug)]
+struct Slots {
+    /// Normalised weights W_i (sum 1).
+    weights: Vec<f64>,
+    /// Cumulative weights (last = Σ weights).
+    cdf: Vec<f64>,
+    lobes: Vec<SlopeGaussian>,
+}
+
+/// The position-normal P-NDF of one footprint of a [`PositionNormalMap`]: an [`Ndf`].
+///
+/// For the Gaussian footprint k_P(u) = N(u; c, Σ_P) (texels, [`Footprint::gaussian_texels`], clamped
+/// to the query cap), element i contributes the closed-form integral over positions
+///
+/// ∫ k_P(u) N(u; u_i, σ_h² I) N(ñ; ñ_i + J_i (u − u_i), σ_r² I) du = w_i · N(ñ; μ_i, C_i),
+///
+/// with w_i = N(u_i; c, Σ_eff), Σ_eff = Σ_P + σ_h² I, μ_i = ñ_i + J_i σ_h² Σ_eff⁻¹ (c − u_i) and
+/// C_i = J_i Σ_u J_iᵀ + σ_r² I, Σ_u = (Σ_P⁻¹ + σ_h⁻² I)⁻¹ (completing the square in u). The P-NDF is
+/// the slope density P(ñ) = Σ W_i N(ñ; μ_i, C_i) with W_i = w_i / Σ_j w_j (normalised by the total
+/// footprint weight of the kept elements), in the crate's convention D_P(m) = P(ñ(m)) / cos⁴θ_m, so
+/// ∫ D_P cos θ dω = 1 up to the slope truncation.
+///
+/// - `d`: the sum over the elements whose slope box contains ñ(m), through the quadtree; elements
+///   outside the ellipse of Mahalanobis radius `weight_sigmas` (under Σ_eff) are left out everywhere.
+/// - Masking (`lambda`, `projected_area`, `visible_area`): those of the **moments lobe**, the
+///   non-centred Beckmann lobe with the P-NDF's own mean slope and slope covariance (floored at σ_r),
+///   computed exactly from the elements; the published BRDF ([`super::PositionNormalBrdf`]) uses a
+///   fixed Beckmann lobe instead.
+/// - Samplers: `sample_normal` draws an element ∝ W_i then its slope Gaussian N(μ_i, C_i) (the
+///   element's slope marginal under the footprint), exactly `pdf_normal`; `sample_visible` draws an
+///   element ∝ W_i V_i(wo) then its visible normal, exactly `pdf_visible`. Both densities sum every
+///   kept element (no slope truncation), O(elements in the footprint).
+///
+/// # Reference
+/// \[Yan2016\] §5 (P-NDF of a Gaussian footprint, truncation, hierarchy).
+#[derive(Clone, Debug)]
+pub struct PositionNormalPatch<'a> {
+    map: &'a PositionNormalMap,
+    geo: Geometry,
+    rect: [[i64; 2]; 2],
+    /// 1 / Σ w_i over the kept elements.
+    inv_total: f64,
+    /// Number of kept elements.
+    count: usize,
+    mean_slope: Vec2,
+    moments: [f32; 5],
+    moments_lobe: SlopeGaussian,
+    slots: OnceLock<Slots>,
+}
+
+impl<'a> PositionNormalPatch<'a> {
+    /// The P-NDF of `footprint` (see the type's docs). Total: any footprint works; cost
+    /// O(elements within `weight_sigmas` of the footprint).
+    pub fn new(map: &'a PositionNormalMap, footprint: &Footprint) -> PositionNormalPatch<'a> {
+        let geo = Geometry::new(map, footprint);
+        let rect = [geo.range(0), geo.range(1)];
+        let mut total = 0.0f64;
+        let mut count = 0usize;
+        let mut acc = [0.0f64; 5];
+        Self::for_each_kept(map, &geo, rect, |w, mean, cov| {
+            total += w;
+            count += 1;
+            acc[0] += w * mean[0];
+            acc[1] += w * mean[1];
+            acc[2] += w * (cov[0] + mean[0] * mean[0]);
+            acc[3] += w * (cov[2] + mean[1] * mean[1]);
+            acc[4] += w * (cov[1] + mean[0] * mean[1]);
+        });
+        // total ≥ the nearest element's weight ≥ e^{−1.39} (weight_sigmas ≥ 2 keeps it).
+        let inv_total = if total > 0.0 { 1.0 / total } else { 0.0 };
+        let moments = acc.map(|v| (v * inv_total) as f32);
+        let moments_lobe = SlopeGaussian::from_moments(moments, map.params.sigma_r);
+        PositionNormalPatch {
+            map,
+            geo,
+            rect,
+            inv_total,
+            count,
+            mean_slope: Vec2::new(moments[0], moments[1]),
+            moments,
+            moments_lobe,
+            slots: OnceLock::new(),
+        }
+    }
+
+    /// Calls `f(w, mean, cov)` for every kept element of the rectangle, in a fixed order.
+    fn for_each_kept(
+        map: &PositionNormalMap,
+        geo: &Geometry,
+        rect: [[i64; 2]; 2],
+        mut f: impl FnMut(f64, [f64; 2], [f64; 3]),
+    ) {
+        let [nx, ny] = map.grid;
+        for j in rect[1][0]..=rect[1][1] {
+            let jw = j.rem_euclid(ny as i64) as usize;
+            for i in rect[0][0]..=rect[0][1] {
+                let Some((w, d)) = geo.weight(i, j) else {
+                    continue;
+                };
+                let iw = i.rem_euclid(nx as i64) as usize;
+                let (mean, cov) = geo.lobe(&map.elements[jw * nx + iw], d);
+                f(w, mean, cov);
+            }
+        }
+    }
+
+    /// Number of elements kept in the footprint (inside the weight ellipse).
+    pub fn element_count(&self) -> usize {
+        self.count
+    }
+
+    /// The P-NDF's mean slope Σ W_i μ_i.
+    pub fn mean_slope(&self) -> Vec2 {
+        self.mean_slope
+    }
+
+    /// The P-NDF's slope moments `[E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]` (exact for the kept elements).
+    pub fn moments(&self) -> [f32; 5] {
+        self.moments
+    }
+
+    /// The moments lobe: the non-centred Beckmann lobe with the P-NDF's mean and covariance (variances
+    /// floored at σ_r²), whose Smith terms the patch reports.
+    pub fn moments_lobe(&self) -> &SlopeGaussian {
+        &self.moments_lobe
+    }
+
+    /// The normalised weights W_i and slope Gaussians N(μ_i, C_i) of the kept elements.
+    pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
+        let s = self.slots();
+        s.weights.iter().zip(&s.lobes).map(|(&w, &l)| (w as f32, l))
+    }
+
+    fn slots(&self) -> &Slots {
+        self.slots.get_or_init(|| {
+            let mut weights = Vec::with_capacity(self.count);
+            let mut lobes = Vec::with_capacity(self.count);
+            Self::for_each_kept(self.map, &self.geo, self.rect, |w, mean, cov| {
+                weights.push(w * self.inv_total);
+                lobes.push(lobe_of(mean, cov, self.map.params.sigma_r));
+            });
+            let mut acc = 0.0;
+            let cdf = weights
+                .iter()
+                .map(|w| {
+                    acc += w;
+                    acc
+                })
+                .collect();
+            Slots {
+                weights,
+                cdf,
+                lobes,
+            }
+        })
+    }
+
+    /// D_P(m) and the number of elements whose contribution was evaluated.
+    ///
+    /// # Reference
+    /// \[Yan2016\] §5.
+    pub fn d_with_stats(&self, m: Vec3) -> (f32, usize) {
+        let Some(s) = normal_to_slope(m) else {
+            return (0.0, 0);
+        };
+        if !s.is_finite() {
+            return (0.0, 0);
+        }
+        let (p, touched) = self.sum_p(s);
+        let c = 1.0 + s.length_squared() as f64;
+        let d = (p * self.inv_total * c * c) as f32;
+        (if d.is_finite() { d } else { f32::MAX }, touched)
+    }
+
+    /// Σ w_i N(ñ; μ_i, C_i) over the kept elements whose slope box contains ñ, by a depth-first walk
+    /// of the quadtree restricted to each (x segment × y segment) of the rectangle.
+    fn sum_p(&self, s: Vec2) -> (f64, usize) {
+        let map = self.map;
+        let tree = &map.tree;
+        let [nx, ny] = map.grid;
+        let sigma_h = SIGMA_H_PER_SPACING * map.spacing;
+        let sq = [s.x, s.y];
+        let sd = [s.x as f64, s.y as f64];
+        let mut acc = 0.0f64;
+        let mut touched = 0usize;
+        let mut stack = [(0u8, 0u32, 0u32); 128];
+        for (x_lo, x_hi, x_off) in segments(self.rect[0], nx) {
+            for (y_lo, y_hi, y_off) in segments(self.rect[1], ny) {
+                let mut len = 1;
+                stack[0] = (tree.top() as u8, 0, 0);
+                while len > 0 {
+                    len -= 1;
+                    let (l, x, y) = stack[len];
+                    let (l, x, y) = (l as usize, x as usize, y as usize);
+                    let (bx0, by0) = (x << l, y << l);
+                    let (bx1, by1) = ((x + 1) << l, (y + 1) << l);
+                    if bx1 <= x_lo || bx0 > x_hi || by1 <= y_lo || by0 > y_hi {
+                        continue;
+                    }
+                    if l == 0 {
+                        let e = &map.elements[y * nx + x];
+                        if !contains(&slope_box(e, sigma_h, &map.params), sq) {
+                            continue;
+                        }
+                        let Some((w, d)) = self.geo.weight(x as i64 + x_off, y as i64 + y_off)
+                        else {
+                            continue;
+                        };
+                        touched += 1;
+                        let (mean, cov) = self.geo.lobe(e, d);
+                        acc += w * gaussian(sd, mean, cov);
+                        continue;
+                    }
+                    if !contains(tree.node_box(l, x, y), sq) {
+                        continue;
+                    }
+                    let [cw, ch] = tree.sizes[l - 1];
+                    for cy in (2 * y)..(2 * y + 2).min(ch) {
+                        for cx in (2 * x)..(2 * x + 2).min(cw) {
+                            stack[len] = ((l - 1) as u8, cx as u32, cy as u32);
+                            len += 1;
+                        }
+                    }
+                }
+            }
+        }
+        (acc, touched)
+    }
+
+    /// Picks a slot by inverting the cdf at u; returns the slot and u rescaled to [0, 1).
+    fn pick(cdf: &[f64], u: f32) -> (usize, f32) {
+        let total = cdf.last().copied().unwrap_or(0.0);
+        let u = if u.is_nan() { 0.5 } else { u.clamp(0.0, 1.0) } as f64;
+        let target = u * total;
+        let s = cdf
+            .partition_point(|&c| c <= target)
+            .min(cdf.len().saturating_sub(1));
+        let lo = if s == 0 { 0.0 } else { cdf[s - 1] };
+        let width = cdf.get(s).copied().unwrap_or(0.0) - lo;
+        let r = if width > 0.0 {
+            (target - lo) / width
+        } else {
+            0.5
+        };
+        (s, (r as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0))
+    }
+
+    /// Σ W_i D_i(m) over every kept element, in `f64`.
+    fn untruncated_d(&self, m: Vec3) -> f64 {
+        let s = self.slots();
+        s.weights
+            .iter()
+            .zip(&s.lobes)
+            .map(|(&w, lobe)| w * lobe.d(m) as f64)
+            .sum()
+    }
+
+    /// Σ W_i V_i(w) over every kept element (the exact visible area of the P-NDF), in `f64`.
+    pub fn visible_area_exact(&self, w: Vec3) -> f32 {
+        self.exact_visible_area(w) as f32
+    }
+
+    fn exact_visible_area(&self, w: Vec3) -> f64 {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let s = self.slots();
+        s.weights
+            .iter()
+            .zip(&s.lobes)
+            .map(|(&wi, lobe)| wi * lobe.visible_area(w) as f64)
+            .sum()
+    }
+}
+
+/// The element lobe as a [`SlopeGaussian`]; the moments fallback (variances floored at σ_r²) if the
+/// covariance leaves the `f32` range.
+fn lobe_of(mean: [f64; 2], cov: [f64; 3], sigma_r: f32) -> SlopeGaussian {
+    let m = Vec2::new(mean[0] as f32, mean[1] as f32);
+    let c = Mat2::from_cols(
+        Vec2::new(cov[0] as f32, cov[1] as f32),
+        Vec2::new(cov[1] as f32, cov[2] as f32),
+    );
+    SlopeGaussian::new(m, c).unwrap_or_else(|_| {
+        SlopeGaussian::from_moments(
+            [
+                m.x,
+                m.y,
+                (cov[0] + mean[0] * mean[0]) as f32,
+                (cov[2] + mean[1] * mean[1]) as f32,
+                (cov[1] + mean[0] * mean[1]) as f32,
+            ],
+            sigma_r,
+        )
+    })
+}
+
+impl Ndf for PositionNormalPatch<'_> {
+    /// D_P(m) = Σ W_i N(ñ(m); μ_i, C_i) / cos⁴θ_m (\[Yan2016\] §5); see [`PositionNormalPatch::d_with_stats`].
+    fn d(&self, m: Vec3) -> f32 {
+        self.d_with_stats(m).0
+    }
+
+    /// Λ of the moments lobe (0 for invalid w).
+    fn lambda(&self, w: Vec3) -> f32 {
+        self.moments_lobe.lambda(w)
+    }
+
+    /// A(w) of the moments lobe: max(cos θ − w_xy·μ_P, 0) with μ_P the P-NDF's mean slope.
+    fn projected_area(&self, w: Vec3) -> f32 {
+        self.moments_lobe.projected_area(w)
+    }
+
+    /// V(w) = A(1 + Λ) of the moments lobe.
+    fn visible_area(&self, w: Vec3) -> f32 {
+        self.moments_lobe.visible_area(w)
+    }
+
+    /// m ~ D_P(m) cos θ_m (untruncated): element ∝ W_i with u.x (rescaled), then its slope Gaussian.
+    fn sample_normal(&self, u: Vec2) -> Vec3 {
+        let s = self.slots();
+        if s.lobes.is_empty() {
+            return self.moments_lobe.sample_normal(u);
+        }
+        let (k, ux) = Self::pick(&s.cdf, u.x);
+        s.lobes[k].sample_normal(Vec2::new(ux, u.y))
+    }
+
+    /// Σ W_i D_i(m) cos θ_m over every kept element: exactly the density of [`Ndf::sample_normal`];
+    /// differs from `d(m) cos θ_m` by at most the slope truncation. O(elements).
+    fn pdf_normal(&self, m: Vec3) -> f32 {
+        if !(m.z > 0.0 && m.is_finite()) {
+            return 0.0;
+        }
+        let p = self.untruncated_d(m) * m.z as f64;
+        if p.is_finite() { p as f32 } else { 0.0 }
+    }
+
+    /// m ~ Σ W_i ⟨wo, m⟩⁺ D_i(m) / Σ W_i V_i(wo): element ∝ W_i V_i(wo), then its visible normal.
+    /// Invalid wo: [`Ndf::sample_normal`].
+    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        let s = self.slots();
+        let total = self.exact_visible_area(wo);
+        if !(total > 0.0 && total.is_finite()) {
+            return self.sample_normal(u);
+        }
+        let ux = if u.x.is_nan() {
+            0.5
+        } else {
+            u.x.clamp(0.0, 1.0)
+        } as f64;
+        let target = ux * total;
+        let mut acc = 0.0;
+        let mut chosen = (0, 0.5f32);
+        for (k, lobe) in s.lobes.iter().enumerate() {
+            let v = s.weights[k] * lobe.visible_area(wo) as f64;
+            if v > 0.0 {
+                chosen = (k, ((target - acc) / v) as f32);
+                if acc + v > target {
+                    break;
+                }
+            }
+            acc += v;
+        }
+        let (k, r) = chosen;
+        let r = r.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        s.lobes[k].sample_visible(wo, Vec2::new(r, u.y))
+    }
+
+    /// ⟨wo, m⟩ Σ W_i D_i(m) / Σ W_i V_i(wo) over every kept element: exactly the density of
+    /// [`Ndf::sample_visible`]. O(elements).
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        let c = wo.dot(m);
+        if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
+            return 0.0;
+        }
+        let v = self.exact_visible_area(wo);
+        if v.is_nan() || v <= 0.0 {
+            return 0.0;
+        }
+        let p = (c as f64 * self.untruncated_d(m) / v) as f32;
+        if p.is_finite() { p } else { 0.0 }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn segments_cover_the_range_once() {
+        for &(lo, hi, n) in &[
+            (-3i64, 4i64, 4usize),
+            (0, 3, 4),
+            (5, 5, 4),
+            (-9, 9, 3),
+            (2, 2, 1),
+        ] {
+            let mut seen = Vec::new();
+            for (a, b, off) in segments([lo, hi], n) {
+                assert!(a <= b && b < n);
+                for w in a..=b {
+                    seen.push(w as i64 + off);
+                }
+            }
+            assert_eq!(seen, (lo..=hi).collect::<Vec<_>>(), "{lo} {hi} {n}");
+        }
+    }
+
+    #[test]
+    fn clamp_keeps_small_and_shrinks_large() {
+        let c = [4.0, 1.0, 2.0];
+        assert_eq!(clamp_covariance(c, 10.0), c);
+        let ([l1, l2], _) = eigen(clamp_covariance([100.0, 0.0, 1.0], 9.0));
+        assert!((l1 - 9.0).abs() < 1e-12 && (l2 - 1.0).abs() < 1e-12);
+    }
+}

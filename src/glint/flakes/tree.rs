@@ -1,0 +1,90 @@
+//! The implicit quadtree of element slope boxes: the 4D bounding-box hierarchy of \[Yan2016\] §5 with
+//! the positional half implicit.
+//!
+//! Elements sit on a regular grid, so a node's positional box is implicit: a node of level l ≥ 1 is
+//! the block of 2^l × 2^l elements starting at element (x·2^l, y·2^l) (clipped at the grid's edge);
+//! it stores the union of its elements' slope boxes as [x_min, y_min, x_max, y_max] (`f32`, 16 bytes).
+//! Level 0 is not stored: the leaf boxes are recomputed from the elements at query time.
+
+/// Sizes of the levels over an `nx × ny` grid: level l has ⌈nx/2^l⌉ × ⌈ny/2^l⌉ nodes, up to 1 × 1.
+fn level_sizes(nx: usize, ny: usize) -> Vec<[usize; 2]> {
+    let mut sizes = vec![[nx, ny]];
+    let (mut w, mut h) = (nx, ny);
+    while w > 1 || h > 1 {
+        w = w.div_ceil(2);
+        h = h.div_ceil(2);
+        sizes.push([w, h]);
+    }
+    sizes
+}
+
+fn union(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
+    [
+        a[0].min(b[0]),
+        a[1].min(b[1]),
+        a[2].max(b[2]),
+        a[3].max(b[3]),
+    ]
+}
+
+/// Whether a slope lies in a box (NaN slopes never do).
+#[inline]
+pub(super) fn contains(b: &[f32; 4], s: [f32; 2]) -> bool {
+    s[0] >= b[0] && s[1] >= b[1] && s[0] <= b[2] && s[1] <= b[3]
+}
+
+/// The quadtree. `boxes[l - 1]` holds level l ≥ 1, row major.
+#[derive(Clone, Debug)]
+pub(super) struct SlopeTree {
+    pub sizes: Vec<[usize; 2]>,
+    pub boxes: Vec<Vec<[f32; 4]>>,
+}
+
+impl SlopeTree {
+    /// Builds the tree from the leaf boxes (row major over the element grid).
+    pub fn build(nx: usize, ny: usize, leaf: &[[f32; 4]]) -> SlopeTree {
+        let sizes = level_sizes(nx, ny);
+        let mut boxes: Vec<Vec<[f32; 4]>> = Vec::with_capacity(sizes.len().saturating_sub(1));
+        for l in 1..sizes.len() {
+            let [pw, ph] = sizes[l - 1];
+            let [w, h] = sizes[l];
+            let prev: &[[f32; 4]] = if l == 1 { leaf } else { &boxes[l - 2] };
+            let mut level = Vec::with_capacity(w * h);
+            for y in 0..h {
+                for x in 0..w {
+                    let mut b = [
+                        f32::INFINITY,
+                        f32::INFINITY,
+                        f32::NEG_INFINITY,
+                        f32::NEG_INFINITY,
+                    ];
+                    for cy in (2 * y)..(2 * y + 2).min(ph) {
+                        for cx in (2 * x)..(2 * x + 2).min(pw) {
+                            b = union(b, prev[cy * pw + cx]);
+                        }
+                    }
+                    level.push(b);
+                }
+            }
+            boxes.push(level);
+        }
+        SlopeTree { sizes, boxes }
+    }
+
+    /// Index of the top level (its single node is the root); 0 for a 1 × 1 grid.
+    #[inline]
+    pub fn top(&self) -> usize {
+        self.sizes.len() - 1
+    }
+
+    /// The box of node (x, y) of level l ≥ 1.
+    #[inline]
+    pub fn node_box(&self, l: usize, x: usize, y: usize) -> &[f32; 4] {
+        &self.boxes[l - 1][y * self.sizes[l][0] + x]
+    }
+
+    /// Bytes held by the boxes.
+    pub fn bytes(&self) -> usize {
+        self.boxes.iter().map(|b| b.len() * 16).sum()
+    }
+}
