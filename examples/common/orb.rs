@@ -20,9 +20,10 @@ use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf};
 use brdf::frame::Frame;
 use brdf::fresnel::{ConductorFresnel, Fresnel};
 use brdf::glint::{
-    BeckmannMixture, BrushedParams, FlakesParams, Footprint, GlintNdf, MaskingMode, MixtureParams,
-    MixturePatch, NormalMap, NormalRepair, PatchOptions, ScratchedParams, TangentConvention,
-    brushed, bumpy, flakes, naive_brdf, scratched,
+    BeckmannMixture, BinMap, BinMapParams, BrushedParams, FlakesParams, Footprint, GlintNdf,
+    MaskingMode, MixtureParams, MixturePatch, NormalMap, NormalRepair, PatchOptions,
+    PositionNormalMap, PositionNormalParams, ScratchedParams, TangentConvention, brushed, bumpy,
+    flakes, naive_brdf, scratched,
 };
 use brdf::ndf::Ndf;
 use glam::{Vec2, Vec3};
@@ -719,10 +720,16 @@ pub fn render_all(opts: &OrbOptions, map: &NormalMap) -> Res<((Image, Image, f64
             lod_lobes: 0.0,
         },
     };
+    // The two other glint methods at their defaults, through the same `MicrofacetBrdf` (for the
+    // position-normal baseline this is its patch with the moments-lobe masking, not the published
+    // BRDF, so that every column differs only in the P-NDF and its masking).
+    let t = Instant::now();
+    let binmap = BinMap::build(map, BinMapParams::default())?;
+    let binmap_build = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let position_normal = PositionNormalMap::build(map, PositionNormalParams::default())?;
+    let position_normal_build = t.elapsed().as_secs_f64();
     // The glint methods. Each is one line: a label, the build time, and the model (any GlintNdf).
-    // TODO(#8): when they land on main, add (build them above, timed like the mixture):
-    //   ("position-normal (Yan 2016)", yan_build, &PositionNormalMap::build(map, ..)?),
-    //   ("bin map (Atanasov 2020)", binmap_build, &BinMap::build(map, ..)?),
     let mut glint = |label: &str, build_s: f64, render: &dyn Fn(&ProgressBar) -> Image| {
         let bar = progress_bar(opts.progress, rows, label);
         let t = Instant::now();
@@ -743,6 +750,12 @@ pub fn render_all(opts: &OrbOptions, map: &NormalMap) -> Res<((Image, Image, f64
     });
     glint("filtered lobe (LOD 0)", mixture_build, &|b| {
         render_glint(&scene, &filtered, b)
+    });
+    glint("bin map (Atanasov 2020)", binmap_build, &|b| {
+        render_glint(&scene, &binmap, b)
+    });
+    glint("position-normal (Yan 2016)", position_normal_build, &|b| {
+        render_glint(&scene, &position_normal, b)
     });
     if opts.naive_spp > 0 {
         let k = ((opts.naive_spp as f64).sqrt().round() as u32).max(1);
