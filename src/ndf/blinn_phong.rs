@@ -33,8 +33,8 @@ pub const MAX_VISIBLE_TRIES: u32 = 64;
 /// default and how far the approximation is from it).
 ///
 /// # Reference
-/// [Walter2007] §5.2 (normalised D, Beckmann-equivalent exponent, approximate Λ),
-/// [MallettYuksel2020] (the visible area in closed form).
+/// \[Walter2007\] §5.2 (normalised D, Beckmann-equivalent exponent, approximate Λ),
+/// \[MallettYuksel2020\] (the visible area in closed form).
 ///
 /// [`beckmann_alpha_from_shininess`]: super::beckmann_alpha_from_shininess
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -81,7 +81,7 @@ impl BlinnPhong {
     /// docs/ndf.md for the measured difference). 0 below the horizon, finite at grazing.
     ///
     /// # Reference
-    /// [Walter2007] §5.1–5.2 (the rational G1 and the Phong–Beckmann exponent mapping).
+    /// \[Walter2007\] §5.1–5.2 (the rational G1 and the Phong–Beckmann exponent mapping).
     pub fn lambda_walter(&self, w: Vec3) -> f32 {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
@@ -186,7 +186,7 @@ impl Ndf for BlinnPhong {
     /// swapped). 0 below the horizon.
     ///
     /// # Reference
-    /// [MallettYuksel2020].
+    /// \[MallettYuksel2020\].
     fn visible_area(&self, w: Vec3) -> f32 {
         match Self::cos_theta(w) {
             Some(c) => (self.gamma + 2.0) * (0.5 / PI) * phong_lobe_integral(self.gamma, c),

@@ -13,8 +13,8 @@ use glam::Vec3;
 /// or when an input is not finite. The result is in [0, 1].
 ///
 /// # Reference
-/// [Heitz2014] (the V-cavity model) and the VSB 2024 BRDF lecture ("Microsurface models"
-/// slide, G1 of the V-cavity model); [CookTorrance1982] (the geometric attenuation term).
+/// \[Heitz2014\] (the V-cavity model) and the VSB 2024 BRDF lecture ("Microsurface models"
+/// slide, G1 of the V-cavity model); \[CookTorrance1982\] (the geometric attenuation term).
 #[inline]
 pub fn g1_vcavity(w: Vec3, m: Vec3) -> f32 {
     let wm = w.dot(m);
@@ -34,7 +34,7 @@ pub fn g1_vcavity(w: Vec3, m: Vec3) -> f32 {
 /// the lecture is not needed: the crate models reflection only.)
 ///
 /// # Reference
-/// [Heitz2014] (V-cavity G2 for reflection); [CookTorrance1982]; the DTU 2021 microfacet lecture ("The
+/// \[Heitz2014\] (V-cavity G2 for reflection); \[CookTorrance1982\]; the DTU 2021 microfacet lecture ("The
 /// Torrance-Sparrow BRDF", geometry term G).
 #[inline]
 pub fn g2_vcavity(wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
@@ -48,7 +48,7 @@ pub fn g2_vcavity(wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
 /// for the NDFs of this crate); an infinite Λ gives 0.
 ///
 /// # Reference
-/// [Heitz2014] eq. 99.
+/// \[Heitz2014\] eq. 99.
 #[inline]
 pub fn g2_height_correlated_from_lambda(lambda_o: f32, lambda_i: f32) -> f32 {
     let lo = if lambda_o > 0.0 { lambda_o } else { 0.0 };
@@ -76,7 +76,7 @@ pub(super) fn g2_height_correlated_checked<N: super::Ndf + ?Sized>(
 /// 1 / ((1 + Λ(wo)) (1 + Λ(wi))). Same conventions as [`g2_height_correlated_from_lambda`].
 ///
 /// # Reference
-/// [Heitz2014] eq. 98.
+/// \[Heitz2014\] eq. 98.
 #[inline]
 pub fn g2_separable_from_lambda(lambda_o: f32, lambda_i: f32) -> f32 {
     let lo = if lambda_o > 0.0 { lambda_o } else { 0.0 };

@@ -29,7 +29,7 @@ use std::f64::consts::PI;
 /// give 0; `gamma = +∞` gives 0 (the limit).
 ///
 /// # Reference
-/// [MallettYuksel2020] (the closed form, as listed in the VSB 2024 BRDF lecture, `calc_I_M`).
+/// \[MallettYuksel2020\] (the closed form, as listed in the VSB 2024 BRDF lecture, `calc_I_M`).
 pub fn phong_lobe_integral(gamma: f32, cos_theta: f32) -> f32 {
     if !(gamma >= 0.0 && gamma.is_finite()) || cos_theta.is_nan() {
         return 0.0;
@@ -88,7 +88,7 @@ fn gamma_ratio(h: f64) -> f64 {
 /// [`phong_lobe_integral`] for large n. `cos_theta` is clamped to [−1, 1]; NaN gives 0.
 ///
 /// # Reference
-/// [Arvo1995] (irradiance tensors; the algorithm as listed in the VSB 2024 BRDF lecture,
+/// \[Arvo1995\] (irradiance tensors; the algorithm as listed in the VSB 2024 BRDF lecture,
 /// `ArvoIntegrateModifiedPhong`).
 pub fn phong_lobe_integral_arvo(n: u32, cos_theta: f32) -> f32 {
     if cos_theta.is_nan() {

@@ -132,7 +132,7 @@ impl<'a> BinMapPatch<'a> {
     ///
     /// # Reference
     /// \[Scarf1958\], the bound
-    /// E[X⁺] ≤ ½(E[X] + √(E[X]² + Var X)).
+    /// E\[X⁺\] ≤ ½(E\[X\] + √(E\[X\]² + Var X)).
     pub fn moment_bound_visible_area(&self, w: Vec3) -> f32 {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
