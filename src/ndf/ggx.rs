@@ -5,9 +5,8 @@
 //! form); visible normals are sampled with Heitz 2018's hemisphere-projection routine.
 
 use super::Ndf;
-use super::beckmann::MIN_ALPHA;
+use super::beckmann::{keep_visible, unit_square, validated_alpha, validated_alphas};
 use crate::Result;
-use crate::error::positive;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -16,36 +15,47 @@ use std::f32::consts::PI;
 /// D(m) = 1 / (π α_x α_y cos⁴θ_m (1 + tan²θ_m (cos²φ_m/α_x² + sin²φ_m/α_y²))²)
 ///      = 1 / (π α_x α_y ((x/α_x)² + (y/α_y)² + z²)²) for m = (x, y, z), z > 0.
 ///
-/// α is clamped to ≥ [`MIN_ALPHA`] = 10⁻⁴ like [`Beckmann`](super::Beckmann) (D(ω_g) = 1/(π α_x α_y)
+/// α is clamped to ≥ [`MIN_ALPHA`](super::MIN_ALPHA) = 10⁻⁴ like [`Beckmann`](super::Beckmann) (D(ω_g) = 1/(π α_x α_y)
 /// stays ≤ 3.2·10⁷).
 ///
 /// # Reference
-/// [Walter2007] §5.2 (isotropic D, Λ), [Heitz2014] (anisotropic D and Λ), [Heitz2018] (visible
-/// normals).
+/// [Walter2007] §5.2 (isotropic D, Λ), [Heitz2014] (anisotropic D and Λ), [Heitz2018] and
+/// [DupuyBenyoub2023] (visible normals).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ggx {
     alpha_x: f32,
     alpha_y: f32,
+    /// 1/α_x, 1/α_y and 1/(π α_x α_y), precomputed so that `d` has one division.
+    inv_alpha_x: f32,
+    inv_alpha_y: f32,
+    norm: f32,
 }
 
 impl Ggx {
     /// An anisotropic GGX NDF with roughness `alpha_x` along x and `alpha_y` along y.
     ///
     /// Errors if either is non-finite or ≤ 0 (naming `alpha_x` or `alpha_y`); values below
-    /// [`MIN_ALPHA`] are clamped to it.
+    /// [`MIN_ALPHA`](super::MIN_ALPHA) are clamped to it.
     pub fn new(alpha_x: f32, alpha_y: f32) -> Result<Self> {
-        let alpha_x = positive("alpha_x", alpha_x)?.max(MIN_ALPHA);
-        let alpha_y = positive("alpha_y", alpha_y)?.max(MIN_ALPHA);
-        Ok(Ggx { alpha_x, alpha_y })
+        let (alpha_x, alpha_y) = validated_alphas(alpha_x, alpha_y)?;
+        Ok(Self::from_valid(alpha_x, alpha_y))
     }
 
     /// An isotropic GGX NDF; errors (naming `alpha`) if `alpha` is non-finite or ≤ 0.
     pub fn isotropic(alpha: f32) -> Result<Self> {
-        let alpha = positive("alpha", alpha)?.max(MIN_ALPHA);
-        Ok(Ggx {
-            alpha_x: alpha,
-            alpha_y: alpha,
-        })
+        let alpha = validated_alpha(alpha)?;
+        Ok(Self::from_valid(alpha, alpha))
+    }
+
+    /// The NDF from validated, clamped α.
+    fn from_valid(alpha_x: f32, alpha_y: f32) -> Self {
+        Ggx {
+            alpha_x,
+            alpha_y,
+            inv_alpha_x: 1.0 / alpha_x,
+            inv_alpha_y: 1.0 / alpha_y,
+            norm: 1.0 / (PI * alpha_x * alpha_y),
+        }
     }
 
     /// α along x (after the clamp).
@@ -68,15 +78,15 @@ impl Ggx {
 
 impl Ndf for Ggx {
     /// D(m) = 1 / (π α_x α_y ((x/α_x)² + (y/α_y)² + z²)²); 0 for z ≤ 0 or non-finite m.
+    ///
+    /// Checked last: the plain arithmetic runs first and one comparison rejects z ≤ 0 and a
+    /// non-finite result (NaN input, or a squared sum that under- or overflows).
     #[inline]
     fn d(&self, m: Vec3) -> f32 {
-        if !(m.z > 0.0 && m.is_finite()) {
-            return 0.0;
-        }
-        let (sx, sy) = (m.x / self.alpha_x, m.y / self.alpha_y);
+        let (sx, sy) = (m.x * self.inv_alpha_x, m.y * self.inv_alpha_y);
         let t = sx * sx + sy * sy + m.z * m.z;
-        let d = 1.0 / (PI * self.alpha_x * self.alpha_y * t * t);
-        if d.is_finite() { d } else { 0.0 }
+        let d = self.norm / (t * t);
+        if m.z > 0.0 && d <= f32::MAX { d } else { 0.0 }
     }
 
     /// Λ(w) = (√(1 + α(φ)² tan²θ) − 1)/2, written as n²/(2z(√(z² + n²) + z)) with
@@ -138,44 +148,41 @@ impl Ndf for Ggx {
         .unwrap_or(Vec3::Z)
     }
 
-    /// m ~ D_wo(m) exactly, by Heitz 2018: stretch wo to the hemisphere configuration, sample the
-    /// projected area of the hemisphere seen from it (a disk whose lower half is squashed by
-    /// s = (1 + cos θ_h)/2), lift onto the hemisphere, unstretch. Below-horizon or non-finite `wo`
-    /// falls back to [`Ndf::sample_normal`].
+    /// m ~ D_wo(m) exactly, by Dupuy & Benyoub 2023: stretch wo to the hemisphere configuration
+    /// (wₕ = normalize(α_x x, α_y y, z)); the visible normals of the unit hemisphere seen from wₕ
+    /// are the half vectors c + wₕ of a point c drawn uniformly on the spherical cap
+    /// z_c ∈ (−z_h, 1] (z_c = (1 − u₂)(1 + z_h) − z_h, azimuth 2πu₁); unstretch and normalise.
+    /// The same distribution as Heitz 2018's disk-projection routine with two square roots fewer.
+    /// Below-horizon `wo` falls back to [`Ndf::sample_normal`], as does any non-finite
+    /// intermediate (non-finite or zero-length `wo`; checked once, on the result).
     ///
-    /// Two deviations, both on a set of directions of measure ~10⁻⁷: the lift keeps
-    /// 1 − t₁² − t₂² ≥ 10⁻¹⁴ and the result keeps z ≥ 10⁻³⁰, so that a sample is never exactly on the
-    /// horizon or exactly orthogonal to wo (where its pdf would be 0).
+    /// Two deviations, on sets of measure ~10⁻⁷: the half vector keeps z ≥ 10⁻³⁰ (u₂ = 1 would put
+    /// it on the horizon) and [`keep_visible`] nudges a result that rounding left orthogonal to wo.
     ///
     /// # Reference
-    /// [Heitz2018] listing 1.
+    /// [DupuyBenyoub2023] listing 3 (spherical caps), [Heitz2018] (stretch / unstretch).
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
-        if !(wo.z > 0.0 && wo.is_finite()) {
+        if !(wo.z > 0.0) {
             return self.sample_normal(u);
         }
-        let Some(vh) = Vec3::new(self.alpha_x * wo.x, self.alpha_y * wo.y, wo.z).try_normalize()
-        else {
-            return self.sample_normal(u);
-        };
-        // Orthonormal basis (t1, t2, vh); t1 horizontal.
-        let len2 = vh.x * vh.x + vh.y * vh.y;
-        let t1 = if len2 > 0.0 {
-            Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt()
+        let u = unit_square(u);
+        let v = Vec3::new(self.alpha_x * wo.x, self.alpha_y * wo.y, wo.z);
+        let wh = v * (1.0 / v.length());
+        let (sp, cp) = (2.0 * PI * u.x).sin_cos();
+        // z_c + z_h = (1 − u₂)(1 + z_h) ≥ 0, formed without the cancellation of z_c + z_h.
+        let hz = (1.0 - u.y) * (1.0 + wh.z);
+        let zc = hz - wh.z;
+        let sin_c = (1.0 - zc * zc).max(0.0).sqrt();
+        let m = Vec3::new(
+            self.alpha_x * (sin_c * cp + wh.x),
+            self.alpha_y * (sin_c * sp + wh.y),
+            hz.max(1e-30),
+        );
+        let m = m * (1.0 / m.length());
+        if m.is_finite() && m.z > 0.0 {
+            keep_visible(m, wo)
         } else {
-            Vec3::X
-        };
-        let t2 = vh.cross(t1);
-        // Uniform point on the unit disk, lower half squashed toward the horizon's projection.
-        let r = u.x.clamp(0.0, 1.0).sqrt();
-        let (sp, cp) = (2.0 * PI * u.y).sin_cos();
-        let p1 = r * cp;
-        let s = 0.5 * (1.0 + vh.z);
-        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * (r * sp);
-        let lift = (1.0 - p1 * p1 - p2 * p2).max(1e-14).sqrt();
-        let nh = p1 * t1 + p2 * t2 + lift * vh;
-        let m = Vec3::new(self.alpha_x * nh.x, self.alpha_y * nh.y, nh.z.max(1e-30))
-            .try_normalize()
-            .unwrap_or(Vec3::Z);
-        super::beckmann::keep_visible(m, wo)
+            self.sample_normal(u)
+        }
     }
 }
