@@ -9,7 +9,7 @@ use super::Ndf;
 use crate::Result;
 use crate::error::positive;
 use crate::frame::slope_to_normal;
-use crate::math::{INV_SQRT_PI, atan2_pos, erf, erfcx_pos, erfinv, exp_neg_sq};
+use crate::math::{INV_SQRT_PI, atan2_pos, erf, erfcx_small, erfinv, exp_neg_sq};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -156,14 +156,14 @@ fn lambda_of_a(a: f32) -> f32 {
     if l.is_finite() { l.max(0.0) } else { f32::MAX }
 }
 
-/// 2 e^(a²) Λ(a) for 0 < a < 10: 1/(a√π) − erfcx(a) for a < 2 (erfcx = e^(a²) erfc, relative
-/// accurate; the difference loses ≤ 10 bits at a = 2), (1/(a√π)) P/(P + Q) for 2 ≤ a < 10 (see
+/// 2 e^(a²) Λ(a) for 0 < a < 10: 1/(a√π) − erfcx(a) for a < 2 (erfcx = e^(a²) erfc by the
+/// polynomial [`erfcx_small`], relative accurate, no exponential; the difference loses ≤ 10 bits at a = 2), (1/(a√π)) P/(P + Q) for 2 ≤ a < 10 (see
 /// [`lambda_of_a`]). Factoring e^(−a²) out of both branches leaves one exponential per Λ.
 #[inline(always)]
 fn lambda_scaled(a: f32) -> f32 {
     let inv = INV_SQRT_PI / a;
     if a < 2.0 {
-        inv - erfcx_pos(a)
+        inv - erfcx_small(a)
     } else {
         // 16th convergent K = A₁₆/B₁₆ of K = ½/(a + 1/(a + (3/2)/(a + …))): A₁₆ = a·P(a²),
         // B₁₆ = Q(a²), so g = K/(a + K) = P/(P + Q).
