@@ -156,8 +156,10 @@ impl Ndf for Ggx {
     /// Below-horizon `wo` falls back to [`Ndf::sample_normal`], as does any non-finite
     /// intermediate (non-finite or zero-length `wo`; checked once, on the result).
     ///
-    /// Two deviations, on sets of measure ~10⁻⁷: the half vector keeps z ≥ 10⁻³⁰ (u₂ = 1 would put
-    /// it on the horizon) and [`keep_visible`] nudges a result that rounding left orthogonal to wo.
+    /// The half vector keeps z ≥ 10⁻³⁰ (u₂ = 1 would put it on the horizon). Where rounding leaves
+    /// the result not strictly visible from wo (u₂ within ~10⁻⁶ of 1 with wₕ near the pole or the
+    /// horizon, where c + wₕ cancels), the sample is redrawn at the same u by Heitz 2018's routine,
+    /// which has no such cancellation and the same distribution.
     ///
     /// # Reference
     /// [DupuyBenyoub2023] listing 3 (spherical caps), [Heitz2018] (stretch / unstretch).
@@ -165,24 +167,121 @@ impl Ndf for Ggx {
         if !(wo.z > 0.0) {
             return self.sample_normal(u);
         }
+        // NaN → 0, clamp to [0, 1]: also what the fallbacks below receive.
         let u = unit_square(u);
         let v = Vec3::new(self.alpha_x * wo.x, self.alpha_y * wo.y, wo.z);
         let wh = v * (1.0 / v.length());
         let (sp, cp) = (2.0 * PI * u.x).sin_cos();
         // z_c + z_h = (1 − u₂)(1 + z_h) ≥ 0, formed without the cancellation of z_c + z_h.
         let hz = (1.0 - u.y) * (1.0 + wh.z);
-        let zc = hz - wh.z;
-        let sin_c = (1.0 - zc * zc).max(0.0).sqrt();
+        // sin θ_c = √((1 + z_c)(1 − z_c)) with 1 + z_c = h_z + (1 − z_h) and
+        // 1 − z_h = (x_h² + y_h²)/(1 + z_h): no cancellation where c is nearly −wₕ (u₂ → 1 with
+        // wₕ near the pole), where 1 − z_c² in f32 had no correct digit and c + wₕ then pointed
+        // anywhere (found by the 200 000-case totality property test).
+        let one_minus_zh = (wh.x * wh.x + wh.y * wh.y) / (1.0 + wh.z);
+        let one_plus_zc = hz + one_minus_zh;
+        let sin_c = (one_plus_zc * (2.0 - one_plus_zc)).max(0.0).sqrt();
         let m = Vec3::new(
             self.alpha_x * (sin_c * cp + wh.x),
             self.alpha_y * (sin_c * sp + wh.y),
             hz.max(1e-30),
         );
         let m = m * (1.0 / m.length());
-        if m.is_finite() && m.z > 0.0 {
-            keep_visible(m, wo)
+        if m.is_finite() && m.z > 0.0 && m.dot(wo) > 0.0 {
+            m
         } else {
-            self.sample_normal(u)
+            self.sample_visible_disk(wo, u)
+        }
+    }
+}
+
+impl Ggx {
+    /// Heitz 2018's disk-projection sampler of D_wo: the fallback of [`Ndf::sample_visible`] where
+    /// the spherical cap loses every digit.
+    ///
+    /// Near the end of the cap (u₂ → 1) the cap point c is nearly −wₕ and the half vector c + wₕ is
+    /// a difference of nearly equal `f32` numbers; when wₕ is also near the horizon (grazing wo,
+    /// small α) its direction is then rounding noise and may face away from wo. This routine works
+    /// in a frame built on wₕ and has no such cancellation. It draws from the same distribution, so
+    /// using it on that set (of measure ~10⁻⁶ in u) changes nothing but the u → m mapping there.
+    /// Non-finite or below-horizon `wo` falls back to [`Ndf::sample_normal`]; the result keeps
+    /// z ≥ 10⁻³⁰ and is nudged toward wo if rounding leaves it orthogonal to wo.
+    ///
+    /// # Reference
+    /// [Heitz2018] listing 1.
+    fn sample_visible_disk(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        if !(wo.z > 0.0 && wo.is_finite()) {
+            return self.sample_normal(u);
+        }
+        let Some(vh) = Vec3::new(self.alpha_x * wo.x, self.alpha_y * wo.y, wo.z).try_normalize()
+        else {
+            return self.sample_normal(u);
+        };
+        // Orthonormal basis (t1, t2, vh); t1 horizontal.
+        let len2 = vh.x * vh.x + vh.y * vh.y;
+        let t1 = if len2 > 0.0 {
+            Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt()
+        } else {
+            Vec3::X
+        };
+        let t2 = vh.cross(t1);
+        // Uniform point on the unit disk, lower half squashed toward the horizon's projection.
+        let r = u.x.sqrt();
+        let (sp, cp) = (2.0 * PI * u.y).sin_cos();
+        let p1 = r * cp;
+        let s = 0.5 * (1.0 + vh.z);
+        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * (r * sp);
+        let lift = (1.0 - p1 * p1 - p2 * p2).max(1e-14).sqrt();
+        let nh = p1 * t1 + p2 * t2 + lift * vh;
+        let m = Vec3::new(self.alpha_x * nh.x, self.alpha_y * nh.y, nh.z.max(1e-30))
+            .try_normalize()
+            .unwrap_or(Vec3::Z);
+        keep_visible(m, wo)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Regression (200 000-case property test, seed 1): for a tiny α, wo away from the pole
+    /// (so wₕ is within 10⁻³ of it) and u₂ at the top of [0, 1), the cap point c is nearly −wₕ;
+    /// the half vector c + wₕ must still be visible from wo, with a positive pdf.
+    #[test]
+    fn sample_visible_near_the_cap_end() {
+        let n = Ggx::isotropic(10f32.powf(-3.253_356_2)).unwrap();
+        let wo = Vec3::new(-0.860_859_5, -0.116_034_34, 0.495_436_07);
+        let mut worst = f32::MAX;
+        for k in 0..=64 {
+            for uy in [0.999_999_94f32, 0.999_999_9, 0.999_999] {
+                let u = Vec2::new(k as f32 / 64.0, uy);
+                let m = n.sample_visible(wo, u);
+                assert!(m.is_finite() && m.z > 0.0, "{u:?}: {m:?}");
+                assert!(n.pdf_visible(wo, m) > 0.0, "{u:?}: {m:?}");
+                worst = worst.min(m.dot(wo));
+            }
+        }
+        assert!(worst > 0.0, "{worst}");
+    }
+
+    /// Regression (same property test): grazing wo along −x with α = 3.2·10⁻³ puts wₕ near the
+    /// horizon; at u = (0, 1 − 2⁻²⁴) the cap's half vector was rounding noise facing away from wo.
+    #[test]
+    fn sample_visible_grazing_cap_end() {
+        let n = Ggx::isotropic(10f32.powf(-2.488_697)).unwrap();
+        for wo in [
+            Vec3::new(-1.0, -6.036_363_5e-7, 3.114_992_6e-7),
+            Vec3::new(0.6, -0.8, 1e-6).normalize(),
+        ] {
+            for k in 0..=64 {
+                for uy in [0.999_999_94f32, 0.999_999_9, 0.999_999] {
+                    let u = Vec2::new(k as f32 / 64.0, uy);
+                    let m = n.sample_visible(wo, u);
+                    assert!(m.is_finite() && m.z > 0.0, "{u:?}: {m:?}");
+                    assert!(m.dot(wo) > 0.0, "{wo:?} {u:?}: {m:?}");
+                    assert!(n.pdf_visible(wo, m) > 0.0, "{wo:?} {u:?}: {m:?}");
+                }
+            }
         }
     }
 }
