@@ -42,60 +42,22 @@ pub(crate) fn atan2_pos(y: f32, x: f32) -> f32 {
     }
 }
 
-/// Bits of 2^(i/32) (correctly rounded `f64`, computed with 40-digit arithmetic) minus i·2⁴⁷, so
-/// that adding k·2⁴⁷ (k ≡ i mod 32) puts ⌊k/32⌋ into the exponent field (the layout of glibc's
-/// `expf` table).
-const EXP2_32: [u64; 32] = [
-    0x3ff0000000000000, 0x3fefd9b0d3158574, 0x3fefb5586cf9890f, 0x3fef9301d0125b51,
-    0x3fef72b83c7d517b, 0x3fef54873168b9aa, 0x3fef387a6e756238, 0x3fef1e9df51fdee1,
-    0x3fef06fe0a31b715, 0x3feef1a7373aa9cb, 0x3feedea64c123422, 0x3feece086061892d,
-    0x3feebfdad5362a27, 0x3feeb42b569d4f82, 0x3feeab07dd485429, 0x3feea47eb03a5585,
-    0x3feea09e667f3bcd, 0x3fee9f75e8ec5f74, 0x3feea11473eb0187, 0x3feea589994cce13,
-    0x3feeace5422aa0db, 0x3feeb737b0cdc5e5, 0x3feec49182a3f090, 0x3feed503b23e255d,
-    0x3feee89f995ad3ad, 0x3feeff76f2fb5e47, 0x3fef199bdd85529c, 0x3fef3720dcef9069,
-    0x3fef5818dcfba487, 0x3fef7c97337b9b5f, 0x3fefa4afa2a490da, 0x3fefd0765b6e4540,
-];
-
-/// e^x for x ≤ 0 in `f64` arithmetic, rounded once to `f32`; inlined, no branch.
-///
-/// e^x = 2^(k/32) · e^(r ln2/32) with k = round(32x/ln 2), |r| ≤ ½, the 32 values of 2^(i/32) from a
-/// table and a degree-3 Taylor polynomial for the rest (truncation (ln2/64)⁴/24 = 5.7·10⁻¹⁰
-/// relative). All in `f64`, so the `f32` result is within 0.5 ulp + 10⁻⁹ relative of e^x
-/// (measured: `tests::exp_neg_error`), subnormal results included. x is clamped to [−110, 0]:
-/// e^(−110) rounds to 0 in `f32`, positive x gives 1, NaN gives 0.
-///
-/// Why: `f32::exp` is a call (to glibc's FMA variant on x86-64 Linux, fast in itself), and a call
-/// makes the compiler spill every live `xmm` register around it; this version is a dozen
-/// instructions inlined into D and Λ. It is the table method of glibc's `expf` (and of ARM's
-/// optimized-routines), written for SSE2 without FMA: the `f64` arithmetic makes FMA unnecessary.
-#[inline(always)]
-pub(crate) fn exp_neg(x: f64) -> f32 {
-    // 1.5·2⁵²: adding it rounds |z| < 2⁵¹ to an integer held in the low mantissa bits.
-    const SHIFT: f64 = 6_755_399_441_055_744.0;
-    const INV_LN2_32: f64 = 46.166_241_308_446_83;
-    const C1: f64 = 0.021_660_849_392_498_29;
-    const C2: f64 = 2.345_961_982_022_467_9e-4;
-    const C3: f64 = 1.693_850_972_437_182e-6;
-    let x = x.max(-110.0).min(0.0);
-    let z = x * INV_LN2_32;
-    let kd = z + SHIFT;
-    let ki = kd.to_bits();
-    let r = z - (kd - SHIFT);
-    let scale = f64::from_bits(EXP2_32[(ki % 32) as usize].wrapping_add(ki << 47));
-    let p = 1.0 + r * (C1 + r * (C2 + r * C3));
-    (scale * p) as f32
-}
-
 /// e^(−x²) with the square formed exactly.
 ///
-/// The product of two `f32` is exact in `f64`, and [`exp_neg`] works in `f64`, so the only
-/// rounding is the final one to `f32` (plus 10⁻⁹ relative): ≤ 1 ulp (measured in the tests; an
-/// `f32` square would instead cost up to x²·2⁻²⁴ relative, 5·10⁻⁶ at x = 9). Returns 0 for
-/// |x| ≥ 10.2 (below the smallest `f32` subnormal), ±∞ and NaN.
+/// `x*x` in `f32` rounds the exponent by up to ½ ulp(x²), a relative error of up to x²·2⁻²⁴ in the
+/// result (5·10⁻⁶ at x = 9). The product of two `f32` is exact in `f64`, so the square is split into
+/// hi + lo and the result is e^(−hi)·(1 − lo). Maximum relative error: ~2 ulp (measured in the tests).
+/// Returns 0 for |x| > 10 (the result is below the smallest `f32` subnormal) and for NaN.
 #[inline]
 pub(crate) fn exp_neg_sq(x: f32) -> f32 {
-    let ax = x as f64;
-    exp_neg(-(ax * ax))
+    let ax = x.abs();
+    if !(ax <= 10.0) {
+        return 0.0;
+    }
+    let sq = ax as f64 * ax as f64;
+    let hi = sq as f32;
+    let lo = (sq - hi as f64) as f32;
+    (-hi).exp() * (1.0 - lo)
 }
 
 /// The scaled complementary error function erfcx(x) = e^(x²) erfc(x) for x ≥ 0: t·e^(P(t)),
@@ -263,35 +225,6 @@ mod tests {
         // reference loses ~x²·2⁻⁵³ ≤ 8·10⁻¹⁴ relative to the rounding of x² inside exp.
         assert!(worst < 5e-7, "{worst:e}");
         assert_eq!(erfcx_pos(f32::INFINITY), 0.0);
-    }
-
-    #[test]
-    fn exp_neg_error() {
-        let (mut worst_ulp, mut at) = (0.0f64, 0.0);
-        // Dense over [−104, 0] (below −103.3 the result is subnormal, then 0).
-        for i in 0..=2_000_000 {
-            let x = -104.0 * i as f64 / 2e6;
-            let truth = x.exp();
-            let got = exp_neg(x) as f64;
-            // Error in units of the f32 spacing at the true value (subnormal spacing 2⁻¹⁴⁹).
-            let ulp = ((truth as f32).abs().max(f32::MIN_POSITIVE) as f64) * f32::EPSILON as f64;
-            let ulp = if truth < f32::MIN_POSITIVE as f64 { 2f64.powi(-149) } else { ulp };
-            let e = (got - truth).abs() / ulp;
-            if e > worst_ulp {
-                worst_ulp = e;
-                at = x;
-            }
-        }
-        println!("exp_neg: max error {worst_ulp} ulp at {at}");
-        // Stated bound: one rounding to f32 (0.5 ulp) plus the f64 error (≤ 10⁻⁹ relative ≈ 0.02
-        // ulp); 0.51 ulp. The ulp here is the spacing below the value, up to 2× finer than the one
-        // above, hence a bound of 1.02 for a result at a power of two.
-        assert!(worst_ulp <= 1.02, "{worst_ulp} ulp at {at}");
-        assert_eq!(exp_neg(0.0), 1.0);
-        assert_eq!(exp_neg(-120.0), 0.0);
-        assert_eq!(exp_neg(f64::NEG_INFINITY), 0.0);
-        assert_eq!(exp_neg(f64::NAN), 0.0);
-        assert_eq!(exp_neg(5.0), 1.0);
     }
 
     #[test]

@@ -9,7 +9,7 @@ use super::Ndf;
 use crate::Result;
 use crate::error::positive;
 use crate::frame::slope_to_normal;
-use crate::math::{INV_SQRT_PI, atan2_pos, erf, erfcx_small, erfinv, exp_neg, exp_neg_sq};
+use crate::math::{INV_SQRT_PI, atan2_pos, erf, erfcx_small, erfinv, exp_neg_sq};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -304,13 +304,13 @@ impl Ndf for Beckmann {
     /// D(m) = exp(−((x/α_x)² + (y/α_y)²)/z²) / (π α_x α_y z⁴); 0 for z ≤ 0 or non-finite m
     /// (and where the numerator underflows, within ~10⁻¹¹ of the horizon).
     ///
-    /// Checked last: one division (1/z²), the inlined [`exp_neg`](crate::math) (NaN → 0), and one
-    /// comparison that rejects z ≤ 0 and any non-finite result.
+    /// Checked last: one division (1/z²), one `exp`, and one comparison that rejects z ≤ 0 and any
+    /// non-finite result.
     #[inline]
     fn d(&self, m: Vec3) -> f32 {
         let (sx, sy) = (m.x * self.inv_alpha_x, m.y * self.inv_alpha_y);
         let q = 1.0 / (m.z * m.z);
-        let d = exp_neg(-((sx * sx + sy * sy) * q) as f64) * (self.norm * q * q);
+        let d = (-(sx * sx + sy * sy) * q).exp() * (self.norm * q * q);
         if m.z > 0.0 && d <= f32::MAX { d } else { 0.0 }
     }
 
