@@ -284,6 +284,7 @@ pub(super) fn validated_alpha(alpha: f32) -> Result<f32> {
 
 /// u clamped to [0, 1]², NaN components to 0 (`f32::max` returns the non-NaN operand).
 #[inline(always)]
+#[allow(clippy::manual_clamp)] // `clamp` would keep NaN; `max` maps it to 0
 pub(super) fn unit_square(u: Vec2) -> Vec2 {
     Vec2::new(u.x.max(0.0).min(1.0), u.y.max(0.0).min(1.0))
 }

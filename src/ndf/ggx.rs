@@ -163,6 +163,7 @@ impl Ndf for Ggx {
     ///
     /// # Reference
     /// [DupuyBenyoub2023] listing 3 (spherical caps), [Heitz2018] (stretch / unstretch).
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(z > 0)` also rejects NaN
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
         if !(wo.z > 0.0) {
             return self.sample_normal(u);
