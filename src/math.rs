@@ -65,7 +65,7 @@ pub(crate) fn exp_neg_sq(x: f32) -> f32 {
 /// factor is simply left out). Finite for every x ≥ 0 (erfcx(+∞) = 0); NaN gives NaN.
 ///
 /// # Reference
-/// [Press1992] §6.2, `erfcc`.
+/// \[Press1992\] §6.2, `erfcc`.
 #[inline]
 pub(crate) fn erfcx_pos(x: f32) -> f32 {
     let t = 1.0 / (1.0 + 0.5 * x);
@@ -115,7 +115,7 @@ fn erfc_exponent(t: f32) -> f32 {
 /// `tests::erfc_error` (< 5·10⁻⁷). erfc(+∞) = 0, erfc(−∞) = 2, erfc(NaN) = 1 (treated as 0).
 ///
 /// # Reference
-/// [Press1992] §6.2, `erfcc`.
+/// \[Press1992\] §6.2, `erfcc`.
 #[inline]
 pub(crate) fn erfc(x: f32) -> f32 {
     if x.is_nan() {
@@ -164,7 +164,7 @@ pub(crate) fn erf(x: f32) -> f32 {
 /// ±erf⁻¹(1 − 2⁻²⁴) ≈ ±3.9 (the largest magnitude `f32` can resolve); NaN gives 0.
 ///
 /// # Reference
-/// [Giles2010], single-precision listing.
+/// \[Giles2010\], single-precision listing.
 #[inline]
 pub(crate) fn erfinv(y: f32) -> f32 {
     const Y_MAX: f32 = 1.0 - f32::EPSILON / 2.0;

@@ -27,7 +27,7 @@ pub const MIN_ALPHA: f32 = 1e-4;
 /// NDF constructors then reject, naming `alpha`).
 ///
 /// # Reference
-/// [Burley2012] §5.4 (α = roughness²).
+/// \[Burley2012\] §5.4 (α = roughness²).
 pub fn alpha_from_roughness(r: f32) -> f32 {
     if r.is_finite() { r * r } else { 0.0 }
 }
@@ -38,7 +38,7 @@ pub fn alpha_from_roughness(r: f32) -> f32 {
 /// γ = 2/α² − 2, inverted). γ = 0 gives α = 1. Negative or NaN γ is treated as 0; γ = +∞ gives 0.
 ///
 /// # Reference
-/// [Walter2007] §5.2.
+/// \[Walter2007\] §5.2.
 pub fn beckmann_alpha_from_shininess(gamma: f32) -> f32 {
     let g = if gamma > 0.0 { gamma } else { 0.0 };
     (2.0 / (g + 2.0)).sqrt()
@@ -51,7 +51,7 @@ pub fn beckmann_alpha_from_shininess(gamma: f32) -> f32 {
 /// α = 0 gives `f32::MAX`, NaN gives 0.
 ///
 /// # Reference
-/// [Walter2007] §5.2.
+/// \[Walter2007\] §5.2.
 pub fn shininess_from_beckmann_alpha(alpha: f32) -> f32 {
     if alpha.is_nan() {
         return 0.0;
@@ -66,8 +66,8 @@ pub fn shininess_from_beckmann_alpha(alpha: f32) -> f32 {
 /// α_x acts along the tangent x; α = √2 σ with σ the RMS slope per axis.
 ///
 /// # Reference
-/// [Walter2007] §5.1 (isotropic D and Λ), [Heitz2014] (anisotropic form through α(φ)),
-/// [Heitz2014b] and [Jakob2014] (visible-normal sampling).
+/// \[Walter2007\] §5.1 (isotropic D and Λ), \[Heitz2014\] (anisotropic form through α(φ)),
+/// \[Heitz2014b\] and \[Jakob2014\] (visible-normal sampling).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Beckmann {
     alpha_x: f32,
@@ -142,7 +142,7 @@ impl Beckmann {
 /// Returns a finite value for every a > 0 (Λ ≈ 1/(2a√π) → capped at `f32::MAX` as a → 0).
 ///
 /// # Reference
-/// [Walter2007] §5.1 (Beckmann G1), [Heitz2014] (Λ of the Beckmann distribution); the continued fraction is [AbramowitzStegun1964] 7.1.14.
+/// \[Walter2007\] §5.1 (Beckmann G1), \[Heitz2014\] (Λ of the Beckmann distribution); the continued fraction is \[AbramowitzStegun1964\] 7.1.14.
 #[inline]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > 0)` also rejects NaN
 fn lambda_of_a(a: f32) -> f32 {
@@ -233,7 +233,7 @@ fn visible_area_of(a: f32, z: f32, n: f32) -> f32 {
 /// chi-square test resolves. The y slope is Gaussian and independent: erf⁻¹(2u₂ − 1).
 ///
 /// # Reference
-/// [Jakob2014] (inversion and initial guess), [Heitz2014b] §4 (the visible slope distribution).
+/// \[Jakob2014\] (inversion and initial guess), \[Heitz2014b\] §4 (the visible slope distribution).
 fn sample_visible_slope_std(cot_theta: f32, tan_theta: f32, theta: f32, u: Vec2) -> Vec2 {
     let c = erf(cot_theta);
     let k = tan_theta * INV_SQRT_PI;
@@ -366,7 +366,7 @@ impl Ndf for Beckmann {
     /// Below-horizon or non-finite `wo` falls back to [`Ndf::sample_normal`].
     ///
     /// # Reference
-    /// [Heitz2014b] §4 (stretch/rotate/unstretch), [Jakob2014] (1D inversion).
+    /// \[Heitz2014b\] §4 (stretch/rotate/unstretch), \[Jakob2014\] (1D inversion).
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
         let Some(a) = self.a_of(wo) else {
             return self.sample_normal(u);

@@ -19,8 +19,8 @@ use std::f32::consts::PI;
 /// stays ≤ 3.2·10⁷).
 ///
 /// # Reference
-/// [Walter2007] §5.2 (isotropic D, Λ), [Heitz2014] (anisotropic D and Λ), [Heitz2018] and
-/// [DupuyBenyoub2023] (visible normals).
+/// \[Walter2007\] §5.2 (isotropic D, Λ), \[Heitz2014\] (anisotropic D and Λ), \[Heitz2018\] and
+/// \[DupuyBenyoub2023\] (visible normals).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ggx {
     alpha_x: f32,
@@ -162,7 +162,7 @@ impl Ndf for Ggx {
     /// which has no such cancellation and the same distribution.
     ///
     /// # Reference
-    /// [DupuyBenyoub2023] listing 3 (spherical caps), [Heitz2018] (stretch / unstretch).
+    /// \[DupuyBenyoub2023\] listing 3 (spherical caps), \[Heitz2018\] (stretch / unstretch).
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(z > 0)` also rejects NaN
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
         if !(wo.z > 0.0) {
@@ -209,7 +209,7 @@ impl Ggx {
     /// z ≥ 10⁻³⁰ and is nudged toward wo if rounding leaves it orthogonal to wo.
     ///
     /// # Reference
-    /// [Heitz2018] listing 1.
+    /// \[Heitz2018\] listing 1.
     fn sample_visible_disk(&self, wo: Vec3, u: Vec2) -> Vec3 {
         if !(wo.z > 0.0 && wo.is_finite()) {
             return self.sample_normal(u);
