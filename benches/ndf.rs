@@ -2,7 +2,11 @@
 //!
 //! Each iteration evaluates a batch of 1024 precomputed inputs (directions from a seeded RNG,
 //! cosine-distributed so that grazing angles appear as often as in a renderer), and criterion's
-//! `Throughput::Elements(1024)` reports the time per call.
+//! `Throughput::Elements(1024)` reports the time per call. Every input passes through `black_box`
+//! and every result is stored to an output buffer (itself passed to `black_box`), so the figure is
+//! the throughput of independent calls, as in a renderer's loop over pixels, not the latency of a
+//! chain of additions into one accumulator (which capped the cheapest functions at one `f32` add
+//! latency per call before 2026-11).
 //!
 //! `cargo bench --bench ndf -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 
@@ -49,12 +53,12 @@ fn bench_ndf<N: Ndf>(c: &mut Criterion, family: &str, make: impl Fn(f32) -> N) {
     for &a in &ALPHAS {
         let (ndf, inp) = (make(a), inputs(a));
         d.bench_with_input(BenchmarkId::from_parameter(a), &inp, |b, inp| {
+            let mut out = vec![0.0f32; BATCH];
             b.iter(|| {
-                let mut s = 0.0f32;
-                for &m in &inp.m {
-                    s += ndf.d(black_box(m));
+                for (o, &m) in out.iter_mut().zip(&inp.m) {
+                    *o = ndf.d(black_box(m));
                 }
-                s
+                black_box(&mut out);
             })
         });
     }
@@ -65,12 +69,12 @@ fn bench_ndf<N: Ndf>(c: &mut Criterion, family: &str, make: impl Fn(f32) -> N) {
     for &a in &ALPHAS {
         let (ndf, inp) = (make(a), inputs(a));
         g.bench_with_input(BenchmarkId::from_parameter(a), &inp, |b, inp| {
+            let mut out = vec![0.0f32; BATCH];
             b.iter(|| {
-                let mut s = 0.0f32;
-                for (&w, &m) in inp.w.iter().zip(&inp.m) {
-                    s += ndf.g1(black_box(w), m);
+                for (o, (&w, &m)) in out.iter_mut().zip(inp.w.iter().zip(&inp.m)) {
+                    *o = ndf.g1(black_box(w), black_box(m));
                 }
-                s
+                black_box(&mut out);
             })
         });
     }
@@ -81,12 +85,12 @@ fn bench_ndf<N: Ndf>(c: &mut Criterion, family: &str, make: impl Fn(f32) -> N) {
     for &a in &ALPHAS {
         let (ndf, inp) = (make(a), inputs(a));
         v.bench_with_input(BenchmarkId::from_parameter(a), &inp, |b, inp| {
+            let mut out = vec![Vec3::ZERO; BATCH];
             b.iter(|| {
-                let mut s = Vec3::ZERO;
-                for (&w, &u) in inp.w.iter().zip(&inp.u) {
-                    s += ndf.sample_visible(black_box(w), u);
+                for (o, (&w, &u)) in out.iter_mut().zip(inp.w.iter().zip(&inp.u)) {
+                    *o = ndf.sample_visible(black_box(w), black_box(u));
                 }
-                s
+                black_box(&mut out);
             })
         });
     }

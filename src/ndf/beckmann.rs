@@ -9,7 +9,7 @@ use super::Ndf;
 use crate::Result;
 use crate::error::positive;
 use crate::frame::slope_to_normal;
-use crate::math::{INV_SQRT_PI, erf, erfc, erfinv, exp_neg_sq};
+use crate::math::{INV_SQRT_PI, atan2_pos, erf, erfcx_small, erfinv, exp_neg_sq};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -27,7 +27,7 @@ pub const MIN_ALPHA: f32 = 1e-4;
 /// NDF constructors then reject, naming `alpha`).
 ///
 /// # Reference
-/// [Burley2012] §5.4 (α = roughness²).
+/// \[Burley2012\] §5.4 (α = roughness²).
 pub fn alpha_from_roughness(r: f32) -> f32 {
     if r.is_finite() { r * r } else { 0.0 }
 }
@@ -38,7 +38,7 @@ pub fn alpha_from_roughness(r: f32) -> f32 {
 /// γ = 2/α² − 2, inverted). γ = 0 gives α = 1. Negative or NaN γ is treated as 0; γ = +∞ gives 0.
 ///
 /// # Reference
-/// [Walter2007] §5.2.
+/// \[Walter2007\] §5.2.
 pub fn beckmann_alpha_from_shininess(gamma: f32) -> f32 {
     let g = if gamma > 0.0 { gamma } else { 0.0 };
     (2.0 / (g + 2.0)).sqrt()
@@ -51,7 +51,7 @@ pub fn beckmann_alpha_from_shininess(gamma: f32) -> f32 {
 /// α = 0 gives `f32::MAX`, NaN gives 0.
 ///
 /// # Reference
-/// [Walter2007] §5.2.
+/// \[Walter2007\] §5.2.
 pub fn shininess_from_beckmann_alpha(alpha: f32) -> f32 {
     if alpha.is_nan() {
         return 0.0;
@@ -66,12 +66,16 @@ pub fn shininess_from_beckmann_alpha(alpha: f32) -> f32 {
 /// α_x acts along the tangent x; α = √2 σ with σ the RMS slope per axis.
 ///
 /// # Reference
-/// [Walter2007] §5.1 (isotropic D and Λ), [Heitz2014] (anisotropic form through α(φ)),
-/// [Heitz2014b] and [Jakob2014] (visible-normal sampling).
+/// \[Walter2007\] §5.1 (isotropic D and Λ), \[Heitz2014\] (anisotropic form through α(φ)),
+/// \[Heitz2014b\] and \[Jakob2014\] (visible-normal sampling).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Beckmann {
     alpha_x: f32,
     alpha_y: f32,
+    /// 1/α_x, 1/α_y and 1/(π α_x α_y), precomputed so that `d` has one division.
+    inv_alpha_x: f32,
+    inv_alpha_y: f32,
+    norm: f32,
 }
 
 impl Beckmann {
@@ -80,18 +84,25 @@ impl Beckmann {
     /// Errors if either is non-finite or ≤ 0 (the error names `alpha_x` or `alpha_y`). Values below
     /// [`MIN_ALPHA`] are clamped to it (see there why).
     pub fn new(alpha_x: f32, alpha_y: f32) -> Result<Self> {
-        let alpha_x = positive("alpha_x", alpha_x)?.max(MIN_ALPHA);
-        let alpha_y = positive("alpha_y", alpha_y)?.max(MIN_ALPHA);
-        Ok(Beckmann { alpha_x, alpha_y })
+        let (alpha_x, alpha_y) = validated_alphas(alpha_x, alpha_y)?;
+        Ok(Self::from_valid(alpha_x, alpha_y))
     }
 
     /// An isotropic Beckmann NDF; errors (naming `alpha`) if `alpha` is non-finite or ≤ 0.
     pub fn isotropic(alpha: f32) -> Result<Self> {
-        let alpha = positive("alpha", alpha)?.max(MIN_ALPHA);
-        Ok(Beckmann {
-            alpha_x: alpha,
-            alpha_y: alpha,
-        })
+        let alpha = validated_alpha(alpha)?;
+        Ok(Self::from_valid(alpha, alpha))
+    }
+
+    /// The NDF from validated, clamped α.
+    fn from_valid(alpha_x: f32, alpha_y: f32) -> Self {
+        Beckmann {
+            alpha_x,
+            alpha_y,
+            inv_alpha_x: 1.0 / alpha_x,
+            inv_alpha_y: 1.0 / alpha_y,
+            norm: 1.0 / (PI * alpha_x * alpha_y),
+        }
     }
 
     /// α along x (after the [`MIN_ALPHA`] clamp).
@@ -131,27 +142,36 @@ impl Beckmann {
 /// Returns a finite value for every a > 0 (Λ ≈ 1/(2a√π) → capped at `f32::MAX` as a → 0).
 ///
 /// # Reference
-/// [Walter2007] §5.1 (Beckmann G1), [Heitz2014] (Λ of the Beckmann distribution); the continued fraction is [AbramowitzStegun1964] 7.1.14.
+/// \[Walter2007\] §5.1 (Beckmann G1), \[Heitz2014\] (Λ of the Beckmann distribution); the continued fraction is \[AbramowitzStegun1964\] 7.1.14.
 #[inline]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > 0)` also rejects NaN
 fn lambda_of_a(a: f32) -> f32 {
     if !(a > 0.0) {
         return f32::MAX;
     }
-    if a < 2.0 {
-        let l = 0.5 * (exp_neg_sq(a) * INV_SQRT_PI / a - erfc(a));
-        return if l.is_finite() { l.max(0.0) } else { f32::MAX };
-    }
     if a >= 10.0 {
         return 0.0;
     }
-    let z = a * a;
-    // 16th convergent K = A₁₆/B₁₆ of K = ½/(a + 1/(a + (3/2)/(a + …))): A₁₆ = a·P(a²), B₁₆ = Q(a²),
-    // so g = K/(a + K) = P/(P + Q).
-    let p = horner(z, &CF_P);
-    let q = horner(z, &CF_Q);
-    let g = p / (p + q);
-    exp_neg_sq(a) * INV_SQRT_PI / (2.0 * a) * g
+    let l = 0.5 * exp_neg_sq(a) * lambda_scaled(a);
+    if l.is_finite() { l.max(0.0) } else { f32::MAX }
+}
+
+/// 2 e^(a²) Λ(a) for 0 < a < 10: 1/(a√π) − erfcx(a) for a < 2 (erfcx = e^(a²) erfc by the
+/// polynomial [`erfcx_small`], relative accurate, no exponential; the difference loses ≤ 10 bits at a = 2), (1/(a√π)) P/(P + Q) for 2 ≤ a < 10 (see
+/// [`lambda_of_a`]). Factoring e^(−a²) out of both branches leaves one exponential per Λ.
+#[inline(always)]
+fn lambda_scaled(a: f32) -> f32 {
+    let inv = INV_SQRT_PI / a;
+    if a < 2.0 {
+        inv - erfcx_small(a)
+    } else {
+        // 16th convergent K = A₁₆/B₁₆ of K = ½/(a + 1/(a + (3/2)/(a + …))): A₁₆ = a·P(a²),
+        // B₁₆ = Q(a²), so g = K/(a + K) = P/(P + Q).
+        let z = a * a;
+        let p = horner(z, &CF_P);
+        let q = horner(z, &CF_Q);
+        inv * (p / (p + q))
+    }
 }
 
 /// Coefficients (ascending powers of a²) of P, from the recurrence X_n = a X_{n−1} + (n/2) X_{n−2}
@@ -213,7 +233,7 @@ fn visible_area_of(a: f32, z: f32, n: f32) -> f32 {
 /// chi-square test resolves. The y slope is Gaussian and independent: erf⁻¹(2u₂ − 1).
 ///
 /// # Reference
-/// [Jakob2014] (inversion and initial guess), [Heitz2014b] §4 (the visible slope distribution).
+/// \[Jakob2014\] (inversion and initial guess), \[Heitz2014b\] §4 (the visible slope distribution).
 fn sample_visible_slope_std(cot_theta: f32, tan_theta: f32, theta: f32, u: Vec2) -> Vec2 {
     let c = erf(cot_theta);
     let k = tan_theta * INV_SQRT_PI;
@@ -248,6 +268,27 @@ fn sample_visible_slope_std(cot_theta: f32, tan_theta: f32, theta: f32, u: Vec2)
     Vec2::new(x, erfinv(2.0 * u.y.clamp(0.0, 1.0) - 1.0))
 }
 
+/// α_x, α_y validated for an NDF constructor: finite and > 0 (the error names `alpha_x` or
+/// `alpha_y`), then clamped to ≥ [`MIN_ALPHA`]. Shared by [`Beckmann`] and [`Ggx`](super::Ggx).
+pub(super) fn validated_alphas(alpha_x: f32, alpha_y: f32) -> Result<(f32, f32)> {
+    Ok((
+        positive("alpha_x", alpha_x)?.max(MIN_ALPHA),
+        positive("alpha_y", alpha_y)?.max(MIN_ALPHA),
+    ))
+}
+
+/// An isotropic α validated like [`validated_alphas`], the error naming `alpha`.
+pub(super) fn validated_alpha(alpha: f32) -> Result<f32> {
+    Ok(positive("alpha", alpha)?.max(MIN_ALPHA))
+}
+
+/// u clamped to [0, 1]², NaN components to 0 (`f32::max` returns the non-NaN operand).
+#[inline(always)]
+#[allow(clippy::manual_clamp)] // `clamp` would keep NaN; `max` maps it to 0
+pub(super) fn unit_square(u: Vec2) -> Vec2 {
+    Vec2::new(u.x.max(0.0).min(1.0), u.y.max(0.0).min(1.0))
+}
+
 /// Nudges a sampled normal that rounding left exactly on (or behind) the visibility boundary
 /// m·wo = 0 toward wo by 10⁻⁶ rad, so that its pdf is positive. Affects only draws whose u lies
 /// within ~10⁻⁶ of the end of the CDF.
@@ -263,19 +304,15 @@ pub(super) fn keep_visible(m: Vec3, wo: Vec3) -> Vec3 {
 impl Ndf for Beckmann {
     /// D(m) = exp(−((x/α_x)² + (y/α_y)²)/z²) / (π α_x α_y z⁴); 0 for z ≤ 0 or non-finite m
     /// (and where the numerator underflows, within ~10⁻¹¹ of the horizon).
+    ///
+    /// Checked last: one division (1/z²), one `exp`, and one comparison that rejects z ≤ 0 and any
+    /// non-finite result.
     #[inline]
     fn d(&self, m: Vec3) -> f32 {
-        if !(m.z > 0.0 && m.is_finite()) {
-            return 0.0;
-        }
-        let (sx, sy) = (m.x / self.alpha_x, m.y / self.alpha_y);
-        let z2 = m.z * m.z;
-        let e = (-(sx * sx + sy * sy) / z2).exp();
-        if e == 0.0 {
-            return 0.0;
-        }
-        let d = e / (PI * self.alpha_x * self.alpha_y * z2 * z2);
-        if d.is_finite() { d } else { 0.0 }
+        let (sx, sy) = (m.x * self.inv_alpha_x, m.y * self.inv_alpha_y);
+        let q = 1.0 / (m.z * m.z);
+        let d = (-(sx * sx + sy * sy) * q).exp() * (self.norm * q * q);
+        if m.z > 0.0 && d <= f32::MAX { d } else { 0.0 }
     }
 
     /// Exact Smith Λ(w) = (erf(a) − 1)/2 + e^(−a²)/(2a√π), a = 1/(α(φ) tan θ_w), evaluated without
@@ -329,7 +366,7 @@ impl Ndf for Beckmann {
     /// Below-horizon or non-finite `wo` falls back to [`Ndf::sample_normal`].
     ///
     /// # Reference
-    /// [Heitz2014b] §4 (stretch/rotate/unstretch), [Jakob2014] (1D inversion).
+    /// \[Heitz2014b\] §4 (stretch/rotate/unstretch), \[Jakob2014\] (1D inversion).
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
         let Some(a) = self.a_of(wo) else {
             return self.sample_normal(u);
@@ -339,7 +376,8 @@ impl Ndf for Beckmann {
         // (cos φ, sin φ) of the stretched direction; any azimuth at normal incidence.
         let cs = if n > 0.0 { stretched / n } else { Vec2::X };
         let tan_theta = n / wo.z;
-        let theta = n.atan2(wo.z);
+        // θ only shapes the initial guess (Newton corrects it): a 10⁻⁵-rad approximation will do.
+        let theta = atan2_pos(n, wo.z);
         let s = sample_visible_slope_std(a, tan_theta, theta, u);
         let rotated = Vec2::new(cs.x * s.x - cs.y * s.y, cs.y * s.x + cs.x * s.y);
         let m = slope_to_normal(Vec2::new(

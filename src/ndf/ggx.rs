@@ -5,9 +5,8 @@
 //! form); visible normals are sampled with Heitz 2018's hemisphere-projection routine.
 
 use super::Ndf;
-use super::beckmann::MIN_ALPHA;
+use super::beckmann::{keep_visible, unit_square, validated_alpha, validated_alphas};
 use crate::Result;
-use crate::error::positive;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -16,36 +15,47 @@ use std::f32::consts::PI;
 /// D(m) = 1 / (π α_x α_y cos⁴θ_m (1 + tan²θ_m (cos²φ_m/α_x² + sin²φ_m/α_y²))²)
 ///      = 1 / (π α_x α_y ((x/α_x)² + (y/α_y)² + z²)²) for m = (x, y, z), z > 0.
 ///
-/// α is clamped to ≥ [`MIN_ALPHA`] = 10⁻⁴ like [`Beckmann`](super::Beckmann) (D(ω_g) = 1/(π α_x α_y)
+/// α is clamped to ≥ [`MIN_ALPHA`](super::MIN_ALPHA) = 10⁻⁴ like [`Beckmann`](super::Beckmann) (D(ω_g) = 1/(π α_x α_y)
 /// stays ≤ 3.2·10⁷).
 ///
 /// # Reference
-/// [Walter2007] §5.2 (isotropic D, Λ), [Heitz2014] (anisotropic D and Λ), [Heitz2018] (visible
-/// normals).
+/// \[Walter2007\] §5.2 (isotropic D, Λ), \[Heitz2014\] (anisotropic D and Λ), \[Heitz2018\] and
+/// \[DupuyBenyoub2023\] (visible normals).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ggx {
     alpha_x: f32,
     alpha_y: f32,
+    /// 1/α_x, 1/α_y and 1/(π α_x α_y), precomputed so that `d` has one division.
+    inv_alpha_x: f32,
+    inv_alpha_y: f32,
+    norm: f32,
 }
 
 impl Ggx {
     /// An anisotropic GGX NDF with roughness `alpha_x` along x and `alpha_y` along y.
     ///
     /// Errors if either is non-finite or ≤ 0 (naming `alpha_x` or `alpha_y`); values below
-    /// [`MIN_ALPHA`] are clamped to it.
+    /// [`MIN_ALPHA`](super::MIN_ALPHA) are clamped to it.
     pub fn new(alpha_x: f32, alpha_y: f32) -> Result<Self> {
-        let alpha_x = positive("alpha_x", alpha_x)?.max(MIN_ALPHA);
-        let alpha_y = positive("alpha_y", alpha_y)?.max(MIN_ALPHA);
-        Ok(Ggx { alpha_x, alpha_y })
+        let (alpha_x, alpha_y) = validated_alphas(alpha_x, alpha_y)?;
+        Ok(Self::from_valid(alpha_x, alpha_y))
     }
 
     /// An isotropic GGX NDF; errors (naming `alpha`) if `alpha` is non-finite or ≤ 0.
     pub fn isotropic(alpha: f32) -> Result<Self> {
-        let alpha = positive("alpha", alpha)?.max(MIN_ALPHA);
-        Ok(Ggx {
-            alpha_x: alpha,
-            alpha_y: alpha,
-        })
+        let alpha = validated_alpha(alpha)?;
+        Ok(Self::from_valid(alpha, alpha))
+    }
+
+    /// The NDF from validated, clamped α.
+    fn from_valid(alpha_x: f32, alpha_y: f32) -> Self {
+        Ggx {
+            alpha_x,
+            alpha_y,
+            inv_alpha_x: 1.0 / alpha_x,
+            inv_alpha_y: 1.0 / alpha_y,
+            norm: 1.0 / (PI * alpha_x * alpha_y),
+        }
     }
 
     /// α along x (after the clamp).
@@ -68,15 +78,15 @@ impl Ggx {
 
 impl Ndf for Ggx {
     /// D(m) = 1 / (π α_x α_y ((x/α_x)² + (y/α_y)² + z²)²); 0 for z ≤ 0 or non-finite m.
+    ///
+    /// Checked last: the plain arithmetic runs first and one comparison rejects z ≤ 0 and a
+    /// non-finite result (NaN input, or a squared sum that under- or overflows).
     #[inline]
     fn d(&self, m: Vec3) -> f32 {
-        if !(m.z > 0.0 && m.is_finite()) {
-            return 0.0;
-        }
-        let (sx, sy) = (m.x / self.alpha_x, m.y / self.alpha_y);
+        let (sx, sy) = (m.x * self.inv_alpha_x, m.y * self.inv_alpha_y);
         let t = sx * sx + sy * sy + m.z * m.z;
-        let d = 1.0 / (PI * self.alpha_x * self.alpha_y * t * t);
-        if d.is_finite() { d } else { 0.0 }
+        let d = self.norm / (t * t);
+        if m.z > 0.0 && d <= f32::MAX { d } else { 0.0 }
     }
 
     /// Λ(w) = (√(1 + α(φ)² tan²θ) − 1)/2, written as n²/(2z(√(z² + n²) + z)) with
@@ -138,18 +148,69 @@ impl Ndf for Ggx {
         .unwrap_or(Vec3::Z)
     }
 
-    /// m ~ D_wo(m) exactly, by Heitz 2018: stretch wo to the hemisphere configuration, sample the
-    /// projected area of the hemisphere seen from it (a disk whose lower half is squashed by
-    /// s = (1 + cos θ_h)/2), lift onto the hemisphere, unstretch. Below-horizon or non-finite `wo`
-    /// falls back to [`Ndf::sample_normal`].
+    /// m ~ D_wo(m) exactly, by Dupuy & Benyoub 2023: stretch wo to the hemisphere configuration
+    /// (wₕ = normalize(α_x x, α_y y, z)); the visible normals of the unit hemisphere seen from wₕ
+    /// are the half vectors c + wₕ of a point c drawn uniformly on the spherical cap
+    /// z_c ∈ (−z_h, 1] (z_c = (1 − u₂)(1 + z_h) − z_h, azimuth 2πu₁); unstretch and normalise.
+    /// The same distribution as Heitz 2018's disk-projection routine with two square roots fewer.
+    /// Below-horizon `wo` falls back to [`Ndf::sample_normal`], as does any non-finite
+    /// intermediate (non-finite or zero-length `wo`; checked once, on the result).
     ///
-    /// Two deviations, both on a set of directions of measure ~10⁻⁷: the lift keeps
-    /// 1 − t₁² − t₂² ≥ 10⁻¹⁴ and the result keeps z ≥ 10⁻³⁰, so that a sample is never exactly on the
-    /// horizon or exactly orthogonal to wo (where its pdf would be 0).
+    /// The half vector keeps z ≥ 10⁻³⁰ (u₂ = 1 would put it on the horizon). Where rounding leaves
+    /// the result not strictly visible from wo (u₂ within ~10⁻⁶ of 1 with wₕ near the pole or the
+    /// horizon, where c + wₕ cancels), the sample is redrawn at the same u by Heitz 2018's routine,
+    /// which has no such cancellation and the same distribution.
     ///
     /// # Reference
-    /// [Heitz2018] listing 1.
+    /// \[DupuyBenyoub2023\] listing 3 (spherical caps), \[Heitz2018\] (stretch / unstretch).
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(z > 0)` also rejects NaN
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        if !(wo.z > 0.0) {
+            return self.sample_normal(u);
+        }
+        // NaN → 0, clamp to [0, 1]: also what the fallbacks below receive.
+        let u = unit_square(u);
+        let v = Vec3::new(self.alpha_x * wo.x, self.alpha_y * wo.y, wo.z);
+        let wh = v * (1.0 / v.length());
+        let (sp, cp) = (2.0 * PI * u.x).sin_cos();
+        // z_c + z_h = (1 − u₂)(1 + z_h) ≥ 0, formed without the cancellation of z_c + z_h.
+        let hz = (1.0 - u.y) * (1.0 + wh.z);
+        // sin θ_c = √((1 + z_c)(1 − z_c)) with 1 + z_c = h_z + (1 − z_h) and
+        // 1 − z_h = (x_h² + y_h²)/(1 + z_h): no cancellation where c is nearly −wₕ (u₂ → 1 with
+        // wₕ near the pole), where 1 − z_c² in f32 had no correct digit and c + wₕ then pointed
+        // anywhere (found by the 200 000-case totality property test).
+        let one_minus_zh = (wh.x * wh.x + wh.y * wh.y) / (1.0 + wh.z);
+        let one_plus_zc = hz + one_minus_zh;
+        let sin_c = (one_plus_zc * (2.0 - one_plus_zc)).max(0.0).sqrt();
+        let m = Vec3::new(
+            self.alpha_x * (sin_c * cp + wh.x),
+            self.alpha_y * (sin_c * sp + wh.y),
+            hz.max(1e-30),
+        );
+        let m = m * (1.0 / m.length());
+        if m.is_finite() && m.z > 0.0 && m.dot(wo) > 0.0 {
+            m
+        } else {
+            self.sample_visible_disk(wo, u)
+        }
+    }
+}
+
+impl Ggx {
+    /// Heitz 2018's disk-projection sampler of D_wo: the fallback of [`Ndf::sample_visible`] where
+    /// the spherical cap loses every digit.
+    ///
+    /// Near the end of the cap (u₂ → 1) the cap point c is nearly −wₕ and the half vector c + wₕ is
+    /// a difference of nearly equal `f32` numbers; when wₕ is also near the horizon (grazing wo,
+    /// small α) its direction is then rounding noise and may face away from wo. This routine works
+    /// in a frame built on wₕ and has no such cancellation. It draws from the same distribution, so
+    /// using it on that set (of measure ~10⁻⁶ in u) changes nothing but the u → m mapping there.
+    /// Non-finite or below-horizon `wo` falls back to [`Ndf::sample_normal`]; the result keeps
+    /// z ≥ 10⁻³⁰ and is nudged toward wo if rounding leaves it orthogonal to wo.
+    ///
+    /// # Reference
+    /// \[Heitz2018\] listing 1.
+    fn sample_visible_disk(&self, wo: Vec3, u: Vec2) -> Vec3 {
         if !(wo.z > 0.0 && wo.is_finite()) {
             return self.sample_normal(u);
         }
@@ -166,7 +227,7 @@ impl Ndf for Ggx {
         };
         let t2 = vh.cross(t1);
         // Uniform point on the unit disk, lower half squashed toward the horizon's projection.
-        let r = u.x.clamp(0.0, 1.0).sqrt();
+        let r = u.x.sqrt();
         let (sp, cp) = (2.0 * PI * u.y).sin_cos();
         let p1 = r * cp;
         let s = 0.5 * (1.0 + vh.z);
@@ -176,6 +237,52 @@ impl Ndf for Ggx {
         let m = Vec3::new(self.alpha_x * nh.x, self.alpha_y * nh.y, nh.z.max(1e-30))
             .try_normalize()
             .unwrap_or(Vec3::Z);
-        super::beckmann::keep_visible(m, wo)
+        keep_visible(m, wo)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Regression (200 000-case property test, seed 1): for a tiny α, wo away from the pole
+    /// (so wₕ is within 10⁻³ of it) and u₂ at the top of [0, 1), the cap point c is nearly −wₕ;
+    /// the half vector c + wₕ must still be visible from wo, with a positive pdf.
+    #[test]
+    fn sample_visible_near_the_cap_end() {
+        let n = Ggx::isotropic(10f32.powf(-3.253_356_2)).unwrap();
+        let wo = Vec3::new(-0.860_859_5, -0.116_034_34, 0.495_436_07);
+        let mut worst = f32::MAX;
+        for k in 0..=64 {
+            for uy in [0.999_999_94f32, 0.999_999_9, 0.999_999] {
+                let u = Vec2::new(k as f32 / 64.0, uy);
+                let m = n.sample_visible(wo, u);
+                assert!(m.is_finite() && m.z > 0.0, "{u:?}: {m:?}");
+                assert!(n.pdf_visible(wo, m) > 0.0, "{u:?}: {m:?}");
+                worst = worst.min(m.dot(wo));
+            }
+        }
+        assert!(worst > 0.0, "{worst}");
+    }
+
+    /// Regression (same property test): grazing wo along −x with α = 3.2·10⁻³ puts wₕ near the
+    /// horizon; at u = (0, 1 − 2⁻²⁴) the cap's half vector was rounding noise facing away from wo.
+    #[test]
+    fn sample_visible_grazing_cap_end() {
+        let n = Ggx::isotropic(10f32.powf(-2.488_697)).unwrap();
+        for wo in [
+            Vec3::new(-1.0, -6.036_363_5e-7, 3.114_992_6e-7),
+            Vec3::new(0.6, -0.8, 1e-6).normalize(),
+        ] {
+            for k in 0..=64 {
+                for uy in [0.999_999_94f32, 0.999_999_9, 0.999_999] {
+                    let u = Vec2::new(k as f32 / 64.0, uy);
+                    let m = n.sample_visible(wo, u);
+                    assert!(m.is_finite() && m.z > 0.0, "{u:?}: {m:?}");
+                    assert!(m.dot(wo) > 0.0, "{wo:?} {u:?}: {m:?}");
+                    assert!(n.pdf_visible(wo, m) > 0.0, "{wo:?} {u:?}: {m:?}");
+                }
+            }
+        }
     }
 }
