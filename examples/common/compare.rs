@@ -17,14 +17,14 @@
 //! Methods plug in through [`Method`] (an object-safe view of `brdf::glint::GlintNdf` plus the
 //! method's own BRDF); [`builders`] lists them.
 
+use super::pndf_images::maps;
 use super::{Artifact, Chart, Res, Scale, Series, line_chart};
 use brdf::bxdf::{Bxdf, Masking};
 use brdf::fresnel::NoFresnel;
 use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, BinnedPndf, BrushedParams, DEFAULT_LOD_LOBES,
-    FlakesParams, Footprint, GlintNdf, HemisphereBins, Kernel, MaskingMode, MixtureParams,
-    NormalMap, PatchOptions, PositionNormalBrdf, PositionNormalMap, PositionNormalParams,
-    ScratchedParams, binned_pndf, brushed, bumpy, flakes, scratched, tv_distance,
+    BeckmannMixture, BinMap, BinMapParams, BinnedPndf, DEFAULT_LOD_LOBES, Footprint, GlintNdf,
+    HemisphereBins, Kernel, MaskingMode, MixtureParams, NormalMap, PatchOptions,
+    PositionNormalBrdf, PositionNormalMap, PositionNormalParams, binned_pndf, tv_distance,
 };
 use brdf::ndf::Ndf;
 use brdf::{MicrofacetBrdf, Vec2, Vec3};
@@ -227,19 +227,6 @@ pub fn builders() -> Vec<(&'static str, Builder)> {
         ("inverse bin map", binmap_methods as Builder),
         ("position-normal", position_normal_methods as Builder),
     ]
-}
-
-/// The four procedural maps at `size`² (same parameters and seeds as the gallery).
-fn maps(size: usize) -> Res<Vec<(&'static str, NormalMap)>> {
-    Ok(vec![
-        ("bumpy", bumpy(size, size, 0.25, 4.0, 1)?),
-        ("brushed", brushed(size, size, BrushedParams::default(), 2)?),
-        (
-            "scratched",
-            scratched(size, size, ScratchedParams::default(), 3)?,
-        ),
-        ("flakes", flakes(size, size, FlakesParams::default(), 4)?),
-    ])
 }
 
 /// Settings of one run.

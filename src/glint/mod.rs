@@ -51,6 +51,7 @@
 
 mod binmap;
 mod bins;
+mod cdf;
 mod flakes;
 mod footprint;
 #[cfg(feature = "image")]
@@ -60,6 +61,7 @@ mod moments;
 mod normal_map;
 mod procedural;
 mod reference;
+mod slope_tree;
 
 pub use binmap::{
     BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, DEFAULT_BINS_PER_AXIS,

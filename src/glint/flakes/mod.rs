@@ -18,15 +18,14 @@
 mod brdf;
 mod build;
 mod patch;
-mod tree;
 
 pub use brdf::{DEFAULT_MASKING_ALPHA, PositionNormalBrdf};
 pub use patch::PositionNormalPatch;
 
 use crate::error::{Error, Result, positive};
+use crate::glint::slope_tree::SlopeTree;
 use crate::glint::{Footprint, GlintNdf, NormalMap};
 use glam::{Mat2, Vec2};
-use tree::SlopeTree;
 
 /// σ_h / h = 1/√(8 ln 2) (see [`PositionNormalMap::SIGMA_H_PER_SPACING`]).
 pub(crate) const SIGMA_H_PER_SPACING: f64 = 0.424_660_900_144_009_5;

@@ -8,10 +8,11 @@
 //! second slope moments. The per-element lobes used by the samplers are built on first use.
 
 use super::build::slope_box;
-use super::tree::contains;
 use super::{PositionNormalMap, SIGMA_H_PER_SPACING};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
+use crate::glint::cdf::invert_cdf;
+use crate::glint::slope_tree::contains;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
 use std::sync::OnceLock;
@@ -355,7 +356,6 @@ impl<'a> PositionNormalPatch<'a> {
         let tree = &map.tree;
         let [nx, ny] = map.grid;
         let sigma_h = SIGMA_H_PER_SPACING * map.spacing;
-        let sq = [s.x, s.y];
         let sd = [s.x as f64, s.y as f64];
         let mut acc = 0.0f64;
         let mut touched = 0usize;
@@ -375,7 +375,7 @@ impl<'a> PositionNormalPatch<'a> {
                     }
                     if l == 0 {
                         let e = &map.elements[y * nx + x];
-                        if !contains(&slope_box(e, sigma_h, &map.params), sq) {
+                        if !contains(&slope_box(e, sigma_h, &map.params), s) {
                             continue;
                         }
                         let Some((w, d)) = self.geo.weight(x as i64 + x_off, y as i64 + y_off)
@@ -387,7 +387,7 @@ impl<'a> PositionNormalPatch<'a> {
                         acc += w * gaussian(sd, mean, cov);
                         continue;
                     }
-                    if !contains(tree.node_box(l, x, y), sq) {
+                    if !contains(tree.node_box(l, x, y), s) {
                         continue;
                     }
                     let [cw, ch] = tree.sizes[l - 1];
@@ -401,24 +401,6 @@ impl<'a> PositionNormalPatch<'a> {
             }
         }
         (acc, touched)
-    }
-
-    /// Picks a slot by inverting the cdf at u; returns the slot and u rescaled to [0, 1).
-    fn pick(cdf: &[f64], u: f32) -> (usize, f32) {
-        let total = cdf.last().copied().unwrap_or(0.0);
-        let u = if u.is_nan() { 0.5 } else { u.clamp(0.0, 1.0) } as f64;
-        let target = u * total;
-        let s = cdf
-            .partition_point(|&c| c <= target)
-            .min(cdf.len().saturating_sub(1));
-        let lo = if s == 0 { 0.0 } else { cdf[s - 1] };
-        let width = cdf.get(s).copied().unwrap_or(0.0) - lo;
-        let r = if width > 0.0 {
-            (target - lo) / width
-        } else {
-            0.5
-        };
-        (s, (r as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0))
     }
 
     /// Σ W_i D_i(m) over every kept element, in `f64`.
@@ -498,7 +480,7 @@ impl Ndf for PositionNormalPatch<'_> {
         if s.lobes.is_empty() {
             return self.moments_lobe.sample_normal(u);
         }
-        let (k, ux) = Self::pick(&s.cdf, u.x);
+        let (k, ux) = invert_cdf(&s.cdf, u.x);
         s.lobes[k].sample_normal(Vec2::new(ux, u.y))
     }
 

@@ -7,8 +7,8 @@
 //! union of its lobes' slope boxes as [x_min, y_min, x_max, y_max] in `f32` (16 bytes). Level 0 (the
 //! lobes' own boxes) is not stored: it is rebuilt from the moments at query time by [`lobe_box`].
 
+use crate::glint::slope_tree::level_sizes;
 use crate::ndf::SlopeGaussian;
-use glam::Vec2;
 
 /// The slope box of one lobe: mean ± k (√Σxx, √Σyy), the axis-aligned box of the ellipse
 /// (ñ − μ)ᵀ Σ⁻¹ (ñ − μ) ≤ k², which holds a fraction 1 − e^{−k²/2} of the lobe's mass.
@@ -20,89 +20,6 @@ pub(super) fn lobe_box(g: &SlopeGaussian, k: f32) -> [f32; 4] {
     let hy = k * (l21 * l21 + l22 * l22).sqrt();
     let m = g.mean();
     [m.x - hx, m.y - hy, m.x + hx, m.y + hy]
-}
-
-/// Whether a slope lies in a box (NaN slopes never do).
-#[inline]
-pub(super) fn contains(b: &[f32; 4], s: Vec2) -> bool {
-    s.x >= b[0] && s.y >= b[1] && s.x <= b[2] && s.y <= b[3]
-}
-
-fn union(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
-    [
-        a[0].min(b[0]),
-        a[1].min(b[1]),
-        a[2].max(b[2]),
-        a[3].max(b[3]),
-    ]
-}
-
-/// Sizes of the levels over an `nx × ny` grid: level l has ⌈nx/2^l⌉ × ⌈ny/2^l⌉ nodes, up to 1 × 1.
-pub(super) fn level_sizes(nx: usize, ny: usize) -> Vec<[usize; 2]> {
-    let mut sizes = vec![[nx, ny]];
-    let (mut w, mut h) = (nx, ny);
-    while w > 1 || h > 1 {
-        w = w.div_ceil(2);
-        h = h.div_ceil(2);
-        sizes.push([w, h]);
-    }
-    sizes
-}
-
-/// The implicit quadtree of slope boxes. `boxes[l - 1]` holds level l ≥ 1, row major.
-#[derive(Clone, Debug)]
-pub(super) struct SlopeTree {
-    pub sizes: Vec<[usize; 2]>,
-    pub boxes: Vec<Vec<[f32; 4]>>,
-}
-
-impl SlopeTree {
-    /// Builds the tree from the level-0 boxes (row major over the lobe grid).
-    pub fn build(nx: usize, ny: usize, leaf: &[[f32; 4]]) -> SlopeTree {
-        let sizes = level_sizes(nx, ny);
-        let mut boxes: Vec<Vec<[f32; 4]>> = Vec::with_capacity(sizes.len().saturating_sub(1));
-        for l in 1..sizes.len() {
-            let [pw, ph] = sizes[l - 1];
-            let [w, h] = sizes[l];
-            let prev: &[[f32; 4]] = if l == 1 { leaf } else { &boxes[l - 2] };
-            let mut level = Vec::with_capacity(w * h);
-            for y in 0..h {
-                for x in 0..w {
-                    let mut b = [
-                        f32::INFINITY,
-                        f32::INFINITY,
-                        f32::NEG_INFINITY,
-                        f32::NEG_INFINITY,
-                    ];
-                    for cy in (2 * y)..(2 * y + 2).min(ph) {
-                        for cx in (2 * x)..(2 * x + 2).min(pw) {
-                            b = union(b, prev[cy * pw + cx]);
-                        }
-                    }
-                    level.push(b);
-                }
-            }
-            boxes.push(level);
-        }
-        SlopeTree { sizes, boxes }
-    }
-
-    /// Index of the top level (its single node is the root); 0 for a 1 × 1 grid.
-    #[inline]
-    pub fn top(&self) -> usize {
-        self.sizes.len() - 1
-    }
-
-    /// The box of node (x, y) of level l ≥ 1.
-    #[inline]
-    pub fn node_box(&self, l: usize, x: usize, y: usize) -> &[f32; 4] {
-        &self.boxes[l - 1][y * self.sizes[l][0] + x]
-    }
-
-    /// Bytes held by the tree's boxes.
-    pub fn bytes(&self) -> usize {
-        self.boxes.iter().map(|b| b.len() * 16).sum()
-    }
 }
 
 /// The mip chain of lobe moments: level 0 = the lobes, level l + 1 = the average of the (up to)

@@ -19,9 +19,10 @@ mod patch;
 pub use patch::MixturePatch;
 
 use crate::error::{Error, Result, positive};
+use crate::glint::slope_tree::SlopeTree;
 use crate::glint::{Footprint, GlintNdf, NormalMap};
 use crate::ndf::SlopeGaussian;
-use hierarchy::{LobePyramid, SlopeTree, lobe_box};
+use hierarchy::{LobePyramid, lobe_box};
 
 /// Default seed spacing h = 1 texel: one lobe per texel, at the texel centres (\[Chermain2019\] §5.1.1).
 pub const DEFAULT_SPACING: f32 = 1.0;

@@ -8,10 +8,12 @@
 //! folded onto the lobe grid (a lobe's slot then carries the sum of its periodic images' weights),
 //! so a patch never holds more slots than the map has lobes.
 
-use super::hierarchy::{contains, lobe_box};
+use super::hierarchy::lobe_box;
 use super::{BeckmannMixture, MaskingMode, PatchOptions, build::kernel_sigma};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
+use crate::glint::cdf::invert_cdf;
+use crate::glint::slope_tree::contains;
 use crate::ndf::{DEFAULT_SIGMA_MIN, Ndf, SIGMA_MIN_FLOOR, SlopeGaussian};
 use glam::{Vec2, Vec3};
 use std::sync::OnceLock;
@@ -529,25 +531,6 @@ impl<'a> MixturePatch<'a> {
             None => self.filtered.projected_area(w),
         }
     }
-
-    /// Picks a slot by inverting the cdf at u ∈ [0, 1); returns the slot and u rescaled to [0, 1).
-    fn pick(g: &Gathered, u: f32) -> (usize, f32) {
-        let total = g.cdf.last().copied().unwrap_or(0.0);
-        let u = if u.is_nan() { 0.5 } else { u.clamp(0.0, 1.0) } as f64;
-        let target = u * total;
-        let s = g
-            .cdf
-            .partition_point(|&c| c <= target)
-            .min(g.cdf.len().saturating_sub(1));
-        let lo = if s == 0 { 0.0 } else { g.cdf[s - 1] };
-        let width = g.cdf[s] - lo;
-        let r = if width > 0.0 {
-            (target - lo) / width
-        } else {
-            0.5
-        };
-        (s, (r as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0))
-    }
 }
 
 impl Ndf for MixturePatch<'_> {
@@ -597,7 +580,7 @@ impl Ndf for MixturePatch<'_> {
         let Some(g) = &self.gathered else {
             return self.filtered.sample_normal(u);
         };
-        let (s, ux) = Self::pick(g, u.x);
+        let (s, ux) = invert_cdf(&g.cdf, u.x);
         self.slot_lobe(g, s).sample_normal(Vec2::new(ux, u.y))
     }
 

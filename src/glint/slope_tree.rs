@@ -1,21 +1,18 @@
-//! The implicit quadtree of element slope boxes: the 4D bounding-box hierarchy of \[Yan2016\] §5 with
-//! the positional half implicit.
+//! The implicit quadtree of slope boxes shared by the glint models whose elements sit on a regular
+//! grid (the Beckmann mixture's lobes, \[Chermain2019\] §5; the position-normal elements, \[Yan2016\]
+//! §5, whose 4D hierarchy has its positional half implicit).
 //!
-//! Elements sit on a regular grid, so a node's positional box is implicit: a node of level l ≥ 1 is
-//! the block of 2^l × 2^l elements starting at element (x·2^l, y·2^l) (clipped at the grid's edge);
-//! it stores the union of its elements' slope boxes as [x_min, y_min, x_max, y_max] (`f32`, 16 bytes).
-//! Level 0 is not stored: the leaf boxes are recomputed from the elements at query time.
+//! A node of level l ≥ 1 is the block of 2^l × 2^l elements starting at element (x·2^l, y·2^l)
+//! (clipped at the grid's edge); it stores only the union of its elements' slope boxes as
+//! [x_min, y_min, x_max, y_max] in `f32` (16 bytes). Level 0 (the elements' own boxes) is not stored:
+//! each model recomputes it from its elements at query time.
 
-/// Sizes of the levels over an `nx × ny` grid: level l has ⌈nx/2^l⌉ × ⌈ny/2^l⌉ nodes, up to 1 × 1.
-fn level_sizes(nx: usize, ny: usize) -> Vec<[usize; 2]> {
-    let mut sizes = vec![[nx, ny]];
-    let (mut w, mut h) = (nx, ny);
-    while w > 1 || h > 1 {
-        w = w.div_ceil(2);
-        h = h.div_ceil(2);
-        sizes.push([w, h]);
-    }
-    sizes
+use glam::Vec2;
+
+/// Whether a slope lies in a box (NaN slopes never do).
+#[inline]
+pub(crate) fn contains(b: &[f32; 4], s: Vec2) -> bool {
+    s.x >= b[0] && s.y >= b[1] && s.x <= b[2] && s.y <= b[3]
 }
 
 fn union(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
@@ -27,21 +24,27 @@ fn union(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
     ]
 }
 
-/// Whether a slope lies in a box (NaN slopes never do).
-#[inline]
-pub(super) fn contains(b: &[f32; 4], s: [f32; 2]) -> bool {
-    s[0] >= b[0] && s[1] >= b[1] && s[0] <= b[2] && s[1] <= b[3]
+/// Sizes of the levels over an `nx × ny` grid: level l has ⌈nx/2^l⌉ × ⌈ny/2^l⌉ nodes, up to 1 × 1.
+pub(crate) fn level_sizes(nx: usize, ny: usize) -> Vec<[usize; 2]> {
+    let mut sizes = vec![[nx, ny]];
+    let (mut w, mut h) = (nx, ny);
+    while w > 1 || h > 1 {
+        w = w.div_ceil(2);
+        h = h.div_ceil(2);
+        sizes.push([w, h]);
+    }
+    sizes
 }
 
-/// The quadtree. `boxes[l - 1]` holds level l ≥ 1, row major.
+/// The implicit quadtree of slope boxes. `boxes[l - 1]` holds level l ≥ 1, row major.
 #[derive(Clone, Debug)]
-pub(super) struct SlopeTree {
+pub(crate) struct SlopeTree {
     pub sizes: Vec<[usize; 2]>,
     pub boxes: Vec<Vec<[f32; 4]>>,
 }
 
 impl SlopeTree {
-    /// Builds the tree from the leaf boxes (row major over the element grid).
+    /// Builds the tree from the level-0 boxes (row major over the element grid).
     pub fn build(nx: usize, ny: usize, leaf: &[[f32; 4]]) -> SlopeTree {
         let sizes = level_sizes(nx, ny);
         let mut boxes: Vec<Vec<[f32; 4]>> = Vec::with_capacity(sizes.len().saturating_sub(1));
@@ -83,7 +86,7 @@ impl SlopeTree {
         &self.boxes[l - 1][y * self.sizes[l][0] + x]
     }
 
-    /// Bytes held by the boxes.
+    /// Bytes held by the tree's boxes.
     pub fn bytes(&self) -> usize {
         self.boxes.iter().map(|b| b.len() * 16).sum()
     }

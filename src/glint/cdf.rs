@@ -1,0 +1,42 @@
+//! Discrete sampling from a cumulative table: the first step of every glint sampler (pick a lobe,
+//! element or texel ∝ its weight, then sample inside it).
+
+/// Inverts an increasing cumulative table (not necessarily normalised) at u ∈ [0, 1): returns the
+/// slot k with cdf[k − 1] ≤ u · total < cdf[k] and u rescaled to [0, 1) inside that slot, so that
+/// one uniform number serves both steps.
+///
+/// Total: NaN u → ½; u clamped to [0, 1]; an empty table → slot 0 (callers check emptiness); a
+/// zero-width slot → ½.
+pub(crate) fn invert_cdf(cdf: &[f64], u: f32) -> (usize, f32) {
+    let total = cdf.last().copied().unwrap_or(0.0);
+    let u = if u.is_nan() { 0.5 } else { u.clamp(0.0, 1.0) } as f64;
+    let target = u * total;
+    let s = cdf
+        .partition_point(|&c| c <= target)
+        .min(cdf.len().saturating_sub(1));
+    let lo = if s == 0 { 0.0 } else { cdf[s - 1] };
+    let width = cdf.get(s).copied().unwrap_or(0.0) - lo;
+    let r = if width > 0.0 {
+        (target - lo) / width
+    } else {
+        0.5
+    };
+    (s, (r as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::invert_cdf;
+
+    #[test]
+    fn picks_the_slot_and_rescales() {
+        let cdf = [1.0, 1.0, 4.0];
+        assert_eq!(invert_cdf(&cdf, 0.0), (0, 0.0));
+        // u · total = 2 lies in slot 2 ([1, 4)), a third of the way in.
+        let (k, r) = invert_cdf(&cdf, 0.5);
+        assert_eq!(k, 2);
+        assert!((r - 1.0 / 3.0).abs() < 1e-6);
+        assert_eq!(invert_cdf(&cdf, f32::NAN).0, 2);
+        assert_eq!(invert_cdf(&[], 0.3), (0, 0.5));
+    }
+}
