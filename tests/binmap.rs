@@ -607,20 +607,8 @@ fn bad_input_is_total() {
 #[test]
 #[ignore]
 fn accuracy_table() {
-    use brdf::glint::{BrushedParams, brushed};
     let n = 256;
-    let maps = vec![
-        ("bumpy", bumpy(n, n, 0.25, 4.0, 1).unwrap()),
-        (
-            "brushed",
-            brushed(n, n, BrushedParams::default(), 2).unwrap(),
-        ),
-        (
-            "scratched",
-            scratched(n, n, ScratchedParams::default(), 3).unwrap(),
-        ),
-        ("flakes", flakes(n, n, FlakesParams::default(), 4).unwrap()),
-    ];
+    let maps = support::procedural_maps(n);
     let bins = HemisphereBins::new(64).unwrap();
     println!(
         "| map | footprint (texels) | TV bins, Gaussian ref. | TV bins, parallelogram ref. | TV α = 0.02, parallelogram ref. | TV mask lobe, Gaussian ref. | reference noise |"

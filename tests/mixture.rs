@@ -12,8 +12,8 @@ mod support;
 use brdf::bxdf::Masking;
 use brdf::fresnel::NoFresnel;
 use brdf::glint::{
-    self, BeckmannMixture, BrushedParams, FlakesParams, Footprint, GlintNdf, MaskingMode,
-    MixtureParams, MixturePatch, NormalMap, PatchOptions, ScratchedParams,
+    self, BeckmannMixture, Footprint, GlintNdf, MaskingMode, MixtureParams, MixturePatch,
+    NormalMap, PatchOptions,
 };
 use brdf::ndf::Ndf;
 use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
@@ -34,22 +34,9 @@ fn noise(n: usize, seed: u64) -> NormalMap {
 /// The four procedural maps (the stand-ins for \[Chermain2019\] Fig. 7, same parameters and seeds as
 /// the gallery) at 64², and white-noise slopes as a stress case.
 fn maps() -> Vec<(&'static str, NormalMap)> {
-    vec![
-        ("bumpy", glint::bumpy(N, N, 0.25, 4.0, 1).unwrap()),
-        (
-            "brushed",
-            glint::brushed(N, N, BrushedParams::default(), 2).unwrap(),
-        ),
-        (
-            "scratched",
-            glint::scratched(N, N, ScratchedParams::default(), 3).unwrap(),
-        ),
-        (
-            "flakes",
-            glint::flakes(N, N, FlakesParams::default(), 4).unwrap(),
-        ),
-        ("noise", noise(N, 2)),
-    ]
+    let mut maps = support::procedural_maps(N);
+    maps.push(("noise", noise(N, 2)));
+    maps
 }
 
 /// The four procedural maps only.
@@ -665,23 +652,9 @@ fn bad_input() {
 #[test]
 #[ignore]
 fn accuracy_table() {
-    use brdf::glint::{
-        BrushedParams, FlakesParams, HemisphereBins, Kernel, ScratchedParams, binned_pndf, brushed,
-        bumpy as bumpy_map, flakes, scratched as scratched_map, tv_distance,
-    };
+    use brdf::glint::{HemisphereBins, Kernel, binned_pndf, tv_distance};
     let n = 256;
-    let maps = vec![
-        ("bumpy", bumpy_map(n, n, 0.25, 4.0, 1).unwrap()),
-        (
-            "brushed",
-            brushed(n, n, BrushedParams::default(), 2).unwrap(),
-        ),
-        (
-            "scratched",
-            scratched_map(n, n, ScratchedParams::default(), 3).unwrap(),
-        ),
-        ("flakes", flakes(n, n, FlakesParams::default(), 4).unwrap()),
-    ];
+    let maps = support::procedural_maps(n);
     let bins = HemisphereBins::new(64).unwrap();
     println!(
         "| map | footprint (texels) | lobes | TV mixture | TV filtered lobe | reference noise |"
@@ -765,21 +738,7 @@ fn lod_table() {
     use brdf::glint::{HemisphereBins, Kernel, binned_pndf, tv_distance};
     use std::time::Instant;
     let n = 512;
-    let maps = [
-        ("bumpy", glint::bumpy(n, n, 0.25, 4.0, 1).unwrap()),
-        (
-            "brushed",
-            glint::brushed(n, n, BrushedParams::default(), 2).unwrap(),
-        ),
-        (
-            "scratched",
-            glint::scratched(n, n, ScratchedParams::default(), 3).unwrap(),
-        ),
-        (
-            "flakes",
-            glint::flakes(n, n, FlakesParams::default(), 4).unwrap(),
-        ),
-    ];
+    let maps = support::procedural_maps(n);
     let bins = HemisphereBins::new(64).unwrap();
     println!(
         "| map | footprint (texels) | TV mixture | TV filtered lobe | d mixture | d filtered lobe |"

@@ -592,23 +592,9 @@ fn published_brdf_creates_energy_on_tilted_surfaces() {
 #[test]
 #[ignore]
 fn accuracy_table() {
-    use brdf::glint::{
-        BrushedParams, FlakesParams, HemisphereBins, Kernel, ScratchedParams, binned_pndf, brushed,
-        bumpy, flakes, scratched, tv_distance,
-    };
+    use brdf::glint::{HemisphereBins, Kernel, binned_pndf, tv_distance};
     let n = 256;
-    let maps = vec![
-        ("bumpy", bumpy(n, n, 0.25, 4.0, 1).unwrap()),
-        (
-            "brushed",
-            brushed(n, n, BrushedParams::default(), 2).unwrap(),
-        ),
-        (
-            "scratched",
-            scratched(n, n, ScratchedParams::default(), 3).unwrap(),
-        ),
-        ("flakes", flakes(n, n, FlakesParams::default(), 4).unwrap()),
-    ];
+    let maps = support::procedural_maps(n);
     let bins = HemisphereBins::new(64).unwrap();
     println!(
         "| map | footprint (texels) | elements | TV position-normal | TV rate 2 | TV moments lobe | reference noise |"

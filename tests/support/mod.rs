@@ -45,3 +45,23 @@ pub fn proptest_config(cases: u32) -> proptest::test_runner::Config {
         ..env
     }
 }
+
+/// The four procedural maps at `n`² with the gallery's parameters and seeds (bumpy: RMS slope 0.25,
+/// ℓ = 4 texels; brushed, scratched, flakes: their defaults), in that order.
+pub fn procedural_maps(n: usize) -> Vec<(&'static str, brdf::glint::NormalMap)> {
+    use brdf::glint::{
+        BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
+    };
+    vec![
+        ("bumpy", bumpy(n, n, 0.25, 4.0, 1).unwrap()),
+        (
+            "brushed",
+            brushed(n, n, BrushedParams::default(), 2).unwrap(),
+        ),
+        (
+            "scratched",
+            scratched(n, n, ScratchedParams::default(), 3).unwrap(),
+        ),
+        ("flakes", flakes(n, n, FlakesParams::default(), 4).unwrap()),
+    ]
+}
