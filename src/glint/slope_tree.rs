@@ -86,6 +86,49 @@ impl SlopeTree {
         &self.boxes[l - 1][y * self.sizes[l][0] + x]
     }
 
+    /// Calls `leaf(x, y)` for every level-0 element (x, y) in the half-open rectangle
+    /// [x.0, x.1) × [y.0, y.1) all of whose ancestors' boxes contain the slope `s`, depth first. The
+    /// caller tests the element's own box (level 0 is not stored).
+    ///
+    /// The stack holds at most 3 pending siblings per level plus one, and a grid of at most 2³²
+    /// elements per side has at most 33 levels: 128 entries always suffice.
+    #[inline]
+    pub fn for_each_leaf(
+        &self,
+        x: (usize, usize),
+        y: (usize, usize),
+        s: Vec2,
+        mut leaf: impl FnMut(usize, usize),
+    ) {
+        let mut stack = [(0u8, 0u32, 0u32); 128];
+        let mut len = 1;
+        stack[0] = (self.top() as u8, 0, 0);
+        while len > 0 {
+            len -= 1;
+            let (l, nx, ny) = stack[len];
+            let (l, nx, ny) = (l as usize, nx as usize, ny as usize);
+            let (bx0, by0) = (nx << l, ny << l);
+            let (bx1, by1) = ((nx + 1) << l, (ny + 1) << l);
+            if bx1 <= x.0 || bx0 >= x.1 || by1 <= y.0 || by0 >= y.1 {
+                continue;
+            }
+            if l == 0 {
+                leaf(nx, ny);
+                continue;
+            }
+            if !contains(self.node_box(l, nx, ny), s) {
+                continue;
+            }
+            let [cw, ch] = self.sizes[l - 1];
+            for cy in (2 * ny)..(2 * ny + 2).min(ch) {
+                for cx in (2 * nx)..(2 * nx + 2).min(cw) {
+                    stack[len] = ((l - 1) as u8, cx as u32, cy as u32);
+                    len += 1;
+                }
+            }
+        }
+    }
+
     /// Bytes held by the tree's boxes.
     pub fn bytes(&self) -> usize {
         self.boxes.iter().map(|b| b.len() * 16).sum()

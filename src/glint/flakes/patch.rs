@@ -359,45 +359,21 @@ impl<'a> PositionNormalPatch<'a> {
         let sd = [s.x as f64, s.y as f64];
         let mut acc = 0.0f64;
         let mut touched = 0usize;
-        let mut stack = [(0u8, 0u32, 0u32); 128];
         for (x_lo, x_hi, x_off) in segments(self.rect[0], nx) {
             for (y_lo, y_hi, y_off) in segments(self.rect[1], ny) {
-                let mut len = 1;
-                stack[0] = (tree.top() as u8, 0, 0);
-                while len > 0 {
-                    len -= 1;
-                    let (l, x, y) = stack[len];
-                    let (l, x, y) = (l as usize, x as usize, y as usize);
-                    let (bx0, by0) = (x << l, y << l);
-                    let (bx1, by1) = ((x + 1) << l, (y + 1) << l);
-                    if bx1 <= x_lo || bx0 > x_hi || by1 <= y_lo || by0 > y_hi {
-                        continue;
+                // Segments are inclusive; the walk takes half-open ranges.
+                tree.for_each_leaf((x_lo, x_hi + 1), (y_lo, y_hi + 1), s, |x, y| {
+                    let e = &map.elements[y * nx + x];
+                    if !contains(&slope_box(e, sigma_h, &map.params), s) {
+                        return;
                     }
-                    if l == 0 {
-                        let e = &map.elements[y * nx + x];
-                        if !contains(&slope_box(e, sigma_h, &map.params), s) {
-                            continue;
-                        }
-                        let Some((w, d)) = self.geo.weight(x as i64 + x_off, y as i64 + y_off)
-                        else {
-                            continue;
-                        };
-                        touched += 1;
-                        let (mean, cov) = self.geo.lobe(e, d);
-                        acc += w * gaussian(sd, mean, cov);
-                        continue;
-                    }
-                    if !contains(tree.node_box(l, x, y), s) {
-                        continue;
-                    }
-                    let [cw, ch] = tree.sizes[l - 1];
-                    for cy in (2 * y)..(2 * y + 2).min(ch) {
-                        for cx in (2 * x)..(2 * x + 2).min(cw) {
-                            stack[len] = ((l - 1) as u8, cx as u32, cy as u32);
-                            len += 1;
-                        }
-                    }
-                }
+                    let Some((w, d)) = self.geo.weight(x as i64 + x_off, y as i64 + y_off) else {
+                        return;
+                    };
+                    touched += 1;
+                    let (mean, cov) = self.geo.lobe(e, d);
+                    acc += w * gaussian(sd, mean, cov);
+                });
             }
         }
         (acc, touched)

@@ -425,53 +425,27 @@ impl<'a> MixturePatch<'a> {
         let leaf = LeafEval::new(mix.params.sigma_min, mix.box_k);
         let mut acc = 0.0f64;
         let mut touched = 0usize;
-        // Depth-first stack: at most 3 pending siblings per level + 1, levels ≤ 33.
-        let mut stack = [(0u8, 0u32, 0u32); 128];
         for &(x_lo, x_hi, x_off) in &xs[..nxs] {
             for &(y_lo, y_hi, y_off) in &ys[..nys] {
-                let mut len = 1;
-                stack[0] = (tree.top() as u8, 0, 0);
-                while len > 0 {
-                    len -= 1;
-                    let (l, x, y) = stack[len];
-                    let (l, x, y) = (l as usize, x as usize, y as usize);
-                    let (bx0, by0) = (x << l, y << l);
-                    let (bx1, by1) = ((x + 1) << l, (y + 1) << l);
-                    if bx1 <= x_lo || bx0 >= x_hi || by1 <= y_lo || by0 >= y_hi {
-                        continue;
-                    }
-                    if l == 0 {
-                        let k = y * nx + x;
-                        let p22 = match leaf.p22_in_box(&mix.lobes[k], s) {
-                            Leaf::Outside => continue,
-                            Leaf::Inside(p) => p,
-                            // Non-finite moments: the lobe's documented fallback.
-                            Leaf::Degenerate => {
-                                let lobe = mix.lobe_at(k);
-                                if !contains(&lobe_box(&lobe, mix.box_k), s) {
-                                    continue;
-                                }
-                                lobe.p22(s) as f64
+                tree.for_each_leaf((x_lo, x_hi), (y_lo, y_hi), s, |x, y| {
+                    let k = y * nx + x;
+                    let p22 = match leaf.p22_in_box(&mix.lobes[k], s) {
+                        Leaf::Outside => return,
+                        Leaf::Inside(p) => p,
+                        // Non-finite moments: the lobe's documented fallback.
+                        Leaf::Degenerate => {
+                            let lobe = mix.lobe_at(k);
+                            if !contains(&lobe_box(&lobe, mix.box_k), s) {
+                                return;
                             }
-                        };
-                        touched += 1;
-                        let sx = (x as i64 + x_off) as usize;
-                        let sy = (y as i64 + y_off) as usize;
-                        let w = g.weights[sy * lx + sx];
-                        acc += w as f64 * p22;
-                        continue;
-                    }
-                    if !contains(tree.node_box(l, x, y), s) {
-                        continue;
-                    }
-                    let [cw, ch] = tree.sizes[l - 1];
-                    for cy in (2 * y)..(2 * y + 2).min(ch) {
-                        for cx in (2 * x)..(2 * x + 2).min(cw) {
-                            stack[len] = ((l - 1) as u8, cx as u32, cy as u32);
-                            len += 1;
+                            lobe.p22(s) as f64
                         }
-                    }
-                }
+                    };
+                    touched += 1;
+                    let sx = (x as i64 + x_off) as usize;
+                    let sy = (y as i64 + y_off) as usize;
+                    acc += g.weights[sy * lx + sx] as f64 * p22;
+                });
             }
         }
         (acc, touched)
