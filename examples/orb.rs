@@ -222,7 +222,9 @@ mod tests {
             };
             let m = load_map(&opts).unwrap();
             let ((a, b, _), methods) = render_all(&opts, &m).unwrap();
-            assert_eq!(methods.len(), 4);
+            // Five glint renders (mixture exact, approximate, filtered lobe, bin map,
+            // position-normal) and naive 16 spp.
+            assert_eq!(methods.len(), 6);
             let mask = coverage(&Scene::new(SIZE, opts.tiles, cosine));
             for img in [&a, &b].into_iter().chain(methods.iter().map(|r| &r.image)) {
                 assert_eq!(img.pixels.len(), (SIZE * SIZE) as usize);
