@@ -79,6 +79,26 @@ pub fn half_vector(wo: Vec3, wi: Vec3) -> Option<Vec3> {
     (wo + wi).try_normalize()
 }
 
+/// The half vector ω_h of two unit directions and the cosine ω_o·ω_h (= ω_i·ω_h), taken as
+/// ‖ω_o + ω_i‖ / 2.
+///
+/// For unit ω_o, ω_i: ω_o·ω_h = (1 + ω_o·ω_i) / ‖ω_o + ω_i‖ = ‖ω_o + ω_i‖ / 2. The dot product loses
+/// every digit as ω_i → −ω_o, where 1 + ω_o·ω_i falls below f32's resolution: a sampler reflecting a
+/// grazing ω_o (cos θo ~ 10⁻⁶) about a micronormal near the pole returns ω_i ≈ −ω_o, and ω_o·ω_h then
+/// comes out of the order of 10⁻³ and of either sign where the true value is ~10⁻⁵. The norm keeps
+/// its relative accuracy. Symmetric in (ω_o, ω_i) to the last bit. `None` as [`half_vector`].
+#[inline]
+pub fn half_vector_cos(wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
+    let s = wo + wi;
+    let len = s.length();
+    if len > 0.0 && len.is_finite() {
+        let h = s / len;
+        h.is_finite().then_some((h, 0.5 * len))
+    } else {
+        None
+    }
+}
+
 /// The slope ñ = (−x/z, −y/z) of a normal ω_n = (x, y, z) (Chermain 2019, §3).
 ///
 /// Returns `None` for normals with z ≤ 0 or non-finite components (slopes are undefined there).

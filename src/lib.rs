@@ -40,7 +40,7 @@ pub use bxdf::{
 };
 pub use error::{Error, Result};
 pub use fresnel::Fresnel;
-pub use glam::{Vec2, Vec3};
+pub use glam::{Mat2, Vec2, Vec3};
 pub use ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
 
 /// The README's examples, compiled and run as doctests so that the quick start stays true.

@@ -20,6 +20,22 @@
 /// 1/√π.
 pub(crate) const INV_SQRT_PI: f32 = 0.564_189_6;
 
+/// An f64 density or area as f32, or 0 where it is negative, NaN or overflows f32 (a huge non-unit
+/// direction can push a sum past f32's range): what the "never NaN, never ∞" promise of the
+/// evaluators rests on at the f64 → f32 boundary.
+#[inline]
+pub(crate) fn finite_or_zero(v: f64) -> f32 {
+    finite_f32(v).max(0.0)
+}
+
+/// A signed f64 quantity (a leaning patch's projected area) as f32, or 0 where it is NaN or
+/// overflows f32.
+#[inline]
+pub(crate) fn finite_f32(v: f64) -> f32 {
+    let v = v as f32;
+    if v.is_finite() { v } else { 0.0 }
+}
+
 /// atan2(y, x) for x, y ≥ 0 (the first quadrant), approximately: a degree-11 odd minimax
 /// polynomial in r = min/max on [0, 1], reflected about π/4.
 ///

@@ -9,7 +9,7 @@ use super::lambert::unit_rgb;
 use super::lobe::{cosine_power, sample_cosine_power};
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::{Error, Result, non_negative};
-use crate::frame::{half_vector, is_upper, reflect};
+use crate::frame::{half_vector, half_vector_cos, is_upper, reflect};
 use crate::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
@@ -152,10 +152,10 @@ impl Bxdf for BlinnPhongLobe {
         if !(is_upper(wo) && is_upper(wi)) {
             return 0.0;
         }
-        let Some(h) = half_vector(wo, wi) else {
+        // c = ‖wo + wi‖/2, not wo·h, which cancels where wi → −wo (frame::half_vector_cos).
+        let Some((h, c)) = half_vector_cos(wo, wi) else {
             return 0.0;
         };
-        let c = wo.dot(h);
         let spec = if c > 0.0 {
             (self.gamma + 1.0) / TAU * cosine_power(h.z, self.gamma) / (4.0 * c)
         } else {
@@ -184,12 +184,7 @@ impl Bxdf for BlinnPhongLobe {
             return None;
         }
         let (f, pdf) = self.eval_pdf(wo, wi);
-        (pdf > 0.0 && pdf.is_finite()).then_some(BxdfSample {
-            wi,
-            f,
-            pdf,
-            flags: LobeFlags::REFLECTION | lobe,
-        })
+        BxdfSample::checked(wi, f, pdf, LobeFlags::REFLECTION | lobe)
     }
 }
 

@@ -79,12 +79,12 @@ impl Bxdf for Lambert {
         }
         let wi = square_to_cosine_hemisphere(u);
         let pdf = self.pdf(wo, wi);
-        (pdf > 0.0).then(|| BxdfSample {
+        BxdfSample::checked(
             wi,
-            f: self.albedo * FRAC_1_PI,
+            self.albedo * FRAC_1_PI,
             pdf,
-            flags: LobeFlags::REFLECTION | LobeFlags::DIFFUSE,
-        })
+            LobeFlags::REFLECTION | LobeFlags::DIFFUSE,
+        )
     }
 }
 

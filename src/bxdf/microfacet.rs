@@ -13,7 +13,7 @@
 //! of A_o, A_i vanishes while the corresponding V does not.
 
 use super::{Bxdf, BxdfSample, LobeFlags};
-use crate::frame::{half_vector, is_upper, reflect};
+use crate::frame::{half_vector_cos, is_upper, reflect};
 use crate::fresnel::Fresnel;
 use crate::ndf::Ndf;
 use glam::{Vec2, Vec3};
@@ -169,11 +169,9 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
         if !(is_upper(wo) && is_upper(wi)) {
             return None;
         }
-        let h = half_vector(wo, wi)?;
-        // wo·h = wi·h in exact arithmetic; their mean is symmetric in (wo, wi) to the last bit, which
-        // keeps F(wo·h) and the Jacobian exactly reciprocal even where wo + wi is small and rounding
-        // makes the two dot products differ.
-        let c = 0.5 * (wo.dot(h) + wi.dot(h));
+        // c = ‖wo + wi‖/2 rather than wo·h: exact where wi → −wo (frame::half_vector_cos) and
+        // symmetric in (wo, wi), so F(c) and the Jacobian 1/(4c) stay reciprocal to the last bit.
+        let (h, c) = half_vector_cos(wo, wi)?;
         (c > 0.0).then_some((h, c))
     }
 
@@ -231,11 +229,6 @@ impl<D: Ndf, F: Fresnel> Bxdf for MicrofacetBrdf<D, F> {
         // f and pdf are evaluated at the drawn wi (through its recomputed half vector, equal to m up to
         // rounding), so that they agree exactly with `eval` and `pdf`.
         let (f, pdf) = self.eval_pdf(wo, wi);
-        (pdf > 0.0).then_some(BxdfSample {
-            wi,
-            f,
-            pdf,
-            flags: LobeFlags::REFLECTION | LobeFlags::GLOSSY,
-        })
+        BxdfSample::checked(wi, f, pdf, LobeFlags::REFLECTION | LobeFlags::GLOSSY)
     }
 }

@@ -82,6 +82,23 @@ pub struct BxdfSample {
 }
 
 impl BxdfSample {
+    /// A sample, if it is usable: a finite positive `pdf`, a finite `f`, a finite upper-hemisphere
+    /// `wi` and a finite weight f · cos θi / pdf; otherwise `None`.
+    ///
+    /// Every sampler of the crate finishes through this check, so that `Some` always means a sample a
+    /// renderer can use as it is. The weight test matters only at the numerical edge: a pdf near
+    /// f32's smallest normal (cos θo ~ 10⁻⁴⁰) can make f · cos θi / pdf overflow.
+    #[inline]
+    pub fn checked(wi: Vec3, f: Vec3, pdf: f32, flags: LobeFlags) -> Option<BxdfSample> {
+        let usable = pdf > 0.0
+            && pdf.is_finite()
+            && f.is_finite()
+            && wi.is_finite()
+            && wi.z > 0.0
+            && (f * (wi.z / pdf)).is_finite();
+        usable.then_some(BxdfSample { wi, f, pdf, flags })
+    }
+
     /// The Monte Carlo weight f · cos θ_i / pdf.
     #[inline]
     pub fn weight(&self) -> Vec3 {

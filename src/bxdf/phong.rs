@@ -88,10 +88,10 @@ fn sample_mixture(
 }
 
 /// Finishes a sample: evaluates f and the pdf at the drawn direction so that both agree exactly with
-/// `eval` and `pdf`; `None` when the pdf is not finite and positive.
+/// `eval` and `pdf`; `None` unless usable ([`BxdfSample::checked`]).
 #[inline]
 fn finish(wi: Vec3, flags: LobeFlags, f: Vec3, pdf: f32) -> Option<BxdfSample> {
-    (pdf > 0.0 && pdf.is_finite() && f.is_finite()).then_some(BxdfSample { wi, f, pdf, flags })
+    BxdfSample::checked(wi, f, pdf, flags)
 }
 
 /// Replaces a non-finite value by 0 (only reachable through f32 overflow at extreme parameters).

@@ -333,7 +333,9 @@ impl Ndf for Beckmann {
             return 0.0;
         }
         let n = Vec2::new(self.alpha_x * w.x, self.alpha_y * w.y).length();
-        visible_area_of(w.z / n, w.z, n)
+        // Finite for unit w; the check keeps an overflowing non-unit w at 0.
+        let v = visible_area_of(w.z / n, w.z, n);
+        if v.is_finite() { v } else { 0.0 }
     }
 
     /// G1(w, m) = χ⁺(w·m) / (1 + Λ(w)).

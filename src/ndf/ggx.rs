@@ -107,7 +107,11 @@ impl Ndf for Ggx {
     #[inline]
     fn visible_area(&self, w: Vec3) -> f32 {
         match self.stretched_sin(w) {
-            Some(n) => 0.5 * (w.z + Vec2::new(w.z, n).length()),
+            Some(n) => {
+                // Finite for unit w; the check keeps an overflowing non-unit w at 0.
+                let v = 0.5 * (w.z + Vec2::new(w.z, n).length());
+                if v.is_finite() { v } else { 0.0 }
+            }
             None => 0.0,
         }
     }

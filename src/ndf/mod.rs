@@ -42,9 +42,9 @@ pub trait Ndf {
     fn lambda(&self, w: Vec3) -> f32;
 
     /// A(w): projected area of the microsurface toward `w` per unit geometric area.
-    /// cos θ_w for a centred NDF (the default), 0 below the horizon.
+    /// cos θ_w for a centred NDF (the default), 0 below the horizon or for a non-finite `w`.
     fn projected_area(&self, w: Vec3) -> f32 {
-        w.z.max(0.0)
+        if w.is_finite() { w.z.max(0.0) } else { 0.0 }
     }
 
     /// ∫ ⟨w, m⟩ D(m) dm = A(w) (1 + Λ(w)): the projected area of the micronormals that face `w`.
@@ -54,11 +54,8 @@ pub trait Ndf {
     /// product (non-centred lobes, patches).
     fn visible_area(&self, w: Vec3) -> f32 {
         let a = self.projected_area(w);
-        if a > 0.0 {
-            a * (1.0 + self.lambda(w))
-        } else {
-            0.0
-        }
+        let v = a * (1.0 + self.lambda(w));
+        if a > 0.0 && v.is_finite() { v } else { 0.0 }
     }
 
     /// Smith masking G1(w, m) = χ⁺(w·m) / (1 + Λ(w)) = χ⁺(w·m) A(w) / ∫⟨w, m'⟩ D dm'.
@@ -96,9 +93,11 @@ pub trait Ndf {
     /// Draws a micronormal m with density D(m) cos θ_m (per unit solid angle), from `u` ∈ [0, 1)².
     fn sample_normal(&self, u: Vec2) -> Vec3;
 
-    /// Density of [`Ndf::sample_normal`]: D(m) cos θ_m.
+    /// Density of [`Ndf::sample_normal`]: D(m) cos θ_m (0 where that is not finite, e.g. for a
+    /// non-finite m, where 0 · ∞ would be NaN).
     fn pdf_normal(&self, m: Vec3) -> f32 {
-        self.d(m) * m.z.max(0.0)
+        let p = self.d(m) * m.z.max(0.0);
+        if p.is_finite() { p } else { 0.0 }
     }
 
     /// Draws a micronormal visible from `wo`, with density D_wo(m) = G1(wo, m) ⟨wo, m⟩ D(m) / A(wo).

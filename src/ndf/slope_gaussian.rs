@@ -16,6 +16,7 @@
 use super::Ndf;
 use super::gauss;
 use crate::error::{Error, Result, positive};
+use crate::math::{finite_f32, finite_or_zero};
 use glam::{Mat2, Vec2, Vec3};
 use std::f64::consts::PI;
 
@@ -301,7 +302,7 @@ impl SlopeGaussian {
     /// \[Chermain2019\] eq. 17 (per lobe, unclamped).
     #[inline]
     pub fn signed_projected_area(&self, w: Vec3) -> f32 {
-        self.view_terms(w).map_or(0.0, |t| t.a_s as f32)
+        self.view_terms(w).map_or(0.0, |t| finite_f32(t.a_s))
     }
 
     /// Both projected areas toward w at once: A_s(w) and V(w) (see [`VisibleAreaParts`]), for
@@ -313,8 +314,8 @@ impl SlopeGaussian {
     pub fn visible_area_parts(&self, w: Vec3) -> VisibleAreaParts {
         match self.view_terms(w) {
             Some(t) => VisibleAreaParts {
-                signed_area: t.a_s as f32,
-                visible_area: visible_area_f64(&t) as f32,
+                signed_area: finite_f32(t.a_s),
+                visible_area: finite_or_zero(visible_area_f64(&t)),
             },
             None => VisibleAreaParts::default(),
         }
@@ -422,7 +423,7 @@ impl Ndf for SlopeGaussian {
     /// \[Chermain2019\] eq. 17 (one lobe).
     #[inline]
     fn projected_area(&self, w: Vec3) -> f32 {
-        self.view_terms(w).map_or(0.0, |t| t.a_s.max(0.0) as f32)
+        self.view_terms(w).map_or(0.0, |t| finite_or_zero(t.a_s))
     }
 
     /// V(w) = ∫ ⟨w, m⟩⁺ D(m) dm = s_w G(A_s / s_w) = A_s Φ(z) + s_w φ(z), exact for every w.
@@ -436,7 +437,7 @@ impl Ndf for SlopeGaussian {
     #[inline]
     fn visible_area(&self, w: Vec3) -> f32 {
         self.view_terms(w)
-            .map_or(0.0, |t| visible_area_f64(&t) as f32)
+            .map_or(0.0, |t| finite_or_zero(visible_area_f64(&t)))
     }
 
     /// Exact sampling of D(m) cos θ_m: slope = μ + L z, z = Box–Muller(u).

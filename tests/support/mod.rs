@@ -5,6 +5,7 @@
 
 pub mod chi2;
 pub mod quadrature;
+pub mod totality;
 
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;

@@ -6,8 +6,9 @@
 
 use super::clip::{Overlap, Parallelogram};
 use super::forest::QueryStats;
-use super::{BinMap, EXACT_MASKING_TEXELS};
+use super::{BinFacet, BinMap, EXACT_MASKING_TEXELS};
 use crate::glint::{Footprint, MIN_WIDTH_TEXELS};
+use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
 use crate::warp::square_to_gaussian_2d;
 use glam::{Vec2, Vec3};
@@ -35,10 +36,13 @@ const SMOOTH_TAIL: f64 = 1e-6;
 ///
 /// **Masking** (the talk defines none). For footprints of at most [`EXACT_MASKING_TEXELS`] texels,
 /// Smith terms of the bin-map D itself, from the footprint's bins enumerated once per patch
-/// (O(|A|), through 𝓑): V(w) = ∫⟨w, m⟩⁺ D dm ≈ Σ_j mass_j ⟨w, c_j⟩⁺ / c̄_j (each bin's D is constant,
-/// so the integral is exact with the bin's mean direction in place of its centre c_j), the signed
-/// projected area A(w) = max(Σ_j mass_j ⟨w, c_j⟩ / c̄_j, 0) and Λ = V/A − 1, the same construction as
-/// the mixture's exact terms (\[Chermain2019\] eq. 13-17). Larger footprints use the Smith terms of
+/// (O(|A|), through 𝓑). Each bin's D is constant, so with m̄_j = (1/|H|) ∫_{H_j} m dω the bin's mean
+/// direction vector (tabulated per bin at build), the projected area A(w) = max(Σ_j mass_j ⟨w, m̄_j⟩
+/// / c̄_j, 0) is exact, and so is V(w) = ∫⟨w, m⟩⁺ D dm = Σ_j (mass_j / c̄_j) (1/|H|) ∫_{H_j} ⟨w, m⟩⁺ dω
+/// for every bin that faces w entirely; for a bin cut by w's horizon (within about one bin width of
+/// grazing) the bin's term is replaced by an upper bound, so that G1 = A/V can only err low and the
+/// BRDF never gains energy (see `visible_part`).
+/// Λ = V/A − 1, the same construction as the mixture's exact terms (\[Chermain2019\] eq. 13-17). Larger footprints use the Smith terms of
 /// the footprint's filtered-moment Beckmann lobe ([`SlopeGaussian::from_moments`] of the map's
 /// moment mip chain at the footprint centre and radius ½√|A|, σ floored at `sigma_min`), whose
 /// first two slope moments approximate the footprint's. See docs/binmap.md and the white furnace in
@@ -294,9 +298,9 @@ impl<'a> BinMapPatch<'a> {
 /// The footprint's bins with their masses, for masking terms computed from the bin-map D itself.
 #[derive(Clone, Debug)]
 struct ExactMasking {
-    /// Per non-empty bin: mass_j · c_j / c̄_j (c_j the bin's centre direction, c̄_j its mean cosine).
-    facets: Vec<Vec3>,
-    /// Σ of `facets`: A(w) = max(w · a, 0).
+    /// Per non-empty bin j, its [`BinFacet`] scaled by s_j = mass_j / c̄_j.
+    facets: Vec<BinFacet>,
+    /// Σ_j s_j m̄_j: A(w) = max(w · a, 0).
     a: Vec3,
 }
 
@@ -331,19 +335,23 @@ impl ExactMasking {
         let mut a = [0.0f64; 3];
         let mut k = 0;
         while k < acc.len() {
-            let bin = acc[k].0;
+            let bin = acc[k].0 as usize;
             let mut mass = 0.0;
-            while k < acc.len() && acc[k].0 == bin {
+            while k < acc.len() && acc[k].0 as usize == bin {
                 mass += acc[k].1;
                 k += 1;
             }
-            let c = map.bins.center(bin as usize).to_array();
-            let scale = mass * inv_area / map.mean_cos[bin as usize] as f64;
-            let f: [f64; 3] = std::array::from_fn(|i| c[i] as f64 * scale);
-            for i in 0..3 {
-                a[i] += f[i];
+            let f = map.facets[bin];
+            let scale = mass * inv_area / map.mean_cos[bin] as f64;
+            for (ai, m) in a.iter_mut().zip(f.mean.to_array()) {
+                *ai += m as f64 * scale;
             }
-            facets.push(Vec3::new(f[0] as f32, f[1] as f32, f[2] as f32));
+            let s = scale as f32;
+            facets.push(BinFacet {
+                mean: f.mean * s,
+                center: f.center * s,
+                radius: f.radius * s,
+            });
         }
         ExactMasking {
             facets,
@@ -351,14 +359,29 @@ impl ExactMasking {
         }
     }
 
-    /// V(w) = Σ_j mass_j ⟨w, c_j⟩⁺ / c̄_j.
+    /// V(w) = Σ_j s_j (1/|H|) ∫_{H_j} ⟨w, m⟩⁺ dω, exact for the bins that face w entirely and bounded
+    /// from above for those that w's horizon cuts (type docs).
     fn visible_area(&self, w: Vec3) -> f32 {
-        let v: f64 = self
-            .facets
-            .iter()
-            .map(|f| (w.dot(*f) as f64).max(0.0))
-            .sum();
-        v as f32
+        let v: f64 = self.facets.iter().map(|f| visible_part(f, w) as f64).sum();
+        finite_or_zero(v)
+    }
+}
+
+/// One bin's (1/|H|) ∫_{H_j} ⟨w, m⟩⁺ dω, scaled by s_j (every field of `f` carries the factor).
+///
+/// If ⟨w, c_j⟩ ≥ r_j the whole bin faces w and the integral is linear: ⟨w, m̄_j⟩, exact. Otherwise
+/// (w's horizon cuts the bin, which happens only within r_j ≈ 1.5·√(2π)/n rad of grazing for a pole
+/// bin) it is bounded from above by both ⟨w, m̄_j⟩ + (r_j − ⟨w, c_j⟩) (the mean of ⟨w, m⟩ plus the
+/// largest ⟨w, m⟩⁻ in the bin) and ⟨w, c_j⟩ + r_j (the largest ⟨w, m⟩⁺). An upper bound of V is a
+/// lower bound of G1 = A/V: the BRDF may lose a little energy at grazing angles but never creates
+/// any (the white furnace in tests/robustness.rs and tests/binmap.rs).
+#[inline]
+fn visible_part(f: &BinFacet, w: Vec3) -> f32 {
+    let (lin, c) = (w.dot(f.mean), w.dot(f.center));
+    if c >= f.radius {
+        lin.max(0.0)
+    } else {
+        (lin + f.radius - c).min(c + f.radius).max(0.0)
     }
 }
 
@@ -376,11 +399,6 @@ fn rehash(u: Vec2) -> Vec2 {
         (x >> 40) as f32 / (1u64 << 24) as f32
     };
     Vec2::new(next(), next())
-}
-
-fn finite_or_zero(v: f64) -> f32 {
-    let v = v as f32;
-    if v.is_finite() { v.max(0.0) } else { 0.0 }
 }
 
 impl Ndf for BinMapPatch<'_> {
@@ -405,19 +423,20 @@ impl Ndf for BinMapPatch<'_> {
         ((self.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
     }
 
-    /// A(w) = max(w · Σ_j mass_j c_j / c̄_j, 0) (exact terms) or the masking lobe's
+    /// A(w) = max(w · Σ_j mass_j m̄_j / c̄_j, 0) (exact terms) or the masking lobe's
     /// max(cos θ − w_xy·μ, 0).
     fn projected_area(&self, w: Vec3) -> f32 {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
         }
         match &self.exact {
-            Some(e) => w.dot(e.a).max(0.0),
+            Some(e) => finite_or_zero(w.dot(e.a) as f64),
             None => self.lobe.signed_projected_area(w).max(0.0),
         }
     }
 
-    /// V(w) = Σ_j mass_j ⟨w, c_j⟩⁺ / c̄_j (exact terms) or the masking lobe's V.
+    /// V(w) = Σ_j (mass_j / c̄_j) (1/|H|) ∫_{H_j} ⟨w, m⟩⁺ dω (exact terms, bounded from above for bins
+    /// cut by w's horizon) or the masking lobe's V.
     fn visible_area(&self, w: Vec3) -> f32 {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;

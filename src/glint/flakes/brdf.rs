@@ -4,7 +4,7 @@
 
 use crate::bxdf::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::Result;
-use crate::frame::{half_vector, is_upper, reflect};
+use crate::frame::{half_vector_cos, is_upper, reflect};
 use crate::fresnel::Fresnel;
 use crate::ndf::{Beckmann, Ndf};
 use glam::{Vec2, Vec3};
@@ -75,8 +75,9 @@ impl<D: Ndf, F: Fresnel> PositionNormalBrdf<D, F> {
         if !(is_upper(wo) && is_upper(wi)) {
             return None;
         }
-        let h = half_vector(wo, wi)?;
-        let c = 0.5 * (wo.dot(h) + wi.dot(h));
+        // c = ‖wo + wi‖/2 rather than wo·h: exact where wi → −wo (frame::half_vector_cos) and
+        // symmetric in (wo, wi), so F(c) and the Jacobian 1/(4c) stay reciprocal to the last bit.
+        let (h, c) = half_vector_cos(wo, wi)?;
         (c > 0.0).then_some((h, c))
     }
 
@@ -130,11 +131,6 @@ impl<D: Ndf, F: Fresnel> Bxdf for PositionNormalBrdf<D, F> {
         }
         let wi = reflect(wo, m);
         let (f, pdf) = self.eval_pdf(wo, wi);
-        (pdf > 0.0).then_some(BxdfSample {
-            wi,
-            f,
-            pdf,
-            flags: LobeFlags::REFLECTION | LobeFlags::GLOSSY,
-        })
+        BxdfSample::checked(wi, f, pdf, LobeFlags::REFLECTION | LobeFlags::GLOSSY)
     }
 }

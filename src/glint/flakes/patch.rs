@@ -13,6 +13,7 @@ use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::cdf::invert_cdf;
 use crate::glint::slope_tree::contains;
+use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
 use std::sync::OnceLock;
@@ -391,7 +392,7 @@ impl<'a> PositionNormalPatch<'a> {
 
     /// Σ W_i V_i(w) over every kept element (the exact visible area of the P-NDF), in `f64`.
     pub fn visible_area_exact(&self, w: Vec3) -> f32 {
-        self.exact_visible_area(w) as f32
+        finite_or_zero(self.exact_visible_area(w))
     }
 
     fn exact_visible_area(&self, w: Vec3) -> f64 {
@@ -467,7 +468,8 @@ impl Ndf for PositionNormalPatch<'_> {
             return 0.0;
         }
         let p = self.untruncated_d(m) * m.z as f64;
-        if p.is_finite() { p as f32 } else { 0.0 }
+        let p = p as f32;
+        if p.is_finite() { p } else { 0.0 }
     }
 
     /// m ~ Σ W_i ⟨wo, m⟩⁺ D_i(m) / Σ W_i V_i(wo): element ∝ W_i V_i(wo), then its visible normal.

@@ -14,6 +14,7 @@ use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::cdf::invert_cdf;
 use crate::glint::slope_tree::contains;
+use crate::math::{finite_f32, finite_or_zero};
 use crate::ndf::{DEFAULT_SIGMA_MIN, Ndf, SIGMA_MIN_FLOOR, SlopeGaussian};
 use glam::{Vec2, Vec3};
 use std::sync::OnceLock;
@@ -476,7 +477,7 @@ impl<'a> MixturePatch<'a> {
     /// \[Chermain2019\] eq. 12-13 (with V_i in place of the clamped ⟨ω_n̄i, w⟩/(ω_n̄i·ω_g)(1 + Λ_i)).
     pub fn visible_area_exact(&self, w: Vec3) -> f32 {
         match &self.gathered {
-            Some(g) => self.exact_visible_area(g, w) as f32,
+            Some(g) => finite_or_zero(self.exact_visible_area(g, w)),
             None => self.filtered.visible_area(w),
         }
     }
@@ -491,7 +492,7 @@ impl<'a> MixturePatch<'a> {
             return 0.0;
         }
         let mu = self.mean_slope();
-        (w.z as f64 - (mu.x as f64 * w.x as f64 + mu.y as f64 * w.y as f64)) as f32
+        finite_f32(w.z as f64 - (mu.x as f64 * w.x as f64 + mu.y as f64 * w.y as f64))
     }
 
     /// The paper's patch projected area with clamped per-lobe areas, Σ W_i max(cos θ − w_xy·μ_i, 0)
@@ -544,7 +545,7 @@ impl Ndf for MixturePatch<'_> {
     /// V_P(w) = A_P (1 + Λ_P): exact Σ W_i V_i(w), or the filtered lobe's V.
     fn visible_area(&self, w: Vec3) -> f32 {
         match (&self.gathered, self.masking) {
-            (Some(g), MaskingMode::Exact) => self.exact_visible_area(g, w) as f32,
+            (Some(g), MaskingMode::Exact) => finite_or_zero(self.exact_visible_area(g, w)),
             _ => self.filtered.visible_area(w),
         }
     }
@@ -604,7 +605,8 @@ impl Ndf for MixturePatch<'_> {
             return 0.0;
         }
         let p = self.untruncated_d(g, m) * m.z as f64;
-        if p.is_finite() { p as f32 } else { 0.0 }
+        let p = p as f32;
+        if p.is_finite() { p } else { 0.0 }
     }
 
     /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe, with the exact V_P in every masking
