@@ -1,0 +1,45 @@
+//! Inverse bin map (Atanasov 2020): build on an arbitrary small map with arbitrary bin counts and leaf
+//! sizes, patch (plain and smoothed) through an arbitrary footprint, query and sample.
+#![no_main]
+
+use arbitrary::Arbitrary;
+use brdf::glint::{BinLookup, BinMap, BinMapParams};
+use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
+use brdf_fuzz::{FootprintInput, MapInput, Probe, check_bxdf, check_ndf};
+use libfuzzer_sys::fuzz_target;
+
+#[derive(Arbitrary, Debug)]
+struct Input {
+    map: MapInput,
+    bins_per_axis: u8,
+    leaf_size: u8,
+    hashed: bool,
+    sigma_min: f32,
+    smoothing_alpha: f32,
+    footprint: FootprintInput,
+    probe: Probe,
+}
+
+fuzz_target!(|input: Input| {
+    let Some(map) = input.map.build() else { return };
+    let params = BinMapParams {
+        bins_per_axis: input.bins_per_axis as usize,
+        leaf_size: input.leaf_size as usize,
+        lookup: if input.hashed {
+            BinLookup::Hash
+        } else {
+            BinLookup::Dense
+        },
+        sigma_min: input.sigma_min,
+    };
+    let Ok(bin_map) = BinMap::build(&map, params) else {
+        return;
+    };
+    let footprint = input.footprint.build();
+    let patch = bin_map.patch(&footprint);
+    check_ndf(&patch, &input.probe);
+    check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), &input.probe);
+    let smoothed = bin_map.patch_smoothed(&footprint, input.smoothing_alpha);
+    check_ndf(&smoothed, &input.probe);
+    check_bxdf(&MicrofacetBrdf::new(&smoothed, NoFresnel), &input.probe);
+});

@@ -1,0 +1,46 @@
+//! Beckmann mixture (Chermain 2019): build on an arbitrary small map with arbitrary parameters, patch
+//! through an arbitrary footprint, query and sample the patch and its P-BRDF.
+#![no_main]
+
+use arbitrary::Arbitrary;
+use brdf::glint::{BeckmannMixture, GlintNdf, MaskingMode, MixtureParams, PatchOptions};
+use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
+use brdf_fuzz::{FootprintInput, MapInput, Probe, check_bxdf, check_ndf};
+use libfuzzer_sys::fuzz_target;
+
+#[derive(Arbitrary, Debug)]
+struct Input {
+    map: MapInput,
+    spacing: f32,
+    sigma_min: f32,
+    samples: u8,
+    approximate: bool,
+    lod_lobes: f32,
+    footprint: FootprintInput,
+    probe: Probe,
+}
+
+fuzz_target!(|input: Input| {
+    let Some(map) = input.map.build() else { return };
+    let params = MixtureParams {
+        spacing: input.spacing,
+        sigma_min: input.sigma_min,
+        samples: input.samples as usize % 64,
+        patch: PatchOptions {
+            masking: if input.approximate {
+                MaskingMode::Approximate
+            } else {
+                MaskingMode::Exact
+            },
+            lod_lobes: input.lod_lobes,
+        },
+        ..MixtureParams::default()
+    };
+    // Out-of-range parameters must be refused at construction; the fuzzer keeps those that build.
+    let Ok(mixture) = BeckmannMixture::build(&map, params) else {
+        return;
+    };
+    let patch = mixture.patch(&input.footprint.build());
+    check_ndf(&patch, &input.probe);
+    check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), &input.probe);
+});

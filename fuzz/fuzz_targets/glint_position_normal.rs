@@ -1,0 +1,39 @@
+//! Position-normal Gaussians (Yan 2016): build on an arbitrary small map with arbitrary parameters,
+//! patch through an arbitrary footprint, query and sample the patch, the published BRDF and ours.
+#![no_main]
+
+use arbitrary::Arbitrary;
+use brdf::glint::{GlintNdf, PositionNormalBrdf, PositionNormalMap, PositionNormalParams};
+use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
+use brdf_fuzz::{FootprintInput, MapInput, Probe, check_bxdf, check_ndf};
+use libfuzzer_sys::fuzz_target;
+
+#[derive(Arbitrary, Debug)]
+struct Input {
+    map: MapInput,
+    sampling_rate: u8,
+    sigma_r: f32,
+    weight_sigmas: f32,
+    slope_sigmas: f32,
+    max_query_texels: f32,
+    footprint: FootprintInput,
+    probe: Probe,
+}
+
+fuzz_target!(|input: Input| {
+    let Some(map) = input.map.build() else { return };
+    let params = PositionNormalParams {
+        sampling_rate: input.sampling_rate as usize % 5,
+        sigma_r: input.sigma_r,
+        weight_sigmas: input.weight_sigmas,
+        slope_sigmas: input.slope_sigmas,
+        max_query_texels: input.max_query_texels,
+    };
+    let Ok(model) = PositionNormalMap::build(&map, params) else {
+        return;
+    };
+    let patch = model.patch(&input.footprint.build());
+    check_ndf(&patch, &input.probe);
+    check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), &input.probe);
+    check_bxdf(&PositionNormalBrdf::new(&patch, NoFresnel), &input.probe);
+});
