@@ -18,7 +18,7 @@ type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
 fn main() -> Res<()> {
     let out = common::out_dir()?;
     let quick = !common::has_flag("--full");
-    let parts: [(&str, &str, Part); 6] = [
+    let parts: [(&str, &str, Part); 7] = [
         (
             "Analytic core",
             "NDF slices, Smith masking and Fresnel curves.",
@@ -52,6 +52,13 @@ fn main() -> Res<()> {
             "Every glint method on the four procedural maps: distance to the ground truth against \
              cost, footprint size and view angle, and the white furnace (the compare example).",
             common::compare::run,
+        ),
+        (
+            "Grazing angles",
+            "Where masking and sampling break down as the view approaches the horizon: visible-area \
+             error, white furnace and the spread of the sample weight of every NDF and glint method \
+             (the grazing example).",
+            common::grazing::run,
         ),
     ];
     let mut sections = Vec::new();

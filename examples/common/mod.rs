@@ -7,6 +7,7 @@
 
 pub mod compare;
 pub mod curves;
+pub mod grazing;
 pub mod lobes;
 pub mod mixture_images;
 pub mod orb;

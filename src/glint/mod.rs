@@ -70,14 +70,15 @@ pub use binmap::{
 };
 pub use bins::HemisphereBins;
 pub use flakes::{
-    DEFAULT_MASKING_ALPHA, PositionNormalBrdf, PositionNormalMap, PositionNormalMemory,
-    PositionNormalParams, PositionNormalPatch,
+    DEFAULT_MASKING_ALPHA, EXACT_MASKING_ELEMENTS, PositionNormalBrdf, PositionNormalMap,
+    PositionNormalMemory, PositionNormalParams, PositionNormalPatch,
 };
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 pub use mixture::{
     BeckmannMixture, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES, DEFAULT_MASKING, DEFAULT_SAMPLES,
-    DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL, DEFAULT_SPACING, DEFAULT_WEIGHT_SIGMAS, MaskingMode,
-    MixtureMemory, MixtureParams, MixturePatch, PatchOptions,
+    DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL, DEFAULT_SPACING, DEFAULT_WEIGHT_SIGMAS,
+    MAX_TRUNCATION_SIGMAS, MIN_SPACING, MaskingMode, MixtureMemory, MixtureParams, MixturePatch,
+    PatchOptions,
 };
 pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,

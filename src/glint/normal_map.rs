@@ -15,7 +15,7 @@ use std::sync::OnceLock;
 /// The largest slope magnitude a map may hold: |ñ| ≤ 10⁴, i.e. normals at least 10⁻⁴ above the horizon
 /// (z ≥ 10⁻⁴, 89.994°). Larger slopes lose all precision in f32 sums of slope moments (x̃² ~ 10⁸ would
 /// swamp the other terms) and describe a surface no renderer can shade meaningfully.
-pub const MAX_SLOPE: f32 = 1.0e4;
+pub const MAX_SLOPE: f32 = crate::ndf::MAX_SLOPE;
 
 /// How a normal map file encodes the direction of its green (Y) channel.
 ///

@@ -40,6 +40,12 @@ const FACING_NUDGE: f64 = 1e-5;
 /// 1/(2π).
 const FRAC_1_2PI: f32 = 0.159_154_94;
 
+/// The largest slope magnitude a lobe (its mean, and the standard deviation along each axis) may
+/// have: 10⁴, i.e. a mean normal at least 10⁻⁴ above the horizon (89.994°). Beyond it the squares of
+/// slopes that the samplers and masking terms form approach f32's range, and no surface a renderer
+/// shades has such lobes. Equal to [`crate::glint::MAX_SLOPE`], the bound on normal-map slopes.
+pub const MAX_SLOPE: f32 = 1.0e4;
+
 /// A non-centred, anisotropic, correlated Beckmann lobe: a 2D Gaussian of microfacet slopes.
 ///
 /// P22(ñ) = exp(−½ (ñ − μ)ᵀ Σ⁻¹ (ñ − μ)) / (2π √|Σ|),  D(m) = P22(ñ(m)) / cos⁴θ_m,
@@ -93,17 +99,24 @@ impl SlopeGaussian {
     /// A lobe with mean slope `mean` and slope covariance `cov`.
     ///
     /// # Errors
-    /// - [`Error::InvalidParameter`] naming `mean` if a component of `mean` is not finite;
+    /// - [`Error::InvalidParameter`] naming `mean` if a component of `mean` is not finite or exceeds
+    ///   [`MAX_SLOPE`] in magnitude;
     /// - [`Error::InvalidMatrix`] naming `cov` if an entry is not finite, if `cov` is not symmetric
     ///   (|c₀₁ − c₁₀| > 1e-6 √(c₀₀ c₁₁); the two are then averaged), if it is not positive definite,
-    ///   or if it is so small or so large that L⁻¹ or the normalisation 1/(2π √|Σ|) leaves the normal
-    ///   `f32` range.
+    ///   if a variance exceeds [`MAX_SLOPE`]², or if it is so small that L⁻¹ or the normalisation
+    ///   1/(2π √|Σ|) leaves the normal `f32` range.
     ///
     /// # Reference
     /// \[Chermain2019\] eq. 4.
     pub fn new(mean: Vec2, cov: Mat2) -> Result<Self> {
         for v in [mean.x, mean.y] {
-            crate::error::finite("mean", v)?;
+            if !(v.abs() <= MAX_SLOPE) {
+                return Err(Error::InvalidParameter {
+                    name: "mean",
+                    value: v as f64,
+                    reason: "components must be finite with |μ| <= MAX_SLOPE = 1e4",
+                });
+            }
         }
         let c = cov.to_cols_array().map(f64::from);
         let (c00, c10, c01, c11) = (c[0], c[1], c[2], c[3]);
@@ -127,7 +140,9 @@ impl SlopeGaussian {
             return Err(err("must be positive definite (determinant > 0)"));
         }
         Self::from_cov_f64(mean, c00, sxy, c11)
-            .ok_or_else(|| err("too small or too large: L⁻¹ or 1/(2π√|Σ|) leaves the f32 range"))
+            .ok_or_else(|| {
+                err("too small or too large: a variance above MAX_SLOPE² = 1e8, or L⁻¹ or 1/(2π√|Σ|) leaves the f32 range")
+            })
     }
 
     /// The centred anisotropic Beckmann NDF of roughness (αx, αy): Σ = diag(αx²/2, αy²/2).
@@ -136,7 +151,8 @@ impl SlopeGaussian {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `alpha_x` / `alpha_y` if not finite and > 0, or naming
-    /// `alpha_x * alpha_y` if the lobe leaves the `f32` range (α below ~1e-18 or above ~1e18).
+    /// `alpha_x * alpha_y` if the lobe leaves the `f32` range (α below ~1e-18) or α exceeds
+    /// √2 · [`MAX_SLOPE`].
     ///
     /// # Reference
     /// \[Walter2007\] eq. 25; \[Chermain2019\] eq. 2 with μ = 0.
@@ -168,8 +184,8 @@ impl SlopeGaussian {
     /// `sigma_min`: non-finite or ≤ 0 → [`DEFAULT_SIGMA_MIN`]; positive values below
     /// [`SIGMA_MIN_FLOOR`] are raised to it.
     ///
-    /// Fallback: if a moment is not finite, or the result would leave the `f32` range (variances
-    /// above ~1e37), the centred isotropic lobe of σ = σ_min is returned.
+    /// Fallback: if a moment is not finite, the mean exceeds [`MAX_SLOPE`] or a variance
+    /// [`MAX_SLOPE`]², the centred isotropic lobe of σ = σ_min is returned.
     ///
     /// # Reference
     /// \[Chermain2019\] eq. 4-6.
@@ -214,7 +230,11 @@ impl SlopeGaussian {
     /// Builds the lobe from an `f64` covariance; `None` unless Σ is positive definite and L, L⁻¹ and
     /// the normalisation are finite normal `f32` numbers.
     fn from_cov_f64(mean: Vec2, sxx: f64, sxy: f64, syy: f64) -> Option<Self> {
-        if !(sxx > 0.0 && sxx.is_finite() && syy.is_finite() && sxy.is_finite()) {
+        let max_var = (MAX_SLOPE as f64) * (MAX_SLOPE as f64);
+        if !(sxx > 0.0 && sxx <= max_var && syy <= max_var && sxy.is_finite()) {
+            return None;
+        }
+        if !(mean.x.abs() <= MAX_SLOPE && mean.y.abs() <= MAX_SLOPE) {
             return None;
         }
         let l11 = sxx.sqrt();
@@ -303,6 +323,23 @@ impl SlopeGaussian {
     #[inline]
     pub fn signed_projected_area(&self, w: Vec3) -> f32 {
         self.view_terms(w).map_or(0.0, |t| finite_f32(t.a_s))
+    }
+
+    /// Scarf's upper bound of the visible area from the lobe's first two moments alone:
+    /// V⁺(w) = ½ (ā + √(ā² + s²)) with ā = cos θ − w_xy·μ and s² = w_xyᵀ Σ w_xy: the largest
+    /// E[(w_z − w_xy·ñ)⁺] over **every** slope distribution of mean μ and covariance Σ, so ≥ the
+    /// Gaussian lobe's own V and ≥ the V of any P-NDF whose first two slope moments these are.
+    /// Masking built on it can only over-shadow (G1 = A/V⁺ errs low), never create energy.
+    /// 0 for invalid `w`.
+    ///
+    /// # Reference
+    /// \[Scarf1958\], the bound E\[X⁺\] ≤ ½(E\[X\] + √(E\[X\]² + Var X)).
+    pub fn visible_area_bound(&self, w: Vec3) -> f32 {
+        let Some(t) = self.view_terms(w) else {
+            return 0.0;
+        };
+        // s_w² = |Lᵀ w_xy|² = w_xyᵀ Σ w_xy.
+        finite_or_zero(0.5 * (t.a_s + (t.a_s * t.a_s + t.s_w * t.s_w).sqrt()))
     }
 
     /// Both projected areas toward w at once: A_s(w) and V(w) (see [`VisibleAreaParts`]), for

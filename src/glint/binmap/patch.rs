@@ -11,7 +11,7 @@ use crate::glint::{Footprint, MIN_WIDTH_TEXELS};
 use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
 use crate::warp::square_to_gaussian_2d;
-use glam::{Vec2, Vec3};
+use glam::{Mat2, Vec2, Vec3};
 
 /// Mass left outside the truncation radius of each smoothing lobe: the isotropic slope Gaussian of σ
 /// has exp(−R²/(2σ²)) of its mass beyond R, so R = √(−2 ln 10⁻⁶) σ ≈ 5.26 σ. The smoothed D and
@@ -42,10 +42,15 @@ const SMOOTH_TAIL: f64 = 1e-6;
 /// for every bin that faces w entirely; for a bin cut by w's horizon (within about one bin width of
 /// grazing) the bin's term is replaced by an upper bound, so that G1 = A/V can only err low and the
 /// BRDF never gains energy (see `visible_part`).
-/// Λ = V/A − 1, the same construction as the mixture's exact terms (\[Chermain2019\] eq. 13-17). Larger footprints use the Smith terms of
+/// Λ = V/A − 1, the same construction as the mixture's exact terms (\[Chermain2019\] eq. 13-17).
+/// For the smoothed variant the sums run over the smoothing lobes instead, exactly as for a mixture:
+/// V(w) = Σ_j mass_j V_j(w) and A(w) = max(Σ_j mass_j (cos θ − w_xy·μ_j), 0), μ_j the centre slope
+/// of bin j (the unsmoothed bins' V under-counted the smoothed D's visible area: white furnace up to
+/// 1.25 at grazing angles before). Larger footprints use the Smith terms of
 /// the footprint's filtered-moment Beckmann lobe ([`SlopeGaussian::from_moments`] of the map's
 /// moment mip chain at the footprint centre and radius ½√|A|, σ floored at `sigma_min`), whose
-/// first two slope moments approximate the footprint's. See docs/binmap.md and the white furnace in
+/// first two slope moments approximate the footprint's (second moments raised by σ² for the
+/// smoothed variant). See docs/binmap.md and the white furnace in
 /// tests/binmap.rs. The lobe's V is replaced by Scarf's moment bound
 /// ([`BinMapPatch::moment_bound_visible_area`]) and A by its signed projected area, so Λ is
 /// conservative (a Gaussian's V can be below a spiky distribution's with the same moments).
@@ -89,17 +94,24 @@ impl<'a> BinMapPatch<'a> {
         let images = Self::images(&para, map.width as f64, map.height as f64);
         let center = Vec2::new(para.center()[0] as f32, para.center()[1] as f32);
         let radius = 0.5 * (para.area() as f32).sqrt();
-        let moments = map.moments.filtered(map.width, map.height, center, radius);
+        let sigma = alpha.map(|a| a as f64 / std::f64::consts::SQRT_2);
+        let mut moments = map.moments.filtered(map.width, map.height, center, radius);
+        if let Some(s) = sigma {
+            // Smoothing convolves the slope distribution with N(0, σ² I): the second moments grow
+            // by σ².
+            moments[2] += (s * s) as f32;
+            moments[3] += (s * s) as f32;
+        }
         let lobe = SlopeGaussian::from_moments(moments, map.params.sigma_min);
         let exact = (para.area() <= EXACT_MASKING_TEXELS as f64)
-            .then(|| ExactMasking::new(map, &para, &images));
+            .then(|| ExactMasking::new(map, &para, &images, sigma));
         BinMapPatch {
             map,
             para,
             images,
             lobe,
             exact,
-            sigma: alpha.map(|a| a as f64 / std::f64::consts::SQRT_2),
+            sigma,
         }
     }
 
@@ -128,27 +140,11 @@ impl<'a> BinMapPatch<'a> {
         self.images.len()
     }
 
-    /// Scarf's bound of the visible area from the masking lobe's first two moments:
-    /// V(w) = ½ (ā + √(ā² + s²)) with ā = cos θ − w_xy·μ and s² = w_xyᵀ Σ w_xy, the largest
-    /// E[(w_z − w_xy·ñ)⁺] over every slope distribution of mean μ and covariance Σ (≥ the Gaussian
-    /// lobe's own V). Conservative, so the white furnace stays ≤ 1 whatever the footprint's slope
-    /// distribution when the moments are the footprint's.
-    ///
-    /// # Reference
-    /// \[Scarf1958\], the bound
-    /// E\[X⁺\] ≤ ½(E\[X\] + √(E\[X\]² + Var X)).
+    /// Scarf's bound of the visible area from the masking lobe's first two moments
+    /// ([`SlopeGaussian::visible_area_bound`]): conservative, so the white furnace stays ≤ 1 whatever
+    /// the footprint's slope distribution when the moments are the footprint's.
     pub fn moment_bound_visible_area(&self, w: Vec3) -> f32 {
-        if !(w.z > 0.0 && w.is_finite()) {
-            return 0.0;
-        }
-        let a = self.lobe.signed_projected_area(w) as f64;
-        let c = self.lobe.covariance();
-        let (x, y) = (w.x as f64, w.y as f64);
-        let s2 = (c.x_axis.x as f64 * x * x
-            + 2.0 * c.y_axis.x as f64 * x * y
-            + c.y_axis.y as f64 * y * y)
-            .max(0.0);
-        finite_or_zero(0.5 * (a + (a * a + s2).sqrt()))
+        self.lobe.visible_area_bound(w)
     }
 
     /// Whether the masking terms are computed from the footprint's bins (|A| ≤
@@ -298,16 +294,24 @@ impl<'a> BinMapPatch<'a> {
 /// The footprint's bins with their masses, for masking terms computed from the bin-map D itself.
 #[derive(Clone, Debug)]
 struct ExactMasking {
-    /// Per non-empty bin j, its [`BinFacet`] scaled by s_j = mass_j / c̄_j.
+    /// Per non-empty bin j of the unsmoothed patch, its [`BinFacet`] scaled by s_j = mass_j / c̄_j.
     facets: Vec<BinFacet>,
-    /// Σ_j s_j m̄_j: A(w) = max(w · a, 0).
+    /// Per non-empty bin j of the smoothed patch, mass_j and its smoothing lobe D_j.
+    lobes: Vec<(f32, SlopeGaussian)>,
+    /// A(w) = max(w · a, 0): Σ_j s_j m̄_j (unsmoothed); Σ_j mass_j (−μ_j, 1) (smoothed, μ_j the
+    /// lobe's mean slope).
     a: Vec3,
 }
 
 impl ExactMasking {
     /// Enumerates the texels of A (every periodic image), their exact overlaps and bins through 𝓑:
     /// O(|A|) once per patch.
-    fn new(map: &BinMap, para: &Parallelogram, images: &[[f64; 2]]) -> ExactMasking {
+    fn new(
+        map: &BinMap,
+        para: &Parallelogram,
+        images: &[[f64; 2]],
+        sigma: Option<f64>,
+    ) -> ExactMasking {
         let (w, h) = (map.width as i64, map.height as i64);
         let mut acc: Vec<(u32, f64)> = Vec::new();
         for &d in images {
@@ -332,6 +336,7 @@ impl ExactMasking {
         acc.sort_unstable_by_key(|e| e.0);
         let inv_area = 1.0 / para.area();
         let mut facets = Vec::new();
+        let mut lobes = Vec::new();
         let mut a = [0.0f64; 3];
         let mut k = 0;
         while k < acc.len() {
@@ -340,6 +345,20 @@ impl ExactMasking {
             while k < acc.len() && acc[k].0 as usize == bin {
                 mass += acc[k].1;
                 k += 1;
+            }
+            let smoothing = sigma.and_then(|s| {
+                let var = (s * s) as f32;
+                SlopeGaussian::new(map.center_slope[bin], Mat2::from_diagonal(Vec2::splat(var)))
+                    .ok()
+            });
+            if let Some(lobe) = smoothing {
+                // ∫ (w·m) D_j dm = w_z − w_xy·μ_j for a slope Gaussian of mean μ_j.
+                let (m, mu) = (mass * inv_area, lobe.mean());
+                a[0] -= m * mu.x as f64;
+                a[1] -= m * mu.y as f64;
+                a[2] += m;
+                lobes.push((m as f32, lobe));
+                continue;
             }
             let f = map.facets[bin];
             let scale = mass * inv_area / map.mean_cos[bin] as f64;
@@ -355,6 +374,7 @@ impl ExactMasking {
         }
         ExactMasking {
             facets,
+            lobes,
             a: Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32),
         }
     }
@@ -362,8 +382,13 @@ impl ExactMasking {
     /// V(w) = Σ_j s_j (1/|H|) ∫_{H_j} ⟨w, m⟩⁺ dω, exact for the bins that face w entirely and bounded
     /// from above for those that w's horizon cuts (type docs).
     fn visible_area(&self, w: Vec3) -> f32 {
-        let v: f64 = self.facets.iter().map(|f| visible_part(f, w) as f64).sum();
-        finite_or_zero(v)
+        let facets: f64 = self.facets.iter().map(|f| visible_part(f, w) as f64).sum();
+        let lobes: f64 = self
+            .lobes
+            .iter()
+            .map(|(m, lobe)| *m as f64 * lobe.visible_area(w) as f64)
+            .sum();
+        finite_or_zero(facets + lobes)
     }
 }
 

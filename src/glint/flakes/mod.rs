@@ -20,11 +20,11 @@ mod build;
 mod patch;
 
 pub use brdf::{DEFAULT_MASKING_ALPHA, PositionNormalBrdf};
-pub use patch::PositionNormalPatch;
+pub use patch::{EXACT_MASKING_ELEMENTS, PositionNormalPatch};
 
 use crate::error::{Error, Result, positive};
 use crate::glint::slope_tree::SlopeTree;
-use crate::glint::{Footprint, GlintNdf, NormalMap};
+use crate::glint::{Footprint, GlintNdf, MAX_TRUNCATION_SIGMAS, NormalMap};
 use glam::{Mat2, Vec2};
 
 /// σ_h / h = 1/√(8 ln 2) (see [`PositionNormalMap::SIGMA_H_PER_SPACING`]).
@@ -38,7 +38,7 @@ pub struct PositionNormalParams {
     pub sampling_rate: usize,
     /// Intrinsic roughness σ_r: slope standard deviation of each element (in [10⁻⁴, 1]).
     pub sigma_r: f32,
-    /// Truncation of the position weights, in σ (≥ 2, finite).
+    /// Truncation of the position weights, in σ (in [2, [`MAX_TRUNCATION_SIGMAS`]]).
     pub weight_sigmas: f32,
     /// Truncation of the element slope densities, in σ per axis (> 0).
     pub slope_sigmas: f32,
@@ -101,12 +101,13 @@ impl PositionNormalParams {
                          densities leave the f32 range)",
             });
         }
-        if !(self.weight_sigmas >= 2.0 && self.weight_sigmas.is_finite()) {
+        if !(self.weight_sigmas >= 2.0 && self.weight_sigmas <= MAX_TRUNCATION_SIGMAS) {
             return Err(Error::InvalidParameter {
                 name: "weight_sigmas",
                 value: self.weight_sigmas as f64,
-                reason: "must be finite and >= 2 (so that the element nearest to any footprint \
-                         centre, at Mahalanobis distance <= 1.67, is always kept)",
+                reason: "must be in [2, 10]: >= 2 so that the element nearest to any footprint \
+                         centre, at Mahalanobis distance <= 1.67, is always kept; <= 10 \
+                         (MAX_TRUNCATION_SIGMAS) so that the enumerated region stays bounded",
             });
         }
         positive("slope_sigmas", self.slope_sigmas)?;

@@ -1,5 +1,5 @@
 //! The patch of a footprint: the closed-form position-normal P-NDF of \[Yan2016\] §5, evaluated
-//! through the slope-box quadtree, its moments lobe for the masking terms, and exact samplers.
+//! through the slope-box quadtree, exact (or moment-bounded) masking terms, and exact samplers.
 //!
 //! Per-footprint work (done once in [`PositionNormalPatch::new`]): the footprint in element units
 //! (clamped to the query cap), the effective position Gaussian Σ_eff = Σ_P + σ_h² I, the conditional
@@ -200,10 +200,12 @@ struct Slots {
 ///
 /// - `d`: the sum over the elements whose slope box contains ñ(m), through the quadtree; elements
 ///   outside the ellipse of Mahalanobis radius `weight_sigmas` (under Σ_eff) are left out everywhere.
-/// - Masking (`lambda`, `projected_area`, `visible_area`): those of the **moments lobe**, the
-///   non-centred Beckmann lobe with the P-NDF's own mean slope and slope covariance (floored at σ_r),
-///   computed exactly from the elements; the published BRDF ([`super::PositionNormalBrdf`]) uses a
-///   fixed Beckmann lobe instead.
+/// - Masking (`lambda`, `projected_area`, `visible_area`): A(w) = max(cos θ − w_xy·μ_P, 0) from the
+///   P-NDF's mean slope (exact), V(w) = Σ W_i V_i(w) exactly for patches of at most
+///   [`EXACT_MASKING_ELEMENTS`] elements and Scarf's upper bound from the P-NDF's first two slope
+///   moments above, Λ = V/A − 1: the mixture's exact construction (\[Chermain2019\] eq. 13-17), so
+///   `MicrofacetBrdf` over the patch conserves energy. The published BRDF
+///   ([`super::PositionNormalBrdf`]) uses a fixed Beckmann lobe instead.
 /// - Samplers: `sample_normal` draws an element ∝ W_i then its slope Gaussian N(μ_i, C_i) (the
 ///   element's slope marginal under the footprint), exactly `pdf_normal`; `sample_visible` draws an
 ///   element ∝ W_i V_i(wo) then its visible normal, exactly `pdf_visible`. Both densities sum every
@@ -225,6 +227,11 @@ pub struct PositionNormalPatch<'a> {
     moments_lobe: SlopeGaussian,
     slots: OnceLock<Slots>,
 }
+
+/// Largest patch (number of elements kept) whose masking terms use the exact V(w) = Σ W_i V_i(w);
+/// larger patches use Scarf's moment bound (O(1) per direction instead of O(elements)). 4096, the
+/// bin map's [`EXACT_MASKING_TEXELS`](crate::glint::EXACT_MASKING_TEXELS) at one element per texel.
+pub const EXACT_MASKING_ELEMENTS: usize = 4096;
 
 impl<'a> PositionNormalPatch<'a> {
     /// The P-NDF of `footprint` (see the type's docs). Total: any footprint works; cost
@@ -436,9 +443,17 @@ impl Ndf for PositionNormalPatch<'_> {
         self.d_with_stats(m).0
     }
 
-    /// Λ of the moments lobe (0 for invalid w).
+    /// Λ = V/A − 1 with V from [`Ndf::visible_area`] (exact, or Scarf's bound for large patches) and A
+    /// from the P-NDF's mean slope; 0 for invalid w, `f32::MAX` where A(w) = 0 < w_z.
     fn lambda(&self, w: Vec3) -> f32 {
-        self.moments_lobe.lambda(w)
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let a = self.projected_area(w);
+        if !(a > 0.0) {
+            return f32::MAX;
+        }
+        ((self.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
     }
 
     /// A(w) of the moments lobe: max(cos θ − w_xy·μ_P, 0) with μ_P the P-NDF's mean slope.
@@ -446,9 +461,18 @@ impl Ndf for PositionNormalPatch<'_> {
         self.moments_lobe.projected_area(w)
     }
 
-    /// V(w) = A(1 + Λ) of the moments lobe.
+    /// V(w) = ∫⟨w, m⟩⁺ D_P dm: exact ([`PositionNormalPatch::visible_area_exact`], O(elements)) for
+    /// patches of at most [`EXACT_MASKING_ELEMENTS`] elements; above, Scarf's bound from the P-NDF's
+    /// first two slope moments ([`SlopeGaussian::visible_area_bound`], O(1)), which is ≥ the exact V.
+    /// Either way masking never under-shadows and `MicrofacetBrdf` over the patch never gains energy.
+    /// The moments lobe's own Gaussian V, used before, could fall below the exact V of a multi-modal
+    /// patch (white furnace up to 1.42 at grazing angles on the bumpy map, docs/robustness.md).
     fn visible_area(&self, w: Vec3) -> f32 {
-        self.moments_lobe.visible_area(w)
+        if self.count <= EXACT_MASKING_ELEMENTS {
+            self.visible_area_exact(w)
+        } else {
+            self.moments_lobe.visible_area_bound(w)
+        }
     }
 
     /// m ~ D_P(m) cos θ_m (untruncated): element ∝ W_i with u.x (rescaled), then its slope Gaussian.

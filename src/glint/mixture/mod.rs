@@ -30,6 +30,14 @@ pub const DEFAULT_SPACING: f32 = 1.0;
 /// Default floor σ_ε = 0.01 of the lobes' slope standard deviation (\[Chermain2019\] §3.2).
 pub const DEFAULT_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
 
+/// Smallest accepted seed spacing h: 1/8 texel. The interpolated map is bilinear per texel, so finer
+/// lobes add memory (∝ 1/h²) without new slope information.
+pub const MIN_SPACING: f32 = 0.125;
+
+/// Largest accepted truncation, in standard deviations, of the seed kernels and position weights
+/// (`kernel_sigmas`, `weight_sigmas`, and the position-normal map's `weight_sigmas`): 10.
+pub const MAX_TRUNCATION_SIGMAS: f32 = 10.0;
+
 /// Default number of quasi-Monte Carlo nodes per lobe for the moments (eq. 6).
 ///
 /// Measured (docs/results.md, `accuracy_table` test, 64² crops of the four procedural maps): the
@@ -104,7 +112,7 @@ impl Default for PatchOptions {
 /// Build parameters of a [`BeckmannMixture`]. `Default` gives the documented `DEFAULT_*` values.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MixtureParams {
-    /// Seed spacing h in texels (> 0). The lobe grid has max(1, round(width / h)) × max(1,
+    /// Seed spacing h in texels (≥ [`MIN_SPACING`]). The lobe grid has max(1, round(width / h)) × max(1,
     /// round(height / h)) lobes, so the spacing actually used per axis is width / nx (height / ny):
     /// an integer number of lobes tiles the map.
     pub spacing: f32,
@@ -112,9 +120,9 @@ pub struct MixtureParams {
     pub sigma_min: f32,
     /// Quasi-Monte Carlo nodes per lobe for the moments (≥ 1).
     pub samples: usize,
-    /// Truncation of k_i for the moment integral, in σ (> 0).
+    /// Truncation of k_i for the moment integral, in σ (in (0, [`MAX_TRUNCATION_SIGMAS`]]).
     pub kernel_sigmas: f32,
-    /// Truncation of the position weights, in σ (> 0).
+    /// Truncation of the position weights, in σ (in (0, [`MAX_TRUNCATION_SIGMAS`]]).
     pub weight_sigmas: f32,
     /// Mass left outside each lobe's slope box (0 < tail < 1).
     pub slope_tail: f32,
@@ -138,10 +146,28 @@ impl Default for MixtureParams {
 
 impl MixtureParams {
     fn validate(&self) -> Result<()> {
-        positive("spacing", self.spacing)?;
+        if !(self.spacing >= MIN_SPACING && self.spacing.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "spacing",
+                value: self.spacing as f64,
+                reason: "must be finite and >= 0.125 texel (MIN_SPACING: finer lobes repeat the \
+                         bilinear map's moments and multiply memory by 1/h²)",
+            });
+        }
         positive("sigma_min", self.sigma_min)?;
-        positive("kernel_sigmas", self.kernel_sigmas)?;
-        positive("weight_sigmas", self.weight_sigmas)?;
+        for (name, v) in [
+            ("kernel_sigmas", self.kernel_sigmas),
+            ("weight_sigmas", self.weight_sigmas),
+        ] {
+            if !(v > 0.0 && v <= MAX_TRUNCATION_SIGMAS) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: v as f64,
+                    reason: "must be in (0, 10] (MAX_TRUNCATION_SIGMAS: beyond 10 σ a Gaussian \
+                             holds < 1e-22 of its mass, and the enumerated region grows as its square)",
+                });
+            }
+        }
         if self.samples == 0 {
             return Err(Error::InvalidParameter {
                 name: "samples",

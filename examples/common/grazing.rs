@@ -1,0 +1,451 @@
+//! Grazing-angle stability: where each NDF's masking and each BRDF's sampler break down as θo → 90°.
+//!
+//! For every analytic NDF (Beckmann, GGX at α = 0.05 and 0.5) and every glint method (a 64-texel
+//! patch of the 256² bumpy and scratched maps), over θo from 0° to 89.99°:
+//!
+//! - **Visible-area error**: |V(wo) − V_ref(wo)| / V_ref(wo), V = A(1 + Λ) = ∫⟨wo, m⟩⁺ D dm, the
+//!   quantity every masking term, G1 and visible-normal pdf is built from. Analytic NDFs: V_ref in f64
+//!   from the closed forms (Beckmann: ½ cos θ (1 + erf a) + α sin θ e^(−a²)/(2√π), a = cot θ/α; GGX:
+//!   ½ (cos θ + √(cos² θ + α² sin² θ))), against the crate's f32 V. Glint patches: V_ref by Monte Carlo
+//!   of ∫⟨wo, m⟩⁺ D dm with the patch's own normal sampler (2¹⁴ R2 points, unbiased; its relative
+//!   standard error is the floor of what the chart can resolve, written to the CSV).
+//! - **White furnace** E(wo) = ∫ f c(wi) dωi with F = 1 and the default `MicrofacetBrdf` (visible-normal
+//!   sampling, height-correlated G2), c = cos θi for the analytic lobes and the patch's A_P(wi)⁺ for the
+//!   glint patches (the measure they are normalised in); and the **relative spread of the sample weight**
+//!   σ_w / E, whose growth is what makes a renderer's noise blow up.
+//!
+//! `cargo run --release --example grazing -- [--out DIR]` writes `grazing.csv`, three charts and
+//! `grazing.md` (also part of the gallery). docs/robustness.md discusses the results.
+
+use super::{Artifact, Chart, Res, Scale, Series, line_chart};
+use brdf::fresnel::NoFresnel;
+use brdf::glint::{
+    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintNdf, MaskingMode, MixtureParams,
+    NormalMap, PatchOptions, PositionNormalBrdf, PositionNormalMap, PositionNormalParams,
+};
+use brdf::ndf::{Beckmann, Ggx, Ndf};
+use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// View angles (degrees): 90° − θo spans 90° down to 0.01° on the chart's log axis.
+pub const THETAS: [f64; 14] = [
+    0.0, 30.0, 60.0, 75.0, 80.0, 85.0, 87.0, 88.0, 89.0, 89.5, 89.8, 89.9, 89.95, 89.99,
+];
+
+/// One (method, θo) measurement.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Method label.
+    pub method: String,
+    /// View angle θo in degrees.
+    pub theta: f64,
+    /// |V − V_ref| / V_ref.
+    pub v_rel_error: f64,
+    /// Relative standard error of V_ref (0 for the closed forms).
+    pub v_ref_rel_se: f64,
+    /// White furnace E(wo).
+    pub furnace: f64,
+    /// Standard error of E.
+    pub furnace_se: f64,
+    /// σ_w / E: relative standard deviation of one sample's weight.
+    pub weight_spread: f64,
+    /// Fraction of samples the sampler rejected (`None`).
+    pub lost: f64,
+}
+
+/// Samples per furnace and per Monte Carlo V_ref.
+pub struct Settings {
+    /// Map side in texels.
+    pub map_size: usize,
+    /// Footprint area in texels.
+    pub footprint: f32,
+    /// Samples for the furnace.
+    pub furnace_samples: usize,
+    /// Samples for the glint V_ref.
+    pub v_samples: usize,
+}
+
+impl Settings {
+    /// The gallery's settings (2¹² furnace samples per point, about a minute on 2 cores).
+    pub fn new() -> Settings {
+        Settings {
+            map_size: 256,
+            footprint: 64.0,
+            furnace_samples: 1 << 12,
+            v_samples: 1 << 14,
+        }
+    }
+
+    /// Tiny settings for the code-path test.
+    pub fn tiny() -> Settings {
+        Settings {
+            map_size: 16,
+            footprint: 16.0,
+            furnace_samples: 256,
+            v_samples: 1024,
+        }
+    }
+}
+
+fn view(theta: f64) -> Vec3 {
+    let (t, p) = (theta.to_radians(), 30f64.to_radians());
+    Vec3::new(
+        (t.sin() * p.cos()) as f32,
+        (t.sin() * p.sin()) as f32,
+        t.cos() as f32,
+    )
+}
+
+/// A low-discrepancy point (R2 sequence) in [0, 1)².
+fn r2(k: usize) -> Vec2 {
+    let (a, b) = (0.754_877_666_246_692_7_f64, 0.569_840_290_998_053_2_f64);
+    Vec2::new(
+        (0.5 + a * k as f64).fract() as f32,
+        (0.5 + b * k as f64).fract() as f32,
+    )
+}
+
+/// Beckmann V(w) in f64 at polar angle θ (isotropic α).
+fn beckmann_v_ref(alpha: f64, theta: f64) -> f64 {
+    let (s, c) = theta.sin_cos();
+    if s == 0.0 {
+        return c;
+    }
+    let a = c / (s * alpha);
+    0.5 * c * (1.0 + libm::erf(a))
+        + alpha * s * (-a * a).exp() / (2.0 * std::f64::consts::PI.sqrt())
+}
+
+/// GGX V(w) in f64 at polar angle θ (isotropic α).
+fn ggx_v_ref(alpha: f64, theta: f64) -> f64 {
+    let (s, c) = theta.sin_cos();
+    0.5 * (c + (c * c + alpha * alpha * s * s).sqrt())
+}
+
+/// ∫⟨wo, m⟩⁺ D dm by importance sampling with the NDF's normal sampler: (mean, standard error).
+fn v_monte_carlo(ndf: &dyn Ndf, wo: Vec3, n: usize) -> (f64, f64) {
+    let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+    for k in 0..n {
+        let m = ndf.sample_normal(r2(k));
+        let p = ndf.pdf_normal(m) as f64;
+        let x = if p > 0.0 {
+            (wo.dot(m).max(0.0) as f64) * ndf.d(m) as f64 / p
+        } else {
+            0.0
+        };
+        sum += x;
+        sum2 += x * x;
+    }
+    let mean = sum / n as f64;
+    let var = (sum2 / n as f64 - mean * mean).max(0.0);
+    (mean, (var / n as f64).sqrt())
+}
+
+/// Furnace, its standard error, the weight's relative spread and the lost fraction.
+fn furnace(brdf: &dyn Bxdf, wo: Vec3, cosine: &dyn Fn(Vec3) -> f32, n: usize) -> [f64; 4] {
+    let (mut sum, mut sum2, mut lost) = (0.0f64, 0.0f64, 0usize);
+    for k in 0..n {
+        let uc = ((k as f64 + 0.5) / n as f64) as f32;
+        match brdf.sample(wo, uc, r2(k)) {
+            Some(s) => {
+                let x = s.f.x as f64 * cosine(s.wi) as f64 / s.pdf as f64;
+                sum += x;
+                sum2 += x * x;
+            }
+            None => lost += 1,
+        }
+    }
+    let mean = sum / n as f64;
+    let var = (sum2 / n as f64 - mean * mean).max(0.0);
+    let spread = if mean > 0.0 { var.sqrt() / mean } else { 0.0 };
+    [
+        mean,
+        (var / n as f64).sqrt(),
+        spread,
+        lost as f64 / n as f64,
+    ]
+}
+
+/// One row; the relative errors are NaN where nothing of the patch faces wo (V_ref = 0: a patch
+/// whose micronormals all lean away from a grazing view).
+fn row(method: &str, theta: f64, v: f64, v_ref: (f64, f64), f: [f64; 4]) -> Row {
+    let rel = |x: f64| if v_ref.0 > 0.0 { x / v_ref.0 } else { f64::NAN };
+    Row {
+        method: method.to_string(),
+        theta,
+        v_rel_error: rel((v - v_ref.0).abs()),
+        v_ref_rel_se: rel(v_ref.1),
+        furnace: f[0],
+        furnace_se: f[1],
+        weight_spread: f[2],
+        lost: f[3],
+    }
+}
+
+fn analytic_rows(settings: &Settings) -> Res<Vec<Row>> {
+    let mut rows = Vec::new();
+    let cos = |w: Vec3| w.z.max(0.0);
+    for alpha in [0.05f32, 0.5] {
+        let b = Beckmann::isotropic(alpha)?;
+        let g = Ggx::isotropic(alpha)?;
+        for theta in THETAS {
+            let wo = view(theta);
+            let t = theta.to_radians();
+            let label = format!("Beckmann α={alpha}");
+            let fb = furnace(
+                &MicrofacetBrdf::new(b, NoFresnel),
+                wo,
+                &cos,
+                settings.furnace_samples,
+            );
+            rows.push(row(
+                &label,
+                theta,
+                b.visible_area(wo) as f64,
+                (beckmann_v_ref(alpha as f64, t), 0.0),
+                fb,
+            ));
+            let label = format!("GGX α={alpha}");
+            let fg = furnace(
+                &MicrofacetBrdf::new(g, NoFresnel),
+                wo,
+                &cos,
+                settings.furnace_samples,
+            );
+            rows.push(row(
+                &label,
+                theta,
+                g.visible_area(wo) as f64,
+                (ggx_v_ref(alpha as f64, t), 0.0),
+                fg,
+            ));
+        }
+    }
+    Ok(rows)
+}
+
+/// The rows of one glint patch (as an NDF inside `MicrofacetBrdf`, furnace in the patch measure).
+fn patch_rows(label: &str, patch: &dyn Ndf, settings: &Settings, rows: &mut Vec<Row>) {
+    let brdf = MicrofacetBrdf::new(patch, NoFresnel);
+    let area = |w: Vec3| patch.projected_area(w).max(0.0);
+    for theta in THETAS {
+        let wo = view(theta);
+        let v_ref = v_monte_carlo(patch, wo, settings.v_samples);
+        let f = furnace(&brdf, wo, &area, settings.furnace_samples);
+        rows.push(row(label, theta, patch.visible_area(wo) as f64, v_ref, f));
+    }
+}
+
+fn glint_rows(name: &str, map: &NormalMap, settings: &Settings) -> Res<Vec<Row>> {
+    let mut rows = Vec::new();
+    let fp = Footprint::isotropic_texels(
+        Vec2::new(0.37, 0.61),
+        settings.footprint,
+        map.width(),
+        map.height(),
+    );
+    let mixture = BeckmannMixture::build(map, MixtureParams::default())?;
+    for (mode, label) in [
+        (MaskingMode::Exact, "mixture (exact)"),
+        (MaskingMode::Approximate, "mixture (approximate)"),
+    ] {
+        let options = PatchOptions {
+            masking: mode,
+            ..PatchOptions::default()
+        };
+        let patch = mixture.patch_with(&fp, options);
+        patch_rows(&format!("{name}: {label}"), &patch, settings, &mut rows);
+    }
+    let bin_map = BinMap::build(map, BinMapParams::default())?;
+    patch_rows(
+        &format!("{name}: bin map"),
+        &bin_map.patch(&fp),
+        settings,
+        &mut rows,
+    );
+    patch_rows(
+        &format!("{name}: bin map (smoothed α=0.1)"),
+        &bin_map.patch_smoothed(&fp, 0.1),
+        settings,
+        &mut rows,
+    );
+    let pn = PositionNormalMap::build(map, PositionNormalParams::default())?;
+    let patch = pn.patch(&fp);
+    patch_rows(
+        &format!("{name}: position-normal"),
+        &patch,
+        settings,
+        &mut rows,
+    );
+    // The published BRDF (cos θo cos θi normalisation), furnace with the geometric cosine: its V
+    // column repeats the patch's.
+    let published = PositionNormalBrdf::new(&patch, NoFresnel);
+    let cos = |w: Vec3| w.z.max(0.0);
+    for theta in THETAS {
+        let wo = view(theta);
+        let f = furnace(&published, wo, &cos, settings.furnace_samples);
+        let v_ref = v_monte_carlo(&patch, wo, settings.v_samples);
+        rows.push(row(
+            &format!("{name}: position-normal (published BRDF)"),
+            theta,
+            patch.visible_area(wo) as f64,
+            v_ref,
+            f,
+        ));
+    }
+    Ok(rows)
+}
+
+/// Every measurement.
+pub fn measure(settings: &Settings) -> Res<Vec<Row>> {
+    let n = settings.map_size;
+    let mut rows = analytic_rows(settings)?;
+    let bumpy = brdf::glint::bumpy(n, n, 0.25, 4.0, 1)?;
+    rows.extend(glint_rows("bumpy", &bumpy, settings)?);
+    let scratched = brdf::glint::scratched(n, n, brdf::glint::ScratchedParams::default(), 3)?;
+    rows.extend(glint_rows("scratched", &scratched, settings)?);
+    Ok(rows)
+}
+
+/// The methods in order of first appearance.
+fn methods(rows: &[Row]) -> Vec<String> {
+    let mut m: Vec<String> = Vec::new();
+    for r in rows {
+        if !m.contains(&r.method) {
+            m.push(r.method.clone());
+        }
+    }
+    m
+}
+
+fn series(rows: &[Row], keep: &dyn Fn(&str) -> bool, y: &dyn Fn(&Row) -> f64) -> Vec<Series> {
+    methods(rows)
+        .into_iter()
+        .filter(|m| keep(m))
+        .map(|m| {
+            let pts = rows
+                .iter()
+                .filter(|r| r.method == m)
+                .map(|r| (90.0 - r.theta, y(r)))
+                .collect();
+            Series::new(m, pts)
+        })
+        .collect()
+}
+
+/// Writes the CSV, the charts and the markdown table.
+pub fn report(rows: &[Row], out: &Path) -> Res<(Vec<Artifact>, String)> {
+    std::fs::create_dir_all(out)?;
+    let mut csv = String::from(
+        "method,theta_deg,v_rel_error,v_ref_rel_se,furnace,furnace_se,weight_spread,lost\n",
+    );
+    for r in rows {
+        writeln!(
+            csv,
+            "\"{}\",{},{:.6e},{:.3e},{:.6},{:.3e},{:.4e},{:.4}",
+            r.method,
+            r.theta,
+            r.v_rel_error,
+            r.v_ref_rel_se,
+            r.furnace,
+            r.furnace_se,
+            r.weight_spread,
+            r.lost
+        )?;
+    }
+    let csv_path = out.join("grazing.csv");
+    std::fs::write(&csv_path, csv)?;
+    let mut artifacts = vec![Artifact::new(
+        &csv_path,
+        "Grazing sweep: every measurement (CSV).",
+    )];
+    let all = |_: &str| true;
+    let not_published = |m: &str| !m.contains("published");
+    let x_label = "90° − θo (degrees, log scale)";
+
+    let mut chart = Chart::new(
+        "Visible-area error against view angle",
+        x_label,
+        "|V − V_ref| / V_ref",
+    );
+    chart.x_scale = Scale::Log;
+    chart.y_scale = Scale::Log;
+    chart.markers = true;
+    chart.size = (900, 560);
+    chart.y_range = Some((1e-8, 10.0));
+    let path = out.join("grazing_visible_area_error.png");
+    line_chart(
+        &path,
+        &chart,
+        &series(rows, &not_published, &|r| r.v_rel_error.max(1e-8)),
+    )?;
+    artifacts.push(Artifact::new(
+        &path,
+        "Relative error of V(wo) = A(1 + Λ) against 90° − θo: analytic NDFs against f64 closed forms, \
+         glint patches against a Monte Carlo integral of their own D (floor ≈ its standard error).",
+    ));
+
+    let mut chart = Chart::new("White furnace against view angle (F = 1)", x_label, "E(wo)");
+    chart.x_scale = Scale::Log;
+    chart.markers = true;
+    chart.size = (900, 560);
+    chart.y_range = Some((0.0, 1.6));
+    let path = out.join("grazing_furnace.png");
+    line_chart(&path, &chart, &series(rows, &all, &|r| r.furnace))?;
+    artifacts.push(Artifact::new(
+        &path,
+        "White furnace against 90° − θo: cos θi measure for the analytic lobes, the patch measure \
+         A_P(wi)⁺ for the glint patches, cos θi for the published position-normal BRDF.",
+    ));
+
+    let mut chart = Chart::new("Spread of the sample weight", x_label, "σ_w / E");
+    chart.x_scale = Scale::Log;
+    chart.y_scale = Scale::Log;
+    chart.markers = true;
+    chart.size = (900, 560);
+    chart.y_range = Some((1e-4, 1e3));
+    let path = out.join("grazing_weight_spread.png");
+    line_chart(
+        &path,
+        &chart,
+        &series(rows, &all, &|r| r.weight_spread.max(1e-4)),
+    )?;
+    artifacts.push(Artifact::new(
+        &path,
+        "Relative standard deviation of one sample's weight f·c/pdf (visible-normal sampling where \
+         the model has it) against 90° − θo: where a renderer's noise grows.",
+    ));
+
+    let mut md = String::from(
+        "| method | θo | V rel. error | (V_ref rel. SE) | furnace | σ_w/E | lost |\n|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        writeln!(
+            md,
+            "| {} | {} | {:.1e} | {:.0e} | {:.3} ± {:.3} | {:.2} | {:.3} |",
+            r.method,
+            r.theta,
+            r.v_rel_error,
+            r.v_ref_rel_se,
+            r.furnace,
+            r.furnace_se,
+            r.weight_spread,
+            r.lost
+        )?;
+    }
+    let md_path = out.join("grazing.md");
+    std::fs::write(&md_path, &md)?;
+    artifacts.push(Artifact::new(
+        &md_path,
+        "Grazing sweep: the table (markdown).",
+    ));
+    Ok((artifacts, md))
+}
+
+/// Runs the sweep and writes its files.
+pub fn run(out: &Path, _quick: bool) -> Res<Vec<Artifact>> {
+    let rows = measure(&Settings::new())?;
+    let (artifacts, _) = report(&rows, out)?;
+    Ok(artifacts)
+}
