@@ -110,7 +110,7 @@ impl SlopeGaussian {
     /// \[Chermain2019\] eq. 4.
     pub fn new(mean: Vec2, cov: Mat2) -> Result<Self> {
         for v in [mean.x, mean.y] {
-            if !(v.abs() <= MAX_SLOPE) {
+            if v.is_nan() || v.abs() > MAX_SLOPE {
                 return Err(Error::InvalidParameter {
                     name: "mean",
                     value: v as f64,

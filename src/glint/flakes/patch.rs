@@ -450,7 +450,7 @@ impl Ndf for PositionNormalPatch<'_> {
             return 0.0;
         }
         let a = self.projected_area(w);
-        if !(a > 0.0) {
+        if a.is_nan() || a <= 0.0 {
             return f32::MAX;
         }
         ((self.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
