@@ -433,6 +433,43 @@ mod images {
         }
     }
 
+    /// A PNG of the given size with an 8-bit RGB IHDR, an empty IDAT and IEND (CRCs computed), for
+    /// sizes that encoders refuse to write.
+    fn png_rgb8_header_only(width: u32, height: u32) -> Vec<u8> {
+        fn crc32(bytes: &[u8]) -> u32 {
+            let mut c = 0xFFFF_FFFFu32;
+            for &b in bytes {
+                c ^= b as u32;
+                for _ in 0..8 {
+                    c = if c & 1 == 1 {
+                        0xEDB8_8320 ^ (c >> 1)
+                    } else {
+                        c >> 1
+                    };
+                }
+            }
+            !c
+        }
+        let chunk = |kind: &[u8], data: &[u8]| {
+            let mut v = (data.len() as u32).to_be_bytes().to_vec();
+            let body: Vec<u8> = kind.iter().chain(data).copied().collect();
+            v.extend_from_slice(&body);
+            v.extend_from_slice(&crc32(&body).to_be_bytes());
+            v
+        };
+        let mut ihdr = width.to_be_bytes().to_vec();
+        ihdr.extend_from_slice(&height.to_be_bytes());
+        ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        png.extend(chunk(b"IHDR", &ihdr));
+        png.extend(chunk(
+            b"IDAT",
+            &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+        ));
+        png.extend(chunk(b"IEND", &[]));
+        png
+    }
+
     #[test]
     fn bad_files_give_errors_naming_the_file() {
         let dir = tmp_dir();
@@ -461,6 +498,15 @@ mod images {
         let e = NormalMap::load(&grey, conv, NormalRepair::Reject).unwrap_err();
         assert!(
             matches!(e, Error::Image { .. }) && e.to_string().contains("grey.png"),
+            "{e}"
+        );
+        // Empty (0 × 0 pixels), written as a valid PNG header with zero width by hand (encoders
+        // refuse it): refused by the decoder or by our own check, and the error names the file.
+        let empty = dir.join("empty.png");
+        std::fs::write(&empty, png_rgb8_header_only(0, 1)).unwrap();
+        let e = NormalMap::load(&empty, conv, NormalRepair::Reject).unwrap_err();
+        assert!(
+            matches!(e, Error::Image { .. }) && e.to_string().contains("empty.png"),
             "{e}"
         );
         // A normal below the horizon (blue = 0 → z = −1) at picture pixel (1, 0) = texel (1, 1).

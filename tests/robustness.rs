@@ -911,3 +911,24 @@ fn regression_slope_gaussian_mean_is_bounded() {
         Vec2::splat(0.5),
     );
 }
+
+/// Found by the `analytic` and `glint_mixture` fuzz targets: the slope Gaussian's visible-normal
+/// sampler fell back to returning wo itself, which is not a unit normal when the caller's wo is not
+/// unit (here of length ~10⁻¹⁸).
+#[test]
+fn regression_visible_sampler_fallback_is_unit() {
+    let sg = SlopeGaussian::new(
+        Vec2::new(0.0, 7.968_867),
+        Mat2::from_cols_array(&[1.0e-4, 0.0, 0.0, 1.0e-4]),
+    )
+    .unwrap();
+    let wo = Vec3::new(5.455_156_4e-19, 5.459_277e-19, 5.458_350_3e-19);
+    let one_minus = 1.0 - f32::EPSILON / 2.0;
+    for u in [
+        Vec2::ZERO,
+        Vec2::new(9.1963e-41, -8.374_822e21),
+        Vec2::splat(one_minus),
+    ] {
+        support::totality::unit_upper("sample_visible", sg.sample_visible(wo, u));
+    }
+}

@@ -42,8 +42,8 @@ impl NormalMap {
     /// `image` crate's default limits (512 MiB).
     ///
     /// # Errors
-    /// [`Error::Image`] (naming `name`) for undecodable bytes or an image that is not RGB/RGBA (e.g.
-    /// greyscale); [`Error::InvalidSize`] for an empty image; [`Error::InvalidParameter`] for a bad
+    /// [`Error::Image`] (naming `name`) for undecodable bytes, an empty image, or an image that is not
+    /// RGB/RGBA (e.g. greyscale); [`Error::InvalidParameter`] for a bad
     /// `ClampZ` bound; [`Error::InvalidTexel`] (naming `name`, the texel and the file pixel) for a
     /// non-finite or zero normal, or one with z ≤ 0 under [`NormalRepair::Reject`].
     pub fn from_image_bytes(
@@ -60,11 +60,7 @@ impl NormalMap {
         let img = image::load_from_memory(bytes).map_err(|e| image_err(e.to_string()))?;
         let (w, h) = (img.width() as usize, img.height() as usize);
         if w == 0 || h == 0 {
-            return Err(Error::InvalidSize {
-                width: w,
-                height: h,
-                reason: "the image is empty",
-            });
+            return Err(image_err(format!("the image is empty ({w}×{h} pixels)")));
         }
         let int = |c: u16, max: f32| 2.0 * (c as f32 / max) - 1.0;
         let texel = |x: u32, y: u32| -> Option<Vec3> {

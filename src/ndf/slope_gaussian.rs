@@ -579,7 +579,9 @@ fn ensure_facing(wo: Vec3, m: Vec3) -> Vec3 {
     if n.is_finite() && n.z > 0.0 && facing(wo, n) > 0.0 {
         n
     } else {
-        wo
+        // wo itself faces wo; normalised, since a caller may pass a non-unit wo (fuzz finding: a
+        // wo of length 1e-18 came back as the "normal").
+        wo.try_normalize().filter(|w| w.z > 0.0).unwrap_or(Vec3::Z)
     }
 }
 
