@@ -653,7 +653,7 @@ fn furnace_table() {
         ("flakes", flakes(n, n, FlakesParams::default(), 4).unwrap()),
     ];
     println!(
-        "| map | footprint (texels) | θo | published (Yan 2016) | MicrofacetBrdf (moments-lobe masking) |"
+        "| map | footprint (texels) | θo | published (Yan 2016) | MicrofacetBrdf (exact masking) |"
     );
     println!("|---|---|---|---|---|");
     for (name, map) in &maps {

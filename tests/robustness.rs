@@ -443,8 +443,10 @@ fn documented_outcomes() {
         err_naming(Ggx::new(0.5, a), "alpha_y");
         err_naming(Beckmann::isotropic(a), "alpha");
     }
-    // α below 1e-4 is accepted and clamped (documented at MIN_ALPHA); large α is accepted.
+    // α below 1e-4 is accepted and clamped (documented at MIN_ALPHA); α up to MAX_ALPHA is accepted.
     assert!(Beckmann::isotropic(1e-7).is_ok() && Ggx::isotropic(10.0).is_ok());
+    assert!(Ggx::isotropic(brdf::ndf::MAX_ALPHA).is_ok());
+    err_naming(Ggx::new(0.5, 2e4), "alpha_y");
     err_naming(BlinnPhong::new(-1.0), "gamma");
     err_naming(BlinnPhong::new(nan), "gamma");
     let singular = Mat2::from_cols_array(&[1.0, 1.0, 1.0, 1.0]);
@@ -632,6 +634,7 @@ fn outcome_table() {
             "Ggx::isotropic(1e-7)",
             outcome(Ggx::isotropic(1e-7).map(|g| g.alpha_x())),
         ),
+        ("Ggx::new(0.5, 2e4)", outcome(Ggx::new(0.5, 2e4))),
         ("BlinnPhong::new(-1)", outcome(BlinnPhong::new(-1.0))),
         (
             "SlopeGaussian::new(0, [[1,1],[1,1]])",
@@ -927,6 +930,43 @@ fn regression_visible_sampler_fallback_is_unit() {
     for u in [
         Vec2::ZERO,
         Vec2::new(9.1963e-41, -8.374_822e21),
+        Vec2::splat(one_minus),
+    ] {
+        support::totality::unit_upper("sample_visible", sg.sample_visible(wo, u));
+    }
+}
+
+/// Found by the `analytic` fuzz target: GGX with α_y = 3.5·10¹³ sampled a "normal" of length 0.99 at a
+/// grazing view (the stretched vector's z underflows against α-scaled x, y). α above
+/// `ndf::MAX_ALPHA` = 10⁴ is now refused; at the bound the sampler stays unit.
+#[test]
+fn regression_alpha_is_bounded() {
+    err_naming(Ggx::new(1.5e-36, 3.518_437_2e13), "alpha_y");
+    err_naming(Beckmann::isotropic(2e4), "alpha");
+    let wo = Vec3::new(-1.399_769_2e-12, 0.0, 6.428_48e-40);
+    let u = Vec2::new(3.761_582e-37, 1.401_877_2e14);
+    for ndf in [
+        &Ggx::new(1.5e-36, brdf::ndf::MAX_ALPHA).unwrap() as &dyn Ndf,
+        &Beckmann::new(1.5e-36, brdf::ndf::MAX_ALPHA).unwrap(),
+    ] {
+        check_ndf(ndf, wo, Vec3::Z, 0.0, u);
+    }
+}
+
+/// Found by the `glint_mixture` fuzz target: the slope Gaussian's facing fallback normalised a wo of
+/// length 2·10⁻²² (squared length subnormal in f32) to length 0.99.
+#[test]
+fn regression_tiny_wo_normalises_exactly() {
+    let sg = SlopeGaussian::new(
+        Vec2::new(0.0, 8319.8),
+        Mat2::from_diagonal(Vec2::splat(1e-4)),
+    )
+    .unwrap();
+    let wo = Vec3::splat(1.283_005_8e-22);
+    let one_minus = 1.0 - f32::EPSILON / 2.0;
+    for u in [
+        Vec2::new(1.283_005_8e-22, -3.146_53e-24),
+        Vec2::ZERO,
         Vec2::splat(one_minus),
     ] {
         support::totality::unit_upper("sample_visible", sg.sample_visible(wo, u));

@@ -666,27 +666,32 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
          the line joins the methods no other beats on both.",
     ));
 
-    // Error against footprint size.
-    let series: Vec<Series> = methods
-        .iter()
-        .map(|m| {
-            let pts = settings
-                .areas
-                .iter()
-                .map(|&a| {
-                    let e = mean(
-                        results
+    // Per method, one point per footprint size: `stat` of `value` over the maps (and centres).
+    let by_area = |value: &dyn Fn(&AccuracyRow) -> f64,
+                   stat: &dyn Fn(&mut dyn Iterator<Item = f64>) -> f64|
+     -> Vec<Series> {
+        methods
+            .iter()
+            .map(|m| {
+                let pts = settings
+                    .areas
+                    .iter()
+                    .map(|&a| {
+                        let mut rows = results
                             .accuracy
                             .iter()
                             .filter(|r| &r.method == m && r.area == a)
-                            .map(|r| r.tv),
-                    );
-                    (a as f64, e)
-                })
-                .collect();
-            Series::new(m.clone(), pts)
-        })
-        .collect();
+                            .map(value);
+                        (a as f64, stat(&mut rows))
+                    })
+                    .collect();
+                Series::new(m.clone(), pts)
+            })
+            .collect()
+    };
+
+    // Error against footprint size.
+    let series = by_area(&|r| r.tv, &|v| mean(v));
     let path = out.join("compare_error_vs_footprint.png");
     let mut chart = Chart::new(
         "P-NDF error against footprint size",
@@ -701,6 +706,33 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
         "Total variation to the ground truth against footprint size, mean over the four maps and \
          three centres (the reference's own noise is in compare_accuracy.csv).",
     ));
+
+    // Cost against footprint size: the per-direction `d` and the per-shading-point `patch()`.
+    for (name, value, what, caption) in [
+        (
+            "compare_d_time_vs_footprint.png",
+            &(|r: &AccuracyRow| r.d_s * 1e6) as &dyn Fn(&AccuracyRow) -> f64,
+            "D evaluation time against footprint size",
+            "Time of one D(h) evaluation (µs, geometric mean over maps and centres, one thread) \
+             against footprint size: flat for the bin map (Atanasov 2020's claim), linear in the \
+             footprint's lobes or elements for the mixture and the position-normal baseline.",
+        ),
+        (
+            "compare_patch_time_vs_footprint.png",
+            &(|r: &AccuracyRow| r.patch_s * 1e6) as &dyn Fn(&AccuracyRow) -> f64,
+            "patch() time against footprint size",
+            "Time of one patch() (per shading point; µs, geometric mean, one thread) against \
+             footprint size.",
+        ),
+    ] {
+        let path = out.join(name);
+        let mut chart = Chart::new(what, "footprint (texels)", "µs (log scale)");
+        chart.x_scale = Scale::Log;
+        chart.y_scale = Scale::Log;
+        chart.markers = true;
+        line_chart(&path, &chart, &by_area(value, &|v| geo_mean(v)))?;
+        artifacts.push(Artifact::new(path, caption));
+    }
 
     // Error and energy against view angle.
     let view_methods = labels(results.view.iter().map(|r| &r.method));

@@ -21,6 +21,13 @@ use std::f32::consts::PI;
 /// below that). The accuracy tests cover α ∈ [10⁻⁴, 10].
 pub const MIN_ALPHA: f32 = 1e-4;
 
+/// Largest α accepted by the Beckmann and GGX constructors: 10⁴ (an RMS slope of ~7000, normals
+/// within ~10⁻⁴ rad of the horizon almost everywhere; the crate's [`MAX_SLOPE`](super::MAX_SLOPE)).
+/// Beyond it the stretched samplers form vectors whose tiny z underflows against α-scaled x, y (a
+/// fuzz finding at α = 3.5·10¹³: a sampled "normal" of length 0.99), and no material has such
+/// roughness. Larger values are refused with an error naming the parameter.
+pub const MAX_ALPHA: f32 = 1e4;
+
 /// α = r²: the perceptual roughness r ∈ [0, 1] of Burley's parameterisation mapped to α.
 ///
 /// Squaring makes equal steps of r look roughly equally spaced. Non-finite r gives 0 (which the
@@ -81,8 +88,8 @@ pub struct Beckmann {
 impl Beckmann {
     /// An anisotropic Beckmann NDF with roughness `alpha_x` along x and `alpha_y` along y.
     ///
-    /// Errors if either is non-finite or ≤ 0 (the error names `alpha_x` or `alpha_y`). Values below
-    /// [`MIN_ALPHA`] are clamped to it (see there why).
+    /// Errors if either is non-finite, ≤ 0 or above [`MAX_ALPHA`] (the error names `alpha_x` or
+    /// `alpha_y`). Values below [`MIN_ALPHA`] are clamped to it (see there why).
     pub fn new(alpha_x: f32, alpha_y: f32) -> Result<Self> {
         let (alpha_x, alpha_y) = validated_alphas(alpha_x, alpha_y)?;
         Ok(Self::from_valid(alpha_x, alpha_y))
@@ -268,18 +275,31 @@ fn sample_visible_slope_std(cot_theta: f32, tan_theta: f32, theta: f32, u: Vec2)
     Vec2::new(x, erfinv(2.0 * u.y.clamp(0.0, 1.0) - 1.0))
 }
 
-/// α_x, α_y validated for an NDF constructor: finite and > 0 (the error names `alpha_x` or
-/// `alpha_y`), then clamped to ≥ [`MIN_ALPHA`]. Shared by [`Beckmann`] and [`Ggx`](super::Ggx).
+/// α_x, α_y validated for an NDF constructor: finite, > 0 and ≤ [`MAX_ALPHA`] (the error names
+/// `alpha_x` or `alpha_y`), then clamped to ≥ [`MIN_ALPHA`]. Shared by [`Beckmann`] and [`Ggx`](super::Ggx).
 pub(super) fn validated_alphas(alpha_x: f32, alpha_y: f32) -> Result<(f32, f32)> {
     Ok((
-        positive("alpha_x", alpha_x)?.max(MIN_ALPHA),
-        positive("alpha_y", alpha_y)?.max(MIN_ALPHA),
+        validated_named("alpha_x", alpha_x)?,
+        validated_named("alpha_y", alpha_y)?,
     ))
 }
 
 /// An isotropic α validated like [`validated_alphas`], the error naming `alpha`.
 pub(super) fn validated_alpha(alpha: f32) -> Result<f32> {
-    Ok(positive("alpha", alpha)?.max(MIN_ALPHA))
+    validated_named("alpha", alpha)
+}
+
+/// Finite, > 0 and ≤ [`MAX_ALPHA`], then clamped to ≥ [`MIN_ALPHA`].
+fn validated_named(name: &'static str, alpha: f32) -> Result<f32> {
+    let a = positive(name, alpha)?;
+    if a > MAX_ALPHA {
+        return Err(crate::Error::InvalidParameter {
+            name,
+            value: a as f64,
+            reason: "must be <= MAX_ALPHA = 1e4",
+        });
+    }
+    Ok(a.max(MIN_ALPHA))
 }
 
 /// u clamped to [0, 1]², NaN components to 0 (`f32::max` returns the non-NaN operand).

@@ -34,8 +34,8 @@ pub struct Ggx {
 impl Ggx {
     /// An anisotropic GGX NDF with roughness `alpha_x` along x and `alpha_y` along y.
     ///
-    /// Errors if either is non-finite or ≤ 0 (naming `alpha_x` or `alpha_y`); values below
-    /// [`MIN_ALPHA`](super::MIN_ALPHA) are clamped to it.
+    /// Errors if either is non-finite, ≤ 0 or above [`MAX_ALPHA`](super::MAX_ALPHA) (naming
+    /// `alpha_x` or `alpha_y`); values below [`MIN_ALPHA`](super::MIN_ALPHA) are clamped to it.
     pub fn new(alpha_x: f32, alpha_y: f32) -> Result<Self> {
         let (alpha_x, alpha_y) = validated_alphas(alpha_x, alpha_y)?;
         Ok(Self::from_valid(alpha_x, alpha_y))

@@ -10,7 +10,7 @@ mod masking;
 mod phong_integral;
 
 pub use beckmann::{
-    Beckmann, MIN_ALPHA, alpha_from_roughness, beckmann_alpha_from_shininess,
+    Beckmann, MAX_ALPHA, MIN_ALPHA, alpha_from_roughness, beckmann_alpha_from_shininess,
     shininess_from_beckmann_alpha,
 };
 pub use blinn_phong::{BlinnPhong, MAX_GAMMA, MAX_VISIBLE_TRIES};

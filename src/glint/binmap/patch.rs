@@ -191,7 +191,7 @@ impl<'a> BinMapPatch<'a> {
         if mass <= 0.0 {
             return 0.0;
         }
-        let c = self.map.mean_cos[bin] as f64;
+        let c = self.map.facets[bin].mean.z as f64;
         mass / (self.map.bins.solid_angle() * c)
     }
 
@@ -361,7 +361,7 @@ impl ExactMasking {
                 continue;
             }
             let f = map.facets[bin];
-            let scale = mass * inv_area / map.mean_cos[bin] as f64;
+            let scale = mass * inv_area / map.facets[bin].mean.z as f64;
             for (ai, m) in a.iter_mut().zip(f.mean.to_array()) {
                 *ai += m as f64 * scale;
             }
