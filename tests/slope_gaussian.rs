@@ -338,8 +338,10 @@ fn chi2_params() -> Vec<LobeParams> {
     let mut v = Vec::new();
     for mean in [(0.0f32, 0.0f32), (0.3, -0.2), (1.0, 0.5)] {
         for (label, sx, sy, rho) in [
-            ("iso0.05", 0.05f32, 0.05f32, 0.0f32),
-            ("iso0.3", 0.3, 0.3, 0.0),
+            // The narrowest and widest roughness of the analytic NDFs' grid: α = 0.05 and α = 1
+            // (σ = α/√2), plus an anisotropic, correlated lobe between them.
+            ("α=0.05", 0.035_355_34f32, 0.035_355_34f32, 0.0f32),
+            ("α=1", 0.707_106_8, 0.707_106_8, 0.0),
             ("aniso", 0.1, 0.4, 0.7),
         ] {
             v.push((
