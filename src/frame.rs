@@ -99,6 +99,26 @@ pub fn half_vector_cos(wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
     }
 }
 
+/// `v` normalised, exactly even where its squared length leaves f32's normal range (below ~10⁻³⁸ or
+/// above ~10³⁸: the plain `normalize` then rounds through a subnormal or infinite square and can
+/// return a vector of length 0.9); `None` for zero-length or non-finite `v`.
+///
+/// The common case costs one extra comparison; out of range, `v` is first divided by its largest
+/// component. Samplers end with it so that what they return is unit whatever the input (fuzz
+/// findings: GGX's visible sampler at α = 10⁻⁴ built a half vector of length ~10⁻²⁰).
+#[inline]
+pub fn normalize_robust(v: Vec3) -> Option<Vec3> {
+    let l2 = v.length_squared();
+    if (1e-30..1e30).contains(&l2) {
+        return Some(v * (1.0 / l2.sqrt()));
+    }
+    let s = v.abs().max_element();
+    if !(s > 0.0 && s.is_finite()) {
+        return None;
+    }
+    (v / s).try_normalize()
+}
+
 /// The slope ñ = (−x/z, −y/z) of a normal ω_n = (x, y, z) (Chermain 2019, §3).
 ///
 /// Returns `None` for normals with z ≤ 0 or non-finite components (slopes are undefined there).

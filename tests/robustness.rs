@@ -972,3 +972,29 @@ fn regression_tiny_wo_normalises_exactly() {
         support::totality::unit_upper("sample_visible", sg.sample_visible(wo, u));
     }
 }
+
+/// Found by the `analytic` fuzz target (third run): GGX's visible sampler at α = 10⁻⁴ (the clamp),
+/// u = (1, 1) and a view along the normal built a half vector of length ~10⁻²⁰, whose squared length
+/// is subnormal: the normalised "normal" had length 0.92. `frame::normalize_robust` rescales first.
+#[test]
+fn regression_ggx_visible_sampler_at_min_alpha() {
+    let ggx = Ggx::new(5e-44, 4e-45).unwrap();
+    let wo = Vec3::new(-0.000_354_243_27, -3.072_570_3e-22, 12_689.568).normalize();
+    for u in [
+        Vec2::ONE,
+        Vec2::new(0.0, 0.249),
+        Vec2::new(6.745_882e32, 12_680.249),
+    ] {
+        support::totality::unit_upper("sample_visible", ggx.sample_visible(wo, u));
+    }
+    for v in [
+        Vec3::splat(1e-25),
+        Vec3::new(3e30, -4e30, 0.0),
+        Vec3::new(0.0, 1e-41, 1e-42),
+    ] {
+        let n = brdf::frame::normalize_robust(v).unwrap();
+        assert!((n.length() - 1.0).abs() < 1e-6, "{v} -> {n}");
+    }
+    assert!(brdf::frame::normalize_robust(Vec3::ZERO).is_none());
+    assert!(brdf::frame::normalize_robust(Vec3::splat(f32::NAN)).is_none());
+}

@@ -22,6 +22,7 @@ use brdf::ndf::{Ndf, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
 use proptest::prelude::*;
 use rayon::prelude::*;
+use std::f32::consts::FRAC_1_SQRT_2;
 use std::f64::consts::PI;
 use support::chi2::Chi2;
 use support::dir;
@@ -341,7 +342,7 @@ fn chi2_params() -> Vec<LobeParams> {
             // The narrowest and widest roughness of the analytic NDFs' grid: α = 0.05 and α = 1
             // (σ = α/√2), plus an anisotropic, correlated lobe between them.
             ("α=0.05", 0.035_355_34f32, 0.035_355_34f32, 0.0f32),
-            ("α=1", 0.707_106_8, 0.707_106_8, 0.0),
+            ("α=1", FRAC_1_SQRT_2, FRAC_1_SQRT_2, 0.0),
             ("aniso", 0.1, 0.4, 0.7),
         ] {
             v.push((

@@ -7,6 +7,7 @@
 use super::Ndf;
 use super::beckmann::{keep_visible, unit_square, validated_alpha, validated_alphas};
 use crate::Result;
+use crate::frame::normalize_robust;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -191,11 +192,9 @@ impl Ndf for Ggx {
             self.alpha_y * (sin_c * sp + wh.y),
             hz.max(1e-30),
         );
-        let m = m * (1.0 / m.length());
-        if m.is_finite() && m.z > 0.0 && m.dot(wo) > 0.0 {
-            m
-        } else {
-            self.sample_visible_disk(wo, u)
+        match normalize_robust(m) {
+            Some(m) if m.z > 0.0 && m.dot(wo) > 0.0 => m,
+            _ => self.sample_visible_disk(wo, u),
         }
     }
 }
@@ -238,9 +237,12 @@ impl Ggx {
         let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * (r * sp);
         let lift = (1.0 - p1 * p1 - p2 * p2).max(1e-14).sqrt();
         let nh = p1 * t1 + p2 * t2 + lift * vh;
-        let m = Vec3::new(self.alpha_x * nh.x, self.alpha_y * nh.y, nh.z.max(1e-30))
-            .try_normalize()
-            .unwrap_or(Vec3::Z);
+        let m = normalize_robust(Vec3::new(
+            self.alpha_x * nh.x,
+            self.alpha_y * nh.y,
+            nh.z.max(1e-30),
+        ))
+        .unwrap_or(Vec3::Z);
         keep_visible(m, wo)
     }
 }

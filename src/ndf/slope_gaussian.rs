@@ -581,11 +581,8 @@ fn ensure_facing(wo: Vec3, m: Vec3) -> Vec3 {
     } else {
         // wo itself faces wo; normalised, since a caller may pass a non-unit wo (fuzz findings: a
         // wo of length 1e-18 came back as the "normal"; one of length 2e-22, whose squared length
-        // is subnormal in f32, normalised to length 0.99). Scaling by the largest component first
-        // keeps the squares normal.
-        let s = wo.abs().max_element();
-        (wo / s)
-            .try_normalize()
+        // is subnormal in f32, normalised to length 0.99).
+        crate::frame::normalize_robust(wo)
             .filter(|w| w.z > 0.0)
             .unwrap_or(Vec3::Z)
     }
