@@ -18,7 +18,7 @@
 //! method's own BRDF); [`builders`] lists them.
 
 use super::pndf_images::maps;
-use super::{Artifact, Chart, Res, Scale, Series, line_chart};
+use super::{Artifact, Chart, Res, Scale, Series, line_chart, r2, view};
 use brdf::bxdf::{Bxdf, Masking};
 use brdf::fresnel::NoFresnel;
 use brdf::glint::{
@@ -341,25 +341,6 @@ fn reference_visible_area(reference: &BinnedPndf, wo: Vec3) -> f64 {
         .filter(|(_, (m, c))| **m > 0.0 && **c > 0.0)
         .map(|(b, (m, c))| m * (bins.center(b).dot(wo) as f64).max(0.0) / c)
         .sum()
-}
-
-/// A direction at polar angle θ (degrees), azimuth 30°.
-fn view(theta: f64) -> Vec3 {
-    let (t, p) = (theta.to_radians(), 30f64.to_radians());
-    Vec3::new(
-        (t.sin() * p.cos()) as f32,
-        (t.sin() * p.sin()) as f32,
-        t.cos() as f32,
-    )
-}
-
-/// A low-discrepancy point (R2 sequence) in [0, 1)².
-fn r2(k: usize) -> Vec2 {
-    let (a, b) = (0.754_877_7_f64, 0.569_840_3_f64);
-    Vec2::new(
-        (0.5 + a * k as f64).fract() as f32,
-        (0.5 + b * k as f64).fract() as f32,
-    )
 }
 
 /// The patch and geometric furnaces by importance sampling with the BRDF's own sampler.

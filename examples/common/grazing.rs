@@ -17,7 +17,7 @@
 //! `cargo run --release --example grazing -- [--out DIR]` writes `grazing.csv`, three charts and
 //! `grazing.md` (also part of the gallery). docs/robustness.md discusses the results.
 
-use super::{Artifact, Chart, Res, Scale, Series, line_chart};
+use super::{Artifact, Chart, Res, Scale, Series, line_chart, r2, view};
 use brdf::fresnel::NoFresnel;
 use brdf::glint::{
     BeckmannMixture, BinMap, BinMapParams, Footprint, GlintNdf, MaskingMode, MixtureParams,
@@ -86,24 +86,6 @@ impl Settings {
             v_samples: 1024,
         }
     }
-}
-
-fn view(theta: f64) -> Vec3 {
-    let (t, p) = (theta.to_radians(), 30f64.to_radians());
-    Vec3::new(
-        (t.sin() * p.cos()) as f32,
-        (t.sin() * p.sin()) as f32,
-        t.cos() as f32,
-    )
-}
-
-/// A low-discrepancy point (R2 sequence) in [0, 1)².
-fn r2(k: usize) -> Vec2 {
-    let (a, b) = (0.754_877_666_246_692_7_f64, 0.569_840_290_998_053_2_f64);
-    Vec2::new(
-        (0.5 + a * k as f64).fract() as f32,
-        (0.5 + b * k as f64).fract() as f32,
-    )
 }
 
 /// Beckmann V(w) in f64 at polar angle θ (isotropic α).
@@ -225,14 +207,27 @@ fn analytic_rows(settings: &Settings) -> Res<Vec<Row>> {
     Ok(rows)
 }
 
-/// The rows of one glint patch (as an NDF inside `MicrofacetBrdf`, furnace in the patch measure).
+/// The rows of one glint patch inside `MicrofacetBrdf`, furnace in the patch measure.
 fn patch_rows(label: &str, patch: &dyn Ndf, settings: &Settings, rows: &mut Vec<Row>) {
-    let brdf = MicrofacetBrdf::new(patch, NoFresnel);
     let area = |w: Vec3| patch.projected_area(w).max(0.0);
+    let brdf = MicrofacetBrdf::new(patch, NoFresnel);
+    brdf_rows(label, patch, &brdf, &area, settings, rows);
+}
+
+/// The rows of `brdf` built on `patch`: the patch's V against its Monte Carlo reference, and the
+/// BRDF's furnace weighted by `cosine`.
+fn brdf_rows(
+    label: &str,
+    patch: &dyn Ndf,
+    brdf: &dyn Bxdf,
+    cosine: &dyn Fn(Vec3) -> f32,
+    settings: &Settings,
+    rows: &mut Vec<Row>,
+) {
     for theta in THETAS {
         let wo = view(theta);
         let v_ref = v_monte_carlo(patch, wo, settings.v_samples);
-        let f = furnace(&brdf, wo, &area, settings.furnace_samples);
+        let f = furnace(brdf, wo, cosine, settings.furnace_samples);
         rows.push(row(label, theta, patch.visible_area(wo) as f64, v_ref, f));
     }
 }
@@ -281,19 +276,14 @@ fn glint_rows(name: &str, map: &NormalMap, settings: &Settings) -> Res<Vec<Row>>
     // The published BRDF (cos θo cos θi normalisation), furnace with the geometric cosine: its V
     // column repeats the patch's.
     let published = PositionNormalBrdf::new(&patch, NoFresnel);
-    let cos = |w: Vec3| w.z.max(0.0);
-    for theta in THETAS {
-        let wo = view(theta);
-        let f = furnace(&published, wo, &cos, settings.furnace_samples);
-        let v_ref = v_monte_carlo(&patch, wo, settings.v_samples);
-        rows.push(row(
-            &format!("{name}: position-normal (published BRDF)"),
-            theta,
-            patch.visible_area(wo) as f64,
-            v_ref,
-            f,
-        ));
-    }
+    brdf_rows(
+        &format!("{name}: position-normal (published BRDF)"),
+        &patch,
+        &published,
+        &|w: Vec3| w.z.max(0.0),
+        settings,
+        &mut rows,
+    );
     Ok(rows)
 }
 

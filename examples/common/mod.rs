@@ -304,3 +304,23 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
     }
     save_rgb(path, w, h, buf)
 }
+
+/// A unit direction at polar angle `theta` (degrees) and azimuth 30° (off the tangent axes, so that
+/// anisotropic lobes are seen obliquely), in the local shading frame.
+pub fn view(theta: f64) -> brdf::Vec3 {
+    let (t, p) = (theta.to_radians(), 30f64.to_radians());
+    brdf::Vec3::new(
+        (t.sin() * p.cos()) as f32,
+        (t.sin() * p.sin()) as f32,
+        t.cos() as f32,
+    )
+}
+
+/// The k-th point of the R2 low-discrepancy sequence in [0, 1)².
+pub fn r2(k: usize) -> brdf::Vec2 {
+    let (a, b) = (0.754_877_7_f64, 0.569_840_3_f64);
+    brdf::Vec2::new(
+        (0.5 + a * k as f64).fract() as f32,
+        (0.5 + b * k as f64).fract() as f32,
+    )
+}

@@ -119,6 +119,21 @@ pub trait Ndf {
     }
 }
 
+/// Λ(w) = V(w)/A(w) − 1 from an NDF's own visible and projected areas: Smith's identity read
+/// backwards, for the NDFs whose V and A are the primary quantities (the glint patches, \[Chermain2019\]
+/// eq. 15). 0 for a below-horizon or non-finite `w`; `f32::MAX` where A(w) ≤ 0 < w_z (a patch leaning
+/// away from `w`: nothing of it is seen).
+pub(crate) fn lambda_from_areas<N: Ndf + ?Sized>(ndf: &N, w: Vec3) -> f32 {
+    if !(w.z > 0.0 && w.is_finite()) {
+        return 0.0;
+    }
+    let a = ndf.projected_area(w);
+    if a.is_nan() || a <= 0.0 {
+        return f32::MAX;
+    }
+    ((ndf.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
+}
+
 /// A reference to an NDF is an NDF (so a BRDF can borrow a patch or a shared lobe).
 impl<T: Ndf + ?Sized> Ndf for &T {
     fn d(&self, m: Vec3) -> f32 {

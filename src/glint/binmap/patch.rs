@@ -438,14 +438,7 @@ impl Ndf for BinMapPatch<'_> {
     /// Λ(w) = V(w)/A(w) − 1 (exact terms) or the masking lobe's Λ (type docs); `f32::MAX` when
     /// A(w) ≤ 0 < w_z, 0 for invalid w.
     fn lambda(&self, w: Vec3) -> f32 {
-        if !(w.z > 0.0 && w.is_finite()) {
-            return 0.0;
-        }
-        let a = self.projected_area(w);
-        if a.is_nan() || a <= 0.0 {
-            return f32::MAX;
-        }
-        ((self.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
+        crate::ndf::lambda_from_areas(self, w)
     }
 
     /// A(w) = max(w · Σ_j mass_j m̄_j / c̄_j, 0) (exact terms) or the masking lobe's

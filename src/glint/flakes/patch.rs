@@ -446,14 +446,7 @@ impl Ndf for PositionNormalPatch<'_> {
     /// Λ = V/A − 1 with V from [`Ndf::visible_area`] (exact, or Scarf's bound for large patches) and A
     /// from the P-NDF's mean slope; 0 for invalid w, `f32::MAX` where A(w) = 0 < w_z.
     fn lambda(&self, w: Vec3) -> f32 {
-        if !(w.z > 0.0 && w.is_finite()) {
-            return 0.0;
-        }
-        let a = self.projected_area(w);
-        if a.is_nan() || a <= 0.0 {
-            return f32::MAX;
-        }
-        ((self.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
+        crate::ndf::lambda_from_areas(self, w)
     }
 
     /// A(w) of the moments lobe: max(cos θ − w_xy·μ_P, 0) with μ_P the P-NDF's mean slope.

@@ -520,15 +520,7 @@ impl Ndf for MixturePatch<'_> {
     /// # Reference
     /// \[Chermain2019\] eq. 15 (exact), §4.2.2 (approximate).
     fn lambda(&self, w: Vec3) -> f32 {
-        if !(w.z > 0.0 && w.is_finite()) {
-            return 0.0;
-        }
-        let a = self.projected_area(w);
-        if a.is_nan() || a <= 0.0 {
-            return f32::MAX;
-        }
-        let l = (self.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32;
-        l.min(f32::MAX)
+        crate::ndf::lambda_from_areas(self, w)
     }
 
     /// A_P(w): max(signed A_P, 0) (exact) or the filtered lobe's A (approximate / level of detail).
