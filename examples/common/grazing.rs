@@ -165,43 +165,31 @@ fn row(method: &str, theta: f64, v: f64, v_ref: (f64, f64), f: [f64; 4]) -> Row 
     }
 }
 
+/// An analytic NDF, its microfacet BRDF, and its f64 closed-form V(α, θ).
+type AnalyticModel<'a> = (&'static str, &'a dyn Ndf, &'a dyn Bxdf, fn(f64, f64) -> f64);
+
 fn analytic_rows(settings: &Settings) -> Res<Vec<Row>> {
     let mut rows = Vec::new();
     let cos = |w: Vec3| w.z.max(0.0);
     for alpha in [0.05f32, 0.5] {
-        let b = Beckmann::isotropic(alpha)?;
-        let g = Ggx::isotropic(alpha)?;
-        for theta in THETAS {
-            let wo = view(theta);
-            let t = theta.to_radians();
-            let label = format!("Beckmann α={alpha}");
-            let fb = furnace(
+        let (b, g) = (Beckmann::isotropic(alpha)?, Ggx::isotropic(alpha)?);
+        let models: [AnalyticModel; 2] = [
+            (
+                "Beckmann",
+                &b,
                 &MicrofacetBrdf::new(b, NoFresnel),
-                wo,
-                &cos,
-                settings.furnace_samples,
-            );
-            rows.push(row(
-                &label,
-                theta,
-                b.visible_area(wo) as f64,
-                (beckmann_v_ref(alpha as f64, t), 0.0),
-                fb,
-            ));
-            let label = format!("GGX α={alpha}");
-            let fg = furnace(
-                &MicrofacetBrdf::new(g, NoFresnel),
-                wo,
-                &cos,
-                settings.furnace_samples,
-            );
-            rows.push(row(
-                &label,
-                theta,
-                g.visible_area(wo) as f64,
-                (ggx_v_ref(alpha as f64, t), 0.0),
-                fg,
-            ));
+                beckmann_v_ref,
+            ),
+            ("GGX", &g, &MicrofacetBrdf::new(g, NoFresnel), ggx_v_ref),
+        ];
+        for (name, ndf, brdf, v_ref) in models {
+            let label = format!("{name} α={alpha}");
+            for theta in THETAS {
+                let wo = view(theta);
+                let f = furnace(brdf, wo, &cos, settings.furnace_samples);
+                let v = (v_ref(alpha as f64, theta.to_radians()), 0.0);
+                rows.push(row(&label, theta, ndf.visible_area(wo) as f64, v, f));
+            }
         }
     }
     Ok(rows)
