@@ -76,7 +76,7 @@ pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
 /// callers check the hemisphere themselves.
 #[inline]
 pub fn half_vector(wo: Vec3, wi: Vec3) -> Option<Vec3> {
-    (wo + wi).try_normalize()
+    half_vector_cos(wo, wi).map(|(h, _)| h)
 }
 
 /// The half vector ω_h of two unit directions and the cosine ω_o·ω_h (= ω_i·ω_h), taken as
@@ -89,14 +89,11 @@ pub fn half_vector(wo: Vec3, wi: Vec3) -> Option<Vec3> {
 /// its relative accuracy. Symmetric in (ω_o, ω_i) to the last bit. `None` as [`half_vector`].
 #[inline]
 pub fn half_vector_cos(wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
+    // A multiply by 1/‖s‖, rounded as `Vec3::try_normalize` rounds.
     let s = wo + wi;
     let len = s.length();
-    if len > 0.0 && len.is_finite() {
-        let h = s / len;
-        h.is_finite().then_some((h, 0.5 * len))
-    } else {
-        None
-    }
+    let rcp = 1.0 / len;
+    (rcp.is_finite() && rcp > 0.0).then(|| (s * rcp, 0.5 * len))
 }
 
 /// `v` normalised, exactly even where its squared length leaves f32's normal range (below ~10⁻³⁸ or

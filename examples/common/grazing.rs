@@ -322,6 +322,19 @@ fn series(rows: &[Row], keep: &dyn Fn(&str) -> bool, y: &dyn Fn(&Row) -> f64) ->
         .collect()
 }
 
+/// One chart of the sweep against 90° − θo.
+struct GrazingChart {
+    file: &'static str,
+    title: &'static str,
+    y_label: &'static str,
+    log_y: bool,
+    y_range: (f64, f64),
+    /// Include the published position-normal BRDF (its V column repeats the patch's).
+    with_published: bool,
+    value: fn(&Row) -> f64,
+    caption: &'static str,
+}
+
 /// Writes the CSV, the charts and the markdown table.
 pub fn report(rows: &[Row], out: &Path) -> Res<(Vec<Artifact>, String)> {
     std::fs::create_dir_all(out)?;
@@ -348,62 +361,58 @@ pub fn report(rows: &[Row], out: &Path) -> Res<(Vec<Artifact>, String)> {
         &csv_path,
         "Grazing sweep: every measurement (CSV).",
     )];
-    let all = |_: &str| true;
-    let not_published = |m: &str| !m.contains("published");
-    let x_label = "90° − θo (degrees, log scale)";
-
-    let mut chart = Chart::new(
-        "Visible-area error against view angle",
-        x_label,
-        "|V − V_ref| / V_ref",
-    );
-    chart.x_scale = Scale::Log;
-    chart.y_scale = Scale::Log;
-    chart.markers = true;
-    chart.size = (900, 560);
-    chart.y_range = Some((1e-8, 10.0));
-    let path = out.join("grazing_visible_area_error.png");
-    line_chart(
-        &path,
-        &chart,
-        &series(rows, &not_published, &|r| r.v_rel_error.max(1e-8)),
-    )?;
-    artifacts.push(Artifact::new(
-        &path,
-        "Relative error of V(wo) = A(1 + Λ) against 90° − θo: analytic NDFs against f64 closed forms, \
-         glint patches against a Monte Carlo integral of their own D (floor ≈ its standard error).",
-    ));
-
-    let mut chart = Chart::new("White furnace against view angle (F = 1)", x_label, "E(wo)");
-    chart.x_scale = Scale::Log;
-    chart.markers = true;
-    chart.size = (900, 560);
-    chart.y_range = Some((0.0, 1.6));
-    let path = out.join("grazing_furnace.png");
-    line_chart(&path, &chart, &series(rows, &all, &|r| r.furnace))?;
-    artifacts.push(Artifact::new(
-        &path,
-        "White furnace against 90° − θo: cos θi measure for the analytic lobes, the patch measure \
-         A_P(wi)⁺ for the glint patches, cos θi for the published position-normal BRDF.",
-    ));
-
-    let mut chart = Chart::new("Spread of the sample weight", x_label, "σ_w / E");
-    chart.x_scale = Scale::Log;
-    chart.y_scale = Scale::Log;
-    chart.markers = true;
-    chart.size = (900, 560);
-    chart.y_range = Some((1e-4, 1e3));
-    let path = out.join("grazing_weight_spread.png");
-    line_chart(
-        &path,
-        &chart,
-        &series(rows, &all, &|r| r.weight_spread.max(1e-4)),
-    )?;
-    artifacts.push(Artifact::new(
-        &path,
-        "Relative standard deviation of one sample's weight f·c/pdf (visible-normal sampling where \
-         the model has it) against 90° − θo: where a renderer's noise grows.",
-    ));
+    let charts = [
+        GrazingChart {
+            file: "grazing_visible_area_error.png",
+            title: "Visible-area error against view angle",
+            y_label: "|V − V_ref| / V_ref",
+            log_y: true,
+            y_range: (1e-8, 10.0),
+            with_published: false,
+            value: |r| r.v_rel_error.max(1e-8),
+            caption: "Relative error of V(wo) = A(1 + Λ) against 90° − θo: analytic NDFs against f64 \
+                      closed forms, glint patches against a Monte Carlo integral of their own D \
+                      (floor ≈ its standard error).",
+        },
+        GrazingChart {
+            file: "grazing_furnace.png",
+            title: "White furnace against view angle (F = 1)",
+            y_label: "E(wo)",
+            log_y: false,
+            y_range: (0.0, 1.6),
+            with_published: true,
+            value: |r| r.furnace,
+            caption: "White furnace against 90° − θo: cos θi measure for the analytic lobes, the \
+                      patch measure A_P(wi)⁺ for the glint patches, cos θi for the published \
+                      position-normal BRDF.",
+        },
+        GrazingChart {
+            file: "grazing_weight_spread.png",
+            title: "Spread of the sample weight",
+            y_label: "σ_w / E",
+            log_y: true,
+            y_range: (1e-4, 1e3),
+            with_published: true,
+            value: |r| r.weight_spread.max(1e-4),
+            caption: "Relative standard deviation of one sample's weight f·c/pdf (visible-normal \
+                      sampling where the model has it) against 90° − θo: where a renderer's noise \
+                      grows.",
+        },
+    ];
+    for c in charts {
+        let mut chart = Chart::new(c.title, "90° − θo (degrees, log scale)", c.y_label);
+        chart.x_scale = Scale::Log;
+        if c.log_y {
+            chart.y_scale = Scale::Log;
+        }
+        chart.markers = true;
+        chart.size = (900, 560);
+        chart.y_range = Some(c.y_range);
+        let path = out.join(c.file);
+        let keep = |m: &str| c.with_published || !m.contains("published");
+        line_chart(&path, &chart, &series(rows, &keep, &c.value))?;
+        artifacts.push(Artifact::new(&path, c.caption));
+    }
 
     let mut md = String::from(
         "| method | θo | V rel. error | (V_ref rel. SE) | furnace | σ_w/E | lost |\n|---|---|---|---|---|---|---|\n",
