@@ -1,6 +1,23 @@
-//! The microfacet BRDF f = F(wo·h) G2 D(h) / (4 A(wo) A(wi)), generic over the NDF and the Fresnel
+//! The microfacet BRDF f = F(wo·h) G2 D(h) / (4 A(wo) cos θi), generic over the NDF and the Fresnel
 //! term: Torrance-Sparrow / Cook-Torrance for centred NDFs (A = cos θ), Chermain's P-BRDF for glint
-//! patches (A = the patch's projected area).
+//! patches (A = the patch's projected area), in the measure every renderer integrates.
+//!
+//! ## The renderer's measure
+//! Chermain's P-BRDF f_P = F G2 D / (4 A(wo) A(wi)) (eq. 7) is normalised in the patch's own measure:
+//! the patch intercepts light from wi in proportion to its projected area A(wi), so the reflected
+//! radiance is ∫ L(wi) f_P A(wi) dωi. A renderer computes ∫ L(wi) f(wo, wi) cos θi dωi with the
+//! *geometric* cos θi, so the value returned here is f = f_P · A(wi)/cos θi
+//! = F G2 D / (4 A(wo) cos θi). For a centred NDF A(wi) = cos θi and the factor is exactly 1 (the
+//! analytic BRDFs are bit-identical to Torrance-Sparrow); for a glint patch whose mean normal leans,
+//! it is what makes the renderer's white furnace ∫ f cos θi dωi ≤ 1:
+//! ∫ f cos θi dωi = ∫ F G2 D(h) / (4 A_o) dωi ≤ ∫ ⟨wo,h⟩⁺ D(h) dh / V_o ≤ 1, using G2 ≤ G1(wo) = A_o/V_o
+//! (Λ(wi) ≥ 0) and V_o ≥ ∫⟨wo,m⟩⁺ D dm — so every model only needs a visible area that is exact or
+//! an upper bound.
+//!
+//! Reciprocity: f_P is symmetric; f itself obeys f(wo, wi) cos θi / A(wi) = f(wi, wo) cos θo / A(wo),
+//! which for centred NDFs is the usual f(wo, wi) = f(wi, wo). A leaning patch is not a reciprocal
+//! BRDF in the geometric measure, and should not be: it is a tilted surface seen through a footprint
+//! of the geometric one, and its reciprocal form lives in its own projected-area measure.
 //!
 //! The masking factor is written with the NDF's visible area V(w) = A(w)(1 + Λ(w)) = ∫⟨w, m⟩ D dm so
 //! that no term divides by a projected area that may vanish (non-centred lobes, patches):
@@ -42,14 +59,17 @@ pub enum Sampling {
     VisibleNormals,
 }
 
-/// The microfacet BRDF f(wo, wi) = F(wo·h) · G2(wo, wi, h) · D(h) / (4 A(wo) A(wi)), h = normalize(wo + wi).
+/// The microfacet BRDF f(wo, wi) = F(wo·h) · G2(wo, wi, h) · D(h) / (4 A(wo) cos θi), h = normalize(wo + wi),
+/// in the renderer's measure (∫ f cos θi dωi with the geometric cosine; module docs).
 ///
 /// With a centred NDF (A = cos θ) this is the Torrance-Sparrow model (\[TorranceSparrow1967\],
 /// \[Walter2007\] eq. 20), called Cook-Torrance with Beckmann's D (\[CookTorrance1982\]); with a glint patch
-/// it is the P-BRDF of \[Chermain2019\], eq. 7. Implemented as F · D(h)/4 · M(wo, wi) with the masking
-/// factor M = G2/(A_o A_i) written through `visible_area` (module docs), so nothing divides by A.
+/// it is the P-BRDF of \[Chermain2019\], eq. 7, times A(wi)/cos θi. Implemented as
+/// F · D(h)/4 · M(wo, wi) · A(wi)/cos θi with the masking factor M = G2/(A_o A_i) written through
+/// `visible_area` (module docs), so nothing divides by A.
 ///
-/// Reciprocal when F(wo·h) is (it is: wo·h = wi·h) and the NDF's masking is; single scattering only:
+/// Reciprocal for centred NDFs when F(wo·h) is (it is: wo·h = wi·h) and the NDF's masking is; for a
+/// leaning glint patch f cos θi / A(wi) is (module docs). Single scattering only:
 /// the albedo is below 1 for rough surfaces even with F = 1 (energy lost by masking, tabulated in
 /// docs/results.md).
 ///
@@ -175,13 +195,30 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
         (c > 0.0).then_some((h, c))
     }
 
+    /// The renderer's-measure factor A(wi)/cos θi that turns the patch BRDF f_P (normalised in the
+    /// measure A(wi) dωi) into the BRDF a renderer integrates against the geometric cos θi dωi:
+    /// exactly 1 for centred NDFs (A = cos θ, and x/x = 1 in IEEE arithmetic), the patch's projected
+    /// area over the geometric cosine for leaning glint patches, 0 when the patch's mean plane faces
+    /// away from wi (A ≤ 0: it intercepts no light from there).
+    #[inline]
+    fn measure_factor(&self, wi: Vec3) -> f32 {
+        let ai = self.ndf.projected_area(wi);
+        if ai > 0.0 && wi.z > 0.0 {
+            ai / wi.z
+        } else {
+            0.0
+        }
+    }
+
+    /// f(wo, wi) in the renderer's measure: F · D/4 · M(wo, wi) · A(wi)/cos θi (module docs).
     #[inline]
     fn eval_at(&self, wo: Vec3, wi: Vec3, h: Vec3, c: f32) -> Vec3 {
         let d = self.ndf.d(h);
         if d.is_nan() || d <= 0.0 {
             return Vec3::ZERO;
         }
-        let v = self.fresnel.eval(c) * (0.25 * d * self.masking_factor(wo, wi));
+        let scale = 0.25 * d * self.masking_factor(wo, wi) * self.measure_factor(wi);
+        let v = self.fresnel.eval(c) * scale;
         if v.is_finite() { v } else { Vec3::ZERO }
     }
 

@@ -20,7 +20,7 @@
 //! \[Chermain2019\] §4.1 (Gaussian footprint k_P); \[Igehy1999\] (ray differentials); \[Atanasov2020\] §2
 //! (the pixel footprint A of the bin map, from ray differentials).
 
-use glam::{Mat2, Vec2};
+use glam::{Mat2, Vec2, Vec3};
 
 /// Smallest footprint width along any principal axis, in texels (so the smallest area is 10⁻⁴ texel²).
 ///
@@ -52,11 +52,25 @@ pub const MAX_EXTENT_PERIODS: f32 = 2.0;
 
 /// A ray footprint on a tiled normal map, in uv units of the map. Cheap to copy.
 ///
-/// Build one per shading point with [`Footprint::from_differentials`]; read it in texel units of a map
-/// with [`Footprint::gaussian_texels`] or [`Footprint::parallelogram_texels`]. See the
-/// [`glint` module docs](crate::glint) and the constants for the two views and the clamps; the
-/// source file's module comment has the full discussion. Map sizes of 0 given to the views are
-/// treated as 1.
+/// # Building one per shading point (the recipe)
+///
+/// A renderer with ray differentials (pbrt's `RayDifferential`: the camera ray plus the rays through
+/// the neighbouring pixels, offsets (rx_o, rx_d) and (ry_o, ry_d)) does, at a hit p with normal n,
+/// uv and the parametrisation's ∂p/∂u, ∂p/∂v:
+/// 1. intersect the two offset rays with the tangent plane at p: t_x = n·(p − rx_o) / n·rx_d,
+///    ∂p/∂x ≈ rx_o + t_x rx_d − p (same for y). Without ray differentials, ∂p/∂x can be
+///    approximated from the camera (pbrt-v4's `Camera::Approximate_dp_dxy`). Scale both by
+///    1/√(samples per pixel) when each pixel takes several samples, so that the footprints of all
+///    samples of a pixel tile it rather than each covering it whole;
+/// 2. call [`Footprint::from_surface_differentials`]`(uv, ∂p/∂u, ∂p/∂v, ∂p/∂x, ∂p/∂y)`, which solves
+///    ∂p/∂x = ∂p/∂u ∂u/∂x + ∂p/∂v ∂v/∂x in the least-squares sense for ∂uv/∂x (and y);
+/// 3. if the material scales uv (a map repeated k times: uv' = k uv), scale uv and both differentials
+///    by k, or call [`Footprint::from_differentials`] with the scaled ∂uv directly.
+///
+/// Then read it in texel units of a map with [`Footprint::gaussian_texels`] or
+/// [`Footprint::parallelogram_texels`] (the glint models do this). See the
+/// [`glint` module docs](crate::glint) and the constants for the two views and the clamps. Map
+/// sizes of 0 given to the views are treated as 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Footprint {
     uv: Vec2,
@@ -120,6 +134,43 @@ impl Footprint {
             (Vec2::ZERO, Vec2::ZERO)
         };
         Footprint { uv, duv_dx, duv_dy }
+    }
+
+    /// The footprint of a ray hit from the surface's ∂p/∂u, ∂p/∂v and the ray differentials ∂p/∂x,
+    /// ∂p/∂y (any common world frame and unit; the recipe is in the type's docs): ∂uv/∂x is the
+    /// least-squares solution of ∂p/∂u ∂u/∂x + ∂p/∂v ∂v/∂x = ∂p/∂x (normal equations in `f64`), the
+    /// same for y, then [`Footprint::from_differentials`].
+    ///
+    /// Degenerate cases: a singular parametrisation (∂p/∂u ∥ ∂p/∂v, or either zero) or non-finite
+    /// input gives zero differentials, i.e. the minimal footprint ([`MIN_WIDTH_TEXELS`]); the result
+    /// is never NaN.
+    ///
+    /// # Reference
+    /// \[Igehy1999\] (ray differentials); the least-squares step is pbrt-v4's
+    /// `SurfaceInteraction::ComputeDifferentials` (\[Pharr2023\] §10.1.1).
+    pub fn from_surface_differentials(
+        uv: Vec2,
+        dpdu: Vec3,
+        dpdv: Vec3,
+        dpdx: Vec3,
+        dpdy: Vec3,
+    ) -> Footprint {
+        let f = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let (pu, pv) = (f(dpdu), f(dpdv));
+        let (a00, a01, a11) = (dot(pu, pu), dot(pu, pv), dot(pv, pv));
+        let det = a00 * a11 - a01 * a01;
+        // Relative test: ∂p/∂u and ∂p/∂v (nearly) parallel, or zero.
+        let solve = |d: Vec3| -> Vec2 {
+            if !(det > 1e-12 * a00 * a11 && det.is_finite()) {
+                return Vec2::ZERO;
+            }
+            let (b0, b1) = (dot(pu, f(d)), dot(pv, f(d)));
+            let du = (a11 * b0 - a01 * b1) / det;
+            let dv = (a00 * b1 - a01 * b0) / det;
+            Vec2::new(du as f32, dv as f32)
+        };
+        Footprint::from_differentials(uv, solve(dpdx), solve(dpdy))
     }
 
     /// A square footprint of `area_texels` texels² (side √area texels, axis aligned) centred at

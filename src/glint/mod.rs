@@ -57,10 +57,12 @@ mod footprint;
 #[cfg(feature = "image")]
 mod image_io;
 mod mixture;
+mod model;
 mod moments;
 mod normal_map;
 mod procedural;
 mod reference;
+mod scratch;
 mod slope_tree;
 
 pub use binmap::{
@@ -80,12 +82,14 @@ pub use mixture::{
     MAX_TRUNCATION_SIGMAS, MIN_SPACING, MaskingMode, MixtureMemory, MixtureParams, MixturePatch,
     PatchOptions,
 };
+pub use model::{GlintModel, GlintPatch};
 pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
 };
 pub use procedural::{
     BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
 };
+pub use scratch::GlintScratch;
 pub use reference::{BinnedPndf, Kernel, REFERENCE_BATCHES, binned_pndf, naive_brdf, tv_distance};
 
 use crate::ndf::Ndf;
@@ -139,5 +143,15 @@ pub trait GlintNdf {
 
     /// The P-NDF of the surface seen through one ray footprint:
     /// D_P(ω_h) = ∫ δ(ω_n(u) − ω_h) k_P(u) du (\[Chermain2019\] eq. 8), as approximated by the model.
+    /// May allocate the patch's working buffers; see [`GlintNdf::patch_in`].
     fn patch(&self, footprint: &Footprint) -> Self::Patch<'_>;
+
+    /// The same patch, with its working buffers lent by a caller's [`GlintScratch`] (one per render
+    /// thread) and given back when the patch drops: once the scratch has grown to the largest
+    /// footprint, building and querying a patch performs no heap allocation. Bit-identical results
+    /// to [`GlintNdf::patch`]. The default ignores the scratch (for models that need none).
+    fn patch_in<'a>(&'a self, footprint: &Footprint, scratch: &'a mut GlintScratch) -> Self::Patch<'a> {
+        let _ = scratch;
+        self.patch(footprint)
+    }
 }

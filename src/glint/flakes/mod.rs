@@ -21,10 +21,12 @@ mod patch;
 
 pub use brdf::{DEFAULT_MASKING_ALPHA, PositionNormalBrdf};
 pub use patch::{EXACT_MASKING_ELEMENTS, PositionNormalPatch};
+/// The position-normal part of [`crate::glint::GlintScratch`].
+pub(crate) type PositionNormalScratch = patch::Slots;
 
 use crate::error::{Error, Result, positive};
 use crate::glint::slope_tree::SlopeTree;
-use crate::glint::{Footprint, GlintNdf, MAX_TRUNCATION_SIGMAS, NormalMap};
+use crate::glint::{Footprint, GlintNdf, GlintScratch, MAX_TRUNCATION_SIGMAS, NormalMap};
 use glam::{Mat2, Vec2};
 
 /// σ_h / h = 1/√(8 ln 2) (see [`PositionNormalMap::SIGMA_H_PER_SPACING`]).
@@ -264,5 +266,14 @@ impl GlintNdf for PositionNormalMap {
     /// The position-normal P-NDF of a footprint ([`PositionNormalPatch::new`]).
     fn patch(&self, footprint: &Footprint) -> PositionNormalPatch<'_> {
         PositionNormalPatch::new(self, footprint)
+    }
+
+    /// [`GlintNdf::patch`] with the per-element buffers lent by `scratch`.
+    fn patch_in<'a>(
+        &'a self,
+        footprint: &Footprint,
+        scratch: &'a mut GlintScratch,
+    ) -> PositionNormalPatch<'a> {
+        PositionNormalPatch::new_in(self, footprint, Some(scratch))
     }
 }

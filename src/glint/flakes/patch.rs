@@ -16,7 +16,8 @@ use crate::glint::slope_tree::contains;
 use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
-use std::sync::OnceLock;
+use crate::glint::GlintScratch;
+use crate::glint::scratch::Loan;
 
 const TWO_PI: f64 = std::f64::consts::TAU;
 
@@ -175,9 +176,10 @@ fn segments(range: [i64; 2], n: usize) -> impl Iterator<Item = (usize, usize, i6
     })
 }
 
-/// The per-element lobes of a patch, for the samplers and the untruncated densities.
-#[derive(Clone, Debug)]
-struct Slots {
+/// The per-element lobes of a patch, for the samplers and the untruncated densities; also the
+/// position-normal part of [`GlintScratch`] (only its capacity is kept between patches).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Slots {
     /// Normalised weights W_i (sum 1).
     weights: Vec<f64>,
     /// Cumulative weights (last = Σ weights).
@@ -225,7 +227,9 @@ pub struct PositionNormalPatch<'a> {
     mean_slope: Vec2,
     moments: [f32; 5],
     moments_lobe: SlopeGaussian,
-    slots: OnceLock<Slots>,
+    /// Built on the first call that needs every element (masking, samplers, densities), in buffers
+    /// lent by the caller's scratch if any.
+    slots: Loan<'a, Slots>,
 }
 
 /// Largest patch (number of elements kept) whose masking terms use the exact V(w) = Σ W_i V_i(w);
@@ -237,6 +241,16 @@ impl<'a> PositionNormalPatch<'a> {
     /// The P-NDF of `footprint` (see the type's docs). Total: any footprint works; cost
     /// O(elements within `weight_sigmas` of the footprint).
     pub fn new(map: &'a PositionNormalMap, footprint: &Footprint) -> PositionNormalPatch<'a> {
+        Self::new_in(map, footprint, None)
+    }
+
+    /// [`PositionNormalPatch::new`] with its per-element buffers lent by `scratch` (given back when
+    /// the patch drops): no heap allocation once the scratch has grown to the footprint's size.
+    pub fn new_in(
+        map: &'a PositionNormalMap,
+        footprint: &Footprint,
+        scratch: Option<&'a mut GlintScratch>,
+    ) -> PositionNormalPatch<'a> {
         let geo = Geometry::new(map, footprint);
         let rect = [geo.range(0), geo.range(1)];
         let mut total = 0.0f64;
@@ -264,7 +278,7 @@ impl<'a> PositionNormalPatch<'a> {
             mean_slope: Vec2::new(moments[0], moments[1]),
             moments,
             moments_lobe,
-            slots: OnceLock::new(),
+            slots: Loan::new(scratch.map(|s| &mut s.position_normal)),
         }
     }
 
@@ -317,26 +331,25 @@ impl<'a> PositionNormalPatch<'a> {
     }
 
     fn slots(&self) -> &Slots {
-        self.slots.get_or_init(|| {
-            let mut weights = Vec::with_capacity(self.count);
-            let mut lobes = Vec::with_capacity(self.count);
+        self.slots.get_or_init(|mut slots| {
+            let Slots {
+                weights,
+                cdf,
+                lobes,
+            } = &mut slots;
+            weights.clear();
+            lobes.clear();
+            cdf.clear();
             Self::for_each_kept(self.map, &self.geo, self.rect, |w, mean, cov| {
                 weights.push(w * self.inv_total);
                 lobes.push(lobe_of(mean, cov, self.map.params.sigma_r));
             });
             let mut acc = 0.0;
-            let cdf = weights
-                .iter()
-                .map(|w| {
-                    acc += w;
-                    acc
-                })
-                .collect();
-            Slots {
-                weights,
-                cdf,
-                lobes,
-            }
+            cdf.extend(weights.iter().map(|w| {
+                acc += w;
+                acc
+            }));
+            slots
         })
     }
 

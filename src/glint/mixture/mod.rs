@@ -17,6 +17,7 @@ mod hierarchy;
 mod patch;
 
 pub use patch::MixturePatch;
+pub(crate) use patch::MixtureScratch;
 
 use crate::error::{Error, Result, positive};
 use crate::glint::slope_tree::SlopeTree;
@@ -85,8 +86,11 @@ pub enum MaskingMode {
     /// slope (\[Chermain2019\] eq. 13-17). O(lobes) per direction.
     #[default]
     Exact,
-    /// Approximate: the Smith terms of one Beckmann lobe filtered from the moment mip chain
-    /// (\[Chermain2019\] §4.2.2). O(1) per direction.
+    /// Approximate: A_P from the patch mean slope (exact) and V_P bounded from above by Scarf's
+    /// bound on the patch's slope mean and covariance, gathered once per patch. O(1) per
+    /// direction. Sound where the paper's filtered-lobe Λ (\[Chermain2019\] §4.2.2) is not: V is never
+    /// under-estimated, so the white furnace stays ≤ 1; the price is darker grazing views (the bound
+    /// over-shadows; docs/results.md, "Beckmann mixture").
     Approximate,
 }
 
@@ -357,5 +361,14 @@ impl GlintNdf for BeckmannMixture {
     /// The P-NDF of a footprint with the options of [`MixtureParams::patch`].
     fn patch(&self, footprint: &Footprint) -> MixturePatch<'_> {
         MixturePatch::new(self, footprint, self.params.patch)
+    }
+
+    /// [`GlintNdf::patch`] with the per-slot buffers lent by `scratch`.
+    fn patch_in<'a>(
+        &'a self,
+        footprint: &Footprint,
+        scratch: &'a mut crate::glint::GlintScratch,
+    ) -> MixturePatch<'a> {
+        MixturePatch::new_in(self, footprint, self.params.patch, Some(scratch))
     }
 }

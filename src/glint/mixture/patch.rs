@@ -17,7 +17,8 @@ use crate::glint::slope_tree::contains;
 use crate::math::{finite_f32, finite_or_zero};
 use crate::ndf::{DEFAULT_SIGMA_MIN, Ndf, SIGMA_MIN_FLOOR, SlopeGaussian};
 use glam::{Vec2, Vec3};
-use std::sync::OnceLock;
+use crate::glint::GlintScratch;
+use crate::glint::scratch::{Lent, Loan};
 
 /// The slots of one axis of the weight rectangle.
 #[derive(Clone, Copy, Debug)]
@@ -111,16 +112,50 @@ impl AxisSlots {
     }
 }
 
-/// The gathered lobes of a footprint.
-#[derive(Clone, Debug)]
-struct Gathered {
-    axes: [AxisSlots; 2],
+/// The per-slot buffers of a patch; also part of the mixture's share of [`GlintScratch`].
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SlotBuffers {
     /// Normalised W per slot, row major (slot_y * len_x + slot_x), summing to 1.
     weights: Vec<f32>,
     /// Cumulative weights (f64), last = Σ of `weights` in f64.
     cdf: Vec<f64>,
+}
+
+/// The mixture's share of [`GlintScratch`]: the buffers a patch borrows.
+#[derive(Debug, Default)]
+pub(crate) struct MixtureScratch {
+    slots: SlotBuffers,
+    lobes: Vec<SlopeGaussian>,
+}
+
+/// The gathered lobes of a footprint.
+#[derive(Clone, Debug)]
+struct Gathered<'a> {
+    axes: [AxisSlots; 2],
+    /// Weights and their cdf, per slot.
+    bufs: Lent<'a, SlotBuffers>,
     /// Σ W_i μ_i: the patch mean slope.
     mean_slope: Vec2,
+    /// The patch's slope covariance Σ_P = Σ W_i (Σ_i + μ_i μ_iᵀ) − μ_P μ_Pᵀ, [xx, xy, yy] (f64), with
+    /// each lobe's covariance as its D uses it (floored, correlation clamped): the second moment that
+    /// the approximate masking's Scarf bound needs.
+    slope_cov: [f64; 3],
+}
+
+/// A lobe's slope mean and covariance as D evaluates it: variances floored at σ², correlation
+/// clamped so that the floored matrix stays positive semi-definite (as
+/// [`SlopeGaussian::from_moments`]). `None` for non-finite moments (the lobe's fallback applies).
+#[inline]
+fn lobe_mean_cov(m: &[f32; 5], s2: f64) -> Option<([f64; 2], [f64; 3])> {
+    if !m.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let [ex, ey, exx, eyy, exy] = m.map(f64::from);
+    let vx = (exx - ex * ex).max(s2);
+    let vy = (eyy - ey * ey).max(s2);
+    let c_max = ((vx - s2) * (vy - s2)).sqrt();
+    let c = (exy - ex * ey).clamp(-c_max, c_max);
+    Some(([ex, ey], [vx, c, vy]))
 }
 
 /// The P-NDF of one footprint of a [`BeckmannMixture`]: an [`Ndf`] with D_P(h) = Σ W_i D_i(h).
@@ -131,7 +166,8 @@ struct Gathered {
 ///   **signed** patch projected area A_P(w) = Σ W_i (cos θ − w_xy·μ_i) = cos θ − w_xy·μ_P (μ_P the
 ///   patch mean slope), clamped at 0; Λ_P = V_P/A_P − 1, G1 = A_P/V_P (eq. 10-17, see
 ///   docs/mixture.md for why the per-lobe areas are not clamped as in eq. 17).
-///   [`MaskingMode::Approximate`]: A, Λ and V of the filtered lobe (§4.2.2).
+///   [`MaskingMode::Approximate`]: the same A_P and Scarf's upper bound of V_P from the patch's slope
+///   mean and covariance (O(1) per direction; sound: never creates energy, see docs/mixture.md).
 /// - Samplers: `sample_normal` draws a lobe ∝ W_i then its slope Gaussian (exactly D_P cos θ);
 ///   `sample_visible` draws a lobe ∝ W_i V_i(wo) then that lobe's visible normal, density
 ///   Σ W_i ⟨wo,m⟩⁺ D_i / V_P(wo) = `pdf_visible` (exact V_P in both masking modes).
@@ -146,10 +182,10 @@ pub struct MixturePatch<'a> {
     /// The Beckmann lobe of the filtered moments (§4.2.2).
     filtered: SlopeGaussian,
     /// `None` when the level of detail serves the filtered lobe alone.
-    gathered: Option<Gathered>,
+    gathered: Option<Gathered<'a>>,
     /// The gathered lobes as [`SlopeGaussian`]s (per slot), built on the first call that loops over
     /// all of them (exact masking, visible sampling): 32 bytes per slot.
-    lobes: OnceLock<Vec<SlopeGaussian>>,
+    lobes: Loan<'a, Vec<SlopeGaussian>>,
 }
 
 /// The effective Gaussian k_i ∗ k_P in lobe units: centre and inverse covariance.
@@ -225,6 +261,16 @@ enum Leaf {
     Degenerate,
 }
 
+/// σ² of the variance floor as [`SlopeGaussian::from_moments`] honours `sigma_min`.
+fn sigma_floor_squared(sigma_min: f32) -> f64 {
+    let s = if sigma_min.is_finite() && sigma_min > 0.0 {
+        sigma_min.max(SIGMA_MIN_FLOOR)
+    } else {
+        DEFAULT_SIGMA_MIN
+    } as f64;
+    s * s
+}
+
 /// The leaf work of the D_P walk straight from a lobe's five stored moments: the box test and P22
 /// without building a [`SlopeGaussian`] (which validates and factors the covariance in `f64`, about
 /// ten times the cost). Same covariance as [`SlopeGaussian::from_moments`] (variances floored at σ²,
@@ -239,13 +285,8 @@ struct LeafEval {
 
 impl LeafEval {
     fn new(sigma_min: f32, box_k: f32) -> LeafEval {
-        let s = if sigma_min.is_finite() && sigma_min > 0.0 {
-            sigma_min.max(SIGMA_MIN_FLOOR)
-        } else {
-            DEFAULT_SIGMA_MIN
-        } as f64;
         LeafEval {
-            s2: s * s,
+            s2: sigma_floor_squared(sigma_min),
             k2: box_k as f64 * box_k as f64,
         }
     }
@@ -256,18 +297,13 @@ impl LeafEval {
     /// \[Chermain2019\] eq. 4-6 (the lobe), §5 (the box).
     #[inline]
     fn p22_in_box(&self, m: &[f32; 5], s: Vec2) -> Leaf {
-        if !m.iter().all(|v| v.is_finite()) {
+        let Some(([ex, ey], [vx, c, vy])) = lobe_mean_cov(m, self.s2) else {
             return Leaf::Degenerate;
-        }
-        let [ex, ey, exx, eyy, exy] = m.map(f64::from);
-        let vx = (exx - ex * ex).max(self.s2);
-        let vy = (eyy - ey * ey).max(self.s2);
+        };
         let (dx, dy) = (s.x as f64 - ex, s.y as f64 - ey);
         if dx * dx > self.k2 * vx || dy * dy > self.k2 * vy {
             return Leaf::Outside;
         }
-        let c_max = ((vx - self.s2) * (vy - self.s2)).sqrt();
-        let c = (exy - ex * ey).clamp(-c_max, c_max);
         let det = vx * vy - c * c;
         let q = (vy * dx * dx - 2.0 * c * dx * dy + vx * dy * dy) / det;
         let p = (-0.5 * q as f32).exp() as f64 / (std::f64::consts::TAU * det.sqrt());
@@ -286,6 +322,21 @@ impl<'a> MixturePatch<'a> {
         footprint: &Footprint,
         options: PatchOptions,
     ) -> MixturePatch<'a> {
+        Self::new_in(mixture, footprint, options, None)
+    }
+
+    /// [`MixturePatch::new`] with its per-slot buffers lent by `scratch` (given back when the patch
+    /// drops): no heap allocation once the scratch has grown to the footprint's size.
+    pub fn new_in(
+        mixture: &'a BeckmannMixture,
+        footprint: &Footprint,
+        options: PatchOptions,
+        scratch: Option<&'a mut GlintScratch>,
+    ) -> MixturePatch<'a> {
+        let (slots, lobes) = match scratch {
+            Some(s) => (Some(&mut s.mixture.slots), Some(&mut s.mixture.lobes)),
+            None => (None, None),
+        };
         let (eff, area) = Effective::new(mixture, footprint);
         let lod = 0.5 * area.max(1e-300).log2();
         let filtered_m = mixture.pyramid.filtered(&mixture.lobes, eff.c, lod);
@@ -293,18 +344,22 @@ impl<'a> MixturePatch<'a> {
         let gathered = if area > options.lod_lobes as f64 {
             None
         } else {
-            Some(Self::gather(mixture, &eff))
+            Some(Self::gather(mixture, &eff, Lent::new(slots)))
         };
         MixturePatch {
             mixture,
             masking: options.masking,
             filtered,
             gathered,
-            lobes: OnceLock::new(),
+            lobes: Loan::new(lobes),
         }
     }
 
-    fn gather(mix: &BeckmannMixture, eff: &Effective) -> Gathered {
+    fn gather<'b>(
+        mix: &BeckmannMixture,
+        eff: &Effective,
+        mut bufs: Lent<'b, SlotBuffers>,
+    ) -> Gathered<'b> {
         let t = mix.params.weight_sigmas as f64;
         let half = [t * eff.cov[0].sqrt(), t * eff.cov[2].sqrt()];
         let axes = [
@@ -312,7 +367,12 @@ impl<'a> MixturePatch<'a> {
             AxisSlots::new(eff.c[1], half[1], mix.grid[1]),
         ];
         let (lx, ly) = (axes[0].len, axes[1].len);
-        let mut w = vec![0.0f64; lx * ly];
+        // Raw weights are summed into the cdf buffer, then normalised and accumulated in place.
+        let SlotBuffers { weights, cdf } = &mut *bufs;
+        weights.clear();
+        cdf.clear();
+        cdf.resize(lx * ly, 0.0);
+        let w = cdf;
         let (i0, i1) = axes[0].unwrapped_range(eff.c[0], half[0]);
         let (j0, j1) = axes[1].unwrapped_range(eff.c[1], half[1]);
         for j in j0..=j1 {
@@ -326,28 +386,40 @@ impl<'a> MixturePatch<'a> {
         // total ≥ the nearest lobe's weight ≥ exp(−½ · 2 · 0.5²/σ_k²) ≈ 0.06 (|d| ≤ ½ per axis,
         // Σ_eff ≥ σ_k² I), so the division is safe.
         let inv = if total > 0.0 { 1.0 / total } else { 0.0 };
-        let mut cdf = Vec::with_capacity(w.len());
         let mut acc = 0.0;
-        let mut mean = [0.0f64; 2];
-        let weights: Vec<f32> = w
-            .iter()
-            .enumerate()
-            .map(|(s, &wi)| {
-                let wn = wi * inv;
+        // Σ W μ and Σ W (Σ + μ μᵀ) with the lobes' covariances as D uses them.
+        let mut m1 = [0.0f64; 2];
+        let mut m2 = [0.0f64; 3];
+        let s2 = sigma_floor_squared(mix.params.sigma_min);
+        weights.extend(w.iter_mut().enumerate().map(|(s, wi)| {
+                let wn = *wi * inv;
                 acc += wn;
-                cdf.push(acc);
+                *wi = acc;
                 let k = axes[1].lobe_of_slot(s / lx) * mix.grid[0] + axes[0].lobe_of_slot(s % lx);
-                let m = mix.lobes[k];
-                mean[0] += wn * m[0] as f64;
-                mean[1] += wn * m[1] as f64;
+                let (mu, cov) = lobe_mean_cov(&mix.lobes[k], s2).unwrap_or_else(|| {
+                    let lobe = mix.lobe_at(k);
+                    let (mu, c) = (lobe.mean(), lobe.covariance());
+                    let c = [c.x_axis.x, c.x_axis.y, c.y_axis.y].map(f64::from);
+                    ([mu.x as f64, mu.y as f64], c)
+                });
+                m1[0] += wn * mu[0];
+                m1[1] += wn * mu[1];
+                m2[0] += wn * (cov[0] + mu[0] * mu[0]);
+                m2[1] += wn * (cov[1] + mu[0] * mu[1]);
+                m2[2] += wn * (cov[2] + mu[1] * mu[1]);
                 wn as f32
-            })
-            .collect();
+            }));
+        // Σ W = 1 up to rounding; the covariance is floored at 0 against cancellation.
+        let slope_cov = [
+            (m2[0] - m1[0] * m1[0]).max(0.0),
+            m2[1] - m1[0] * m1[1],
+            (m2[2] - m1[1] * m1[1]).max(0.0),
+        ];
         Gathered {
             axes,
-            weights,
-            cdf,
-            mean_slope: Vec2::new(mean[0] as f32, mean[1] as f32),
+            bufs,
+            mean_slope: Vec2::new(m1[0] as f32, m1[1] as f32),
+            slope_cov,
         }
     }
 
@@ -369,7 +441,7 @@ impl<'a> MixturePatch<'a> {
 
     /// Number of lobe slots (weights) the patch holds (0 for the filtered lobe).
     pub fn lobe_count(&self) -> usize {
-        self.gathered.as_ref().map_or(0, |g| g.weights.len())
+        self.gathered.as_ref().map_or(0, |g| g.bufs.weights.len())
     }
 
     /// The patch mean slope μ_P = Σ W_i μ_i (the filtered lobe's mean under the level of detail).
@@ -382,8 +454,8 @@ impl<'a> MixturePatch<'a> {
     /// The normalised weights W_i and their lobes, for tests and tools: (W, lobe) per slot.
     pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
         let g = self.gathered.as_ref();
-        let n = g.map_or(0, |g| g.weights.len());
-        (0..n).filter_map(move |s| g.map(|g| (g.weights[s], self.slot_lobe(g, s))))
+        let n = g.map_or(0, |g| g.bufs.weights.len());
+        (0..n).filter_map(move |s| g.map(|g| (g.bufs.weights[s], self.slot_lobe(g, s))))
     }
 
     #[inline]
@@ -445,7 +517,7 @@ impl<'a> MixturePatch<'a> {
                     touched += 1;
                     let sx = (x as i64 + x_off) as usize;
                     let sy = (y as i64 + y_off) as usize;
-                    acc += g.weights[sy * lx + sx] as f64 * p22;
+                    acc += g.bufs.weights[sy * lx + sx] as f64 * p22;
                 });
             }
         }
@@ -454,8 +526,11 @@ impl<'a> MixturePatch<'a> {
 
     /// The gathered lobes per slot (built once).
     fn slot_lobes(&self, g: &Gathered) -> &[SlopeGaussian] {
-        self.lobes
-            .get_or_init(|| (0..g.weights.len()).map(|s| self.slot_lobe(g, s)).collect())
+        self.lobes.get_or_init(|mut lobes| {
+            lobes.clear();
+            lobes.extend((0..g.bufs.weights.len()).map(|s| self.slot_lobe(g, s)));
+            lobes
+        })
     }
 
     /// Exact V_P(w) = Σ W_i V_i(w) in `f64` (0 for invalid w).
@@ -463,7 +538,7 @@ impl<'a> MixturePatch<'a> {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
         }
-        g.weights
+        g.bufs.weights
             .iter()
             .zip(self.slot_lobes(g))
             .map(|(&wi, lobe)| wi as f64 * lobe.visible_area(w) as f64)
@@ -480,6 +555,24 @@ impl<'a> MixturePatch<'a> {
             Some(g) => finite_or_zero(self.exact_visible_area(g, w)),
             None => self.filtered.visible_area(w),
         }
+    }
+
+    /// Scarf's bound V⁺(w) = ½ (ā + √(ā² + w_xyᵀ Σ_P w_xy)) ≥ ∫⟨w,m⟩⁺ D_P dm, with ā the signed
+    /// projected area and Σ_P the patch's slope covariance: the largest E[(w_z − w_xy·ñ)⁺] over
+    /// every slope distribution of that mean and covariance, so masking built on it can only
+    /// over-shadow (never create energy). 0 for invalid w. O(1).
+    ///
+    /// # Reference
+    /// \[Scarf1958\]; the per-lobe form is [`SlopeGaussian::visible_area_bound`].
+    fn visible_area_bound(&self, g: &Gathered, w: Vec3) -> f32 {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let a = self.signed_projected_area(w) as f64;
+        let [sxx, sxy, syy] = g.slope_cov;
+        let (x, y) = (w.x as f64, w.y as f64);
+        let s2 = (sxx * x * x + 2.0 * sxy * x * y + syy * y * y).max(0.0);
+        finite_or_zero(0.5 * (a + (a * a + s2).sqrt()))
     }
 
     /// The signed patch projected area A_s(w) = cos θ − w_xy·μ_P = Σ W_i ∫ (w·m) D_i dm (may be
@@ -500,8 +593,8 @@ impl<'a> MixturePatch<'a> {
     /// comparison. The filtered lobe's A under the level of detail.
     pub fn paper_projected_area(&self, w: Vec3) -> f32 {
         match &self.gathered {
-            Some(g) => (0..g.weights.len())
-                .map(|s| g.weights[s] as f64 * self.slot_lobe(g, s).projected_area(w) as f64)
+            Some(g) => (0..g.bufs.weights.len())
+                .map(|s| g.bufs.weights[s] as f64 * self.slot_lobe(g, s).projected_area(w) as f64)
                 .sum::<f64>() as f32,
             None => self.filtered.projected_area(w),
         }
@@ -523,22 +616,26 @@ impl Ndf for MixturePatch<'_> {
         crate::ndf::lambda_from_areas(self, w)
     }
 
-    /// A_P(w): max(signed A_P, 0) (exact) or the filtered lobe's A (approximate / level of detail).
+    /// A_P(w) = max(signed A_P, 0) from the patch mean slope, in both masking modes (exact and
+    /// O(1)); the filtered lobe's A under the level of detail.
     ///
     /// # Reference
-    /// \[Chermain2019\] eq. 17, §4.2.2.
+    /// \[Chermain2019\] eq. 17 (without the per-lobe clamp, docs/mixture.md).
     fn projected_area(&self, w: Vec3) -> f32 {
-        match (&self.gathered, self.masking) {
-            (Some(_), MaskingMode::Exact) => self.signed_projected_area(w).max(0.0),
-            _ => self.filtered.projected_area(w),
+        match &self.gathered {
+            Some(_) => self.signed_projected_area(w).max(0.0),
+            None => self.filtered.projected_area(w),
         }
     }
 
-    /// V_P(w) = A_P (1 + Λ_P): exact Σ W_i V_i(w), or the filtered lobe's V.
+    /// V_P(w) = A_P (1 + Λ_P): exact Σ W_i V_i(w) ([`MaskingMode::Exact`]), Scarf's upper bound from
+    /// the patch's slope mean and covariance ([`MaskingMode::Approximate`]), or the filtered lobe's
+    /// V under the level of detail.
     fn visible_area(&self, w: Vec3) -> f32 {
         match (&self.gathered, self.masking) {
             (Some(g), MaskingMode::Exact) => finite_or_zero(self.exact_visible_area(g, w)),
-            _ => self.filtered.visible_area(w),
+            (Some(g), MaskingMode::Approximate) => self.visible_area_bound(g, w),
+            (None, _) => self.filtered.visible_area(w),
         }
     }
 
@@ -547,7 +644,7 @@ impl Ndf for MixturePatch<'_> {
         let Some(g) = &self.gathered else {
             return self.filtered.sample_normal(u);
         };
-        let (s, ux) = invert_cdf(&g.cdf, u.x);
+        let (s, ux) = invert_cdf(&g.bufs.cdf, u.x);
         self.slot_lobe(g, s).sample_normal(Vec2::new(ux, u.y))
     }
 
@@ -572,7 +669,7 @@ impl Ndf for MixturePatch<'_> {
         let mut chosen = (0, 0.5f32);
         let lobes = self.slot_lobes(g);
         for (s, lobe) in lobes.iter().enumerate() {
-            let v = g.weights[s] as f64 * lobe.visible_area(wo) as f64;
+            let v = g.bufs.weights[s] as f64 * lobe.visible_area(wo) as f64;
             if v > 0.0 {
                 chosen = (s, ((target - acc) / v) as f32);
                 if acc + v > target {
@@ -623,7 +720,7 @@ impl Ndf for MixturePatch<'_> {
 impl MixturePatch<'_> {
     /// Σ W_i D_i(m) over every gathered lobe, in `f64`.
     fn untruncated_d(&self, g: &Gathered, m: Vec3) -> f64 {
-        g.weights
+        g.bufs.weights
             .iter()
             .zip(self.slot_lobes(g))
             .map(|(&w, lobe)| w as f64 * lobe.d(m) as f64)
