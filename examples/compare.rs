@@ -34,13 +34,14 @@ mod tests {
         }
         for r in &results.view {
             assert!(
-                r.v_rel_error.is_finite() && r.furnace_patch.is_finite(),
+                r.v_rel_error.is_finite() && r.furnace.is_finite(),
                 "{r:?}"
             );
-            // Exact masking conserves energy in the patch measure (Monte Carlo with 64 samples:
-            // a generous 10 % for the estimator's noise).
-            if r.method == "mixture (exact)" {
-                assert!(r.furnace_patch <= 1.1, "{r:?}");
+            // Every model except the published position-normal BRDF (the compare's
+            // "position-normal" rows) conserves energy in the renderer's measure (Monte Carlo with
+            // 64 samples: a generous 10 % for the noise).
+            if !r.method.starts_with("position-normal") {
+                assert!(r.furnace <= 1.1, "{r:?}");
             }
         }
         let out = std::env::temp_dir().join("brdf-compare-test");

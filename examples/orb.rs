@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release --example orb -- [--map scratched|brushed|bumpy|flakes|PATH] [--spp N]
 //! [--size PIXELS] [--map-size TEXELS] [--tiles UxV] [--naive-spp N] [--sigma S]
-//! [--cosine patch|geometric] [--out DIR] [--quiet]`, or `-- --quick [--out DIR]` for the gallery's
+//! [--out DIR] [--quiet]`, or `-- --quick [--out DIR]` for the gallery's
 //! small strip (scratched 512² map, 160² pixels, 256 spp).
 //!
 //! Writes one PNG per method, a labelled strip and a CSV of times and errors into DIR (default
@@ -11,7 +11,7 @@
 
 mod common;
 
-use common::orb::{Cosine, MapSource, OrbOptions};
+use common::orb::{MapSource, OrbOptions};
 use common::{Res, arg_value, has_flag};
 
 fn parsed<T: std::str::FromStr>(name: &str, default: T) -> Res<T> {
@@ -32,11 +32,6 @@ fn options() -> Res<OrbOptions> {
         }
         None => d.tiles,
     };
-    let cosine = match arg_value("--cosine").as_deref() {
-        None | Some("patch") => Cosine::Patch,
-        Some("geometric") => Cosine::Geometric,
-        Some(c) => return Err(format!("--cosine: expected patch or geometric, got {c:?}").into()),
-    };
     Ok(OrbOptions {
         size: parsed("--size", d.size)?,
         map: arg_value("--map").map_or(d.map.clone(), |m| MapSource::parse(&m)),
@@ -45,7 +40,6 @@ fn options() -> Res<OrbOptions> {
         spp: parsed("--spp", d.spp)?,
         naive_spp: parsed("--naive-spp", d.naive_spp)?,
         sigma_eps: parsed("--sigma", d.sigma_eps)?,
-        cosine,
         seed: parsed("--seed", d.seed)?,
         mixture_samples: parsed("--mixture-samples", d.mixture_samples)?,
         progress: !has_flag("--quiet"),
@@ -129,7 +123,7 @@ mod tests {
             ..MixtureParams::default()
         };
         let mixture = BeckmannMixture::build(&map, params).unwrap();
-        let scene = Scene::new(SIZE, Vec2::new(4.0, 2.0), Cosine::Patch);
+        let scene = Scene::new(SIZE, Vec2::new(4.0, 2.0));
         let alpha = std::f64::consts::SQRT_2 * sigma as f64;
         let fresnel = ConductorFresnel::ALUMINIUM;
         for model in variants(&mixture) {
@@ -199,23 +193,17 @@ mod tests {
         }
     }
 
-    /// Every code path (three mixture variants, the naive row, the reference, both cosines) on every
+    /// Every code path (three mixture variants, the naive row, the reference) on every
     /// procedural map gives finite, non-negative pixels, and the figures are finite.
     #[test]
     fn every_path_is_finite_and_non_negative() {
-        for (map, cosine) in [
-            ("scratched", Cosine::Patch),
-            ("brushed", Cosine::Geometric),
-            ("bumpy", Cosine::Patch),
-            ("flakes", Cosine::Geometric),
-        ] {
+        for map in ["scratched", "brushed", "bumpy", "flakes"] {
             let opts = OrbOptions {
                 size: SIZE,
                 map: MapSource::parse(map),
                 map_size: 64,
                 spp: 8,
                 naive_spp: 4,
-                cosine,
                 mixture_samples: 16,
                 progress: false,
                 ..OrbOptions::default()
@@ -225,7 +213,7 @@ mod tests {
             // Five glint renders (mixture exact, approximate, filtered lobe, bin map,
             // position-normal) and naive 16 spp.
             assert_eq!(methods.len(), 6);
-            let mask = coverage(&Scene::new(SIZE, opts.tiles, cosine));
+            let mask = coverage(&Scene::new(SIZE, opts.tiles));
             for img in [&a, &b].into_iter().chain(methods.iter().map(|r| &r.image)) {
                 assert_eq!(img.pixels.len(), (SIZE * SIZE) as usize);
                 for p in &img.pixels {
@@ -248,7 +236,7 @@ mod tests {
     #[test]
     fn reference_converges() {
         let bar = ProgressBar::hidden();
-        let scene = Scene::new(SIZE, Vec2::new(4.0, 2.0), Cosine::Patch);
+        let scene = Scene::new(SIZE, Vec2::new(4.0, 2.0));
         let mask = coverage(&scene);
         let bumpy = brdf::glint::bumpy(64, 64, 0.25, 4.0, 3).unwrap();
         let noise = |k| {
@@ -286,7 +274,7 @@ mod tests {
     #[test]
     fn tilted_map_moves_the_highlight_where_the_frame_says() {
         let size = 64u32;
-        let scene = Scene::new(size, Vec2::new(4.0, 2.0), Cosine::Patch);
+        let scene = Scene::new(size, Vec2::new(4.0, 2.0));
         let argmax = |img: &Image| {
             let k = (0..img.pixels.len())
                 .max_by(|&i, &j| img.value(i).total_cmp(&img.value(j)))

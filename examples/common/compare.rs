@@ -308,8 +308,8 @@ pub struct ViewRow {
     pub method: String,
     pub theta: f64,
     pub v_rel_error: f64,
-    pub furnace_patch: f64,
-    pub furnace_geometric: f64,
+    /// ∫ f cos θi dωi with the geometric cosine (the renderer's measure).
+    pub furnace: f64,
 }
 
 /// One row of the build table.
@@ -343,19 +343,17 @@ fn reference_visible_area(reference: &BinnedPndf, wo: Vec3) -> f64 {
         .sum()
 }
 
-/// The patch and geometric furnaces by importance sampling with the BRDF's own sampler.
-fn furnace(brdf: &(dyn Bxdf + Sync), patch: &(dyn Ndf + Sync), wo: Vec3, n: usize) -> (f64, f64) {
-    let (mut own, mut geo) = (0.0, 0.0);
+/// The renderer's furnace ∫ f cos θi dωi: the mean of `sample().weight()` with the BRDF's own sampler.
+fn furnace(brdf: &(dyn Bxdf + Sync), wo: Vec3, n: usize) -> f64 {
+    let mut sum = 0.0;
     for k in 0..n {
         let u = r2(k);
         let uc = ((k as f64 + 0.5) / n as f64) as f32;
         if let Some(s) = brdf.sample(wo, uc, u) {
-            let f = s.f.x as f64 / s.pdf as f64;
-            own += f * patch.projected_area(s.wi).max(0.0) as f64;
-            geo += f * s.wi.z as f64;
+            sum += s.weight().x as f64;
         }
     }
-    (own / n as f64, geo / n as f64)
+    sum / n as f64
 }
 
 /// Mean single-thread seconds per call of `f` over `n` inputs (after one warm-up pass).
@@ -502,19 +500,14 @@ pub fn measure(settings: &Settings, progress: &mut dyn FnMut(&str)) -> Res<Resul
                         method: label.clone(),
                         theta,
                         v_rel_error: 0.0,
-                        furnace_patch: 0.0,
-                        furnace_geometric: 0.0,
+                        furnace: 0.0,
                     };
                     method.with_patch(&view_fp, &mut |p| {
                         let v = p.visible_area(wo) as f64;
                         row.v_rel_error = (v - v_ref).abs() / v_ref.max(1e-12);
                     });
                     method.with_brdf(&view_fp, &mut |b| {
-                        method.with_patch(&view_fp, &mut |p| {
-                            let (own, geo) = furnace(b, p, wo, settings.furnace_samples);
-                            row.furnace_patch = own;
-                            row.furnace_geometric = geo;
-                        })
+                        row.furnace = furnace(b, wo, settings.furnace_samples);
                     });
                     results.view.push(row);
                 }
@@ -575,12 +568,12 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
     }
     std::fs::write(out.join("compare_accuracy.csv"), csv)?;
     let mut csv =
-        String::from("map,method,theta_deg,v_rel_error,furnace_patch,furnace_geometric\n");
+        String::from("map,method,theta_deg,v_rel_error,furnace\n");
     for r in &results.view {
         writeln!(
             csv,
-            "{},{},{},{:.5},{:.5},{:.5}",
-            r.map, r.method, r.theta, r.v_rel_error, r.furnace_patch, r.furnace_geometric
+            "{},{},{},{:.5},{:.5}",
+            r.map, r.method, r.theta, r.v_rel_error, r.furnace
         )?;
     }
     std::fs::write(out.join("compare_view.csv"), csv)?;
@@ -754,30 +747,17 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
          over the maps: where normalisation and masking fail near grazing.",
     ));
     let title = format!(
-        "White furnace, patch measure ({} texels)",
+        "White furnace, renderer's measure ({} texels)",
         settings.view_area
     );
     let path = out.join("compare_energy_vs_view.png");
-    let mut chart = Chart::new(&title, "θo (degrees)", "∫ f A_P(wi) dωi");
-    chart.markers = true;
-    line_chart(&path, &chart, &by_theta(&|r| r.furnace_patch))?;
-    artifacts.push(Artifact::new(
-        path,
-        "White furnace (F = 1) in the patch's own measure ∫ f A_P(wi)⁺ dωi, mean over the maps: ≤ 1 \
-         for an energy-conserving model.",
-    ));
-    let title = format!(
-        "White furnace, geometric cosine ({} texels)",
-        settings.view_area
-    );
-    let path = out.join("compare_energy_geometric_vs_view.png");
     let mut chart = Chart::new(&title, "θo (degrees)", "∫ f cos θi dωi");
     chart.markers = true;
-    line_chart(&path, &chart, &by_theta(&|r| r.furnace_geometric))?;
+    line_chart(&path, &chart, &by_theta(&|r| r.furnace))?;
     artifacts.push(Artifact::new(
         path,
-        "The same furnace with the geometric cosine a renderer usually applies (docs/mixture.md, \
-         \"Energy\").",
+        "White furnace (F = 1) as a renderer integrates it, ∫ eval · cos θi dωi with the geometric \
+         cosine (mean of sample().weight()), mean over the maps: ≤ 1 for an energy-conserving model.",
     ));
 
     // Markdown tables.
@@ -834,8 +814,7 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
                 "V rel. error",
                 &(|r: &ViewRow| r.v_rel_error) as &dyn Fn(&ViewRow) -> f64,
             ),
-            ("furnace (patch)", &|r: &ViewRow| r.furnace_patch),
-            ("furnace (geometric)", &|r: &ViewRow| r.furnace_geometric),
+            ("furnace", &|r: &ViewRow| r.furnace),
         ] {
             write!(md, "| {m} | {q} |")?;
             for &t in &settings.thetas {

@@ -205,11 +205,11 @@ fn analytic_rows(settings: &Settings) -> Res<Vec<Row>> {
     Ok(rows)
 }
 
-/// The rows of one glint patch inside `MicrofacetBrdf`, furnace in the patch measure.
+/// The rows of one glint patch inside `MicrofacetBrdf`, furnace in the renderer's measure.
 fn patch_rows(label: &str, patch: &dyn Ndf, settings: &Settings, rows: &mut Vec<Row>) {
-    let area = |w: Vec3| patch.projected_area(w).max(0.0);
+    let cos = |w: Vec3| w.z.max(0.0);
     let brdf = MicrofacetBrdf::new(patch, NoFresnel);
-    brdf_rows(label, patch, &brdf, &area, settings, rows);
+    brdf_rows(label, patch, &brdf, &cos, settings, rows);
 }
 
 /// The rows of `brdf` built on `patch`: the patch's V against its Monte Carlo reference, and the
@@ -382,9 +382,9 @@ pub fn report(rows: &[Row], out: &Path) -> Res<(Vec<Artifact>, String)> {
             y_range: (0.0, 1.6),
             with_published: true,
             value: |r| r.furnace,
-            caption: "White furnace against 90° − θo: cos θi measure for the analytic lobes, the \
-                      patch measure A_P(wi)⁺ for the glint patches, cos θi for the published \
-                      position-normal BRDF.",
+            caption: "White furnace against 90° − θo in the renderer's measure (∫ eval · cos θi \
+                      dωi with the geometric cosine) for every model, the published \
+                      position-normal BRDF included.",
         },
         GrazingChart {
             file: "grazing_weight_spread.png",

@@ -7,10 +7,10 @@
 //! (u, v) parametrisation ([`OrbOptions::tiles`] times); every pixel gets a footprint on the map from
 //! analytic ray differentials, and the glint models shade it with one BRDF evaluation:
 //!
-//! L = f_P(wo, wi) · A_P(wi) · I / r², f_P = `MicrofacetBrdf::new(model.patch(&footprint), fresnel)`,
+//! L = f(wo, wi) · cos θi · I / r², f = `MicrofacetBrdf::new(model.patch(&footprint), fresnel)`,
 //!
-//! where A_P(wi) is the patch's projected area (the measure of the P-BRDF, \[Chermain2019\] eq. 7; see
-//! docs/mixture.md, "Energy: which cosine", and [`Cosine`]). The reference averages, over jittered
+//! in the renderer's measure (f = f_P A_P(wi)/cos θi, so L = f_P A_P(wi) I / r² with the P-BRDF of
+//! \[Chermain2019\] eq. 7; src/bxdf/microfacet.rs, "The renderer's measure"). The reference averages, over jittered
 //! positions inside the pixel, the near-specular lobe of σ_ε around the interpolated normal found
 //! there ([`brdf::glint::naive_brdf`]), which converges to the same quantity as σ_ε → 0 and the
 //! sample count grows. See docs/orb.md.
@@ -25,7 +25,6 @@ use brdf::glint::{
     PositionNormalMap, PositionNormalParams, ScratchedParams, TangentConvention, brushed, bumpy,
     flakes, naive_brdf, scratched,
 };
-use brdf::ndf::Ndf;
 use glam::{Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::prelude::*;
@@ -66,18 +65,6 @@ impl MapSource {
     }
 }
 
-/// Which cosine multiplies the BRDF in the point-light estimate.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Cosine {
-    /// The projected area A(wi) of the microsurface under the pixel: the patch's A_P(wi) for the glint
-    /// models, the tilted lobe's A(wi) = wi_z − ñ·wi_xy for the reference. The measure in which the
-    /// P-BRDF of eq. 7 is normalised; for the σ_ε → 0 reference it is the classic normal-mapping
-    /// ⟨wi, n⟩ with the shading normal's own BRDF (docs/orb.md). The default.
-    Patch,
-    /// The geometric cos θi, as a renderer unaware of patches would do (docs/mixture.md, "Energy").
-    Geometric,
-}
-
 /// Settings of one orb run. `Default` is the command line's default (≤ 60 s on 2 cores).
 #[derive(Clone, Debug)]
 pub struct OrbOptions {
@@ -97,8 +84,6 @@ pub struct OrbOptions {
     pub naive_spp: u32,
     /// Slope standard deviation σ_ε of the reference's near-specular lobe, and the mixture's floor.
     pub sigma_eps: f32,
-    /// The cosine of the point-light estimate.
-    pub cosine: Cosine,
     /// Seed of the procedural map and of the reference's jitter.
     pub seed: u64,
     /// Quasi-Monte Carlo nodes per lobe of the mixture build.
@@ -117,7 +102,6 @@ impl Default for OrbOptions {
             spp: 512,
             naive_spp: 16,
             sigma_eps: brdf::glint::DEFAULT_SIGMA_MIN,
-            cosine: Cosine::Patch,
             seed: 7,
             mixture_samples: 64,
             progress: true,
@@ -146,13 +130,11 @@ pub struct Scene {
     pub tiles: Vec2,
     /// The conductor.
     pub fresnel: ConductorFresnel,
-    /// The cosine of the estimate.
-    pub cosine: Cosine,
 }
 
 impl Scene {
-    /// The orb scene at `size` pixels with the given tiling and cosine.
-    pub fn new(size: u32, tiles: Vec2, cosine: Cosine) -> Scene {
+    /// The orb scene at `size` pixels with the given tiling.
+    pub fn new(size: u32, tiles: Vec2) -> Scene {
         Scene {
             size: size.max(1),
             camera: Vec3::new(0.0, 0.0, 5.0),
@@ -162,7 +144,6 @@ impl Scene {
             intensity: 60.0,
             tiles,
             fresnel: ConductorFresnel::ALUMINIUM,
-            cosine,
         }
     }
 
@@ -227,14 +208,6 @@ impl Scene {
             wi: frame.to_local(to_light / r2.sqrt()),
             irradiance: self.intensity / r2,
         })
-    }
-
-    /// The cosine factor for a microsurface whose projected area toward `wi` is `area`.
-    fn cosine_factor(&self, area: f32, wi: Vec3) -> f32 {
-        match self.cosine {
-            Cosine::Patch => area.max(0.0),
-            Cosine::Geometric => wi.z.max(0.0),
-        }
     }
 }
 
@@ -388,8 +361,8 @@ pub fn render_glint<G: GlintNdf + Sync>(scene: &Scene, model: &G, bar: &Progress
         };
         let brdf = MicrofacetBrdf::new(model.patch(&sp.footprint()), scene.fresnel)
             .with_masking(Masking::Separable);
-        let cos = scene.cosine_factor(brdf.ndf().projected_area(sp.wi), sp.wi);
-        let l = brdf.eval(sp.wo, sp.wi) * (cos * sp.irradiance);
+        // The renderer's measure: eval × the geometric cos θi (eval carries A_P(wi)/cos θi).
+        let l = brdf.eval(sp.wo, sp.wi) * (sp.wi.z.max(0.0) * sp.irradiance);
         if l.is_finite() { l } else { Vec3::ZERO }
     })
 }
@@ -432,8 +405,8 @@ fn naive_radiance(scene: &Scene, map: &NormalMap, sigma_eps: f32, sp: &ShadingPo
     };
     let s = map.slope_at(sp.uv);
     let area = sp.wi.z - s.x * sp.wi.x - s.y * sp.wi.y;
-    let cos = scene.cosine_factor(area, sp.wi);
-    let l = scene.fresnel.eval(sp.wo.dot(h)) * (f * cos * sp.irradiance);
+    // The same measure as the models: the tilted facet's f_P × its projected area A(wi).
+    let l = scene.fresnel.eval(sp.wo.dot(h)) * (f * area.max(0.0) * sp.irradiance);
     if l.is_finite() { l } else { Vec3::ZERO }
 }
 
@@ -683,7 +656,7 @@ pub struct Rendered {
 /// Renders the reference and every glint method available. Returns the reference halves and the
 /// methods' images (the naive equal-time row included when `naive_spp > 0`).
 pub fn render_all(opts: &OrbOptions, map: &NormalMap) -> Res<((Image, Image, f64), Vec<Rendered>)> {
-    let scene = Scene::new(opts.size, opts.tiles, opts.cosine);
+    let scene = Scene::new(opts.size, opts.tiles);
     let rows = opts.size as u64;
     let mut out = Vec::new();
 
@@ -801,7 +774,7 @@ pub fn run(opts: &OrbOptions, out: &Path) -> Res<Vec<Artifact>> {
     let map_s = t.elapsed().as_secs_f64();
     let name = opts.map.name();
     let ((a, b, ref_s), methods) = render_all(opts, &map)?;
-    let scene = Scene::new(opts.size, opts.tiles, opts.cosine);
+    let scene = Scene::new(opts.size, opts.tiles);
     let mask = coverage(&scene);
     let reference = mean_image(&a, &b);
     let exposure = exposure_of(&reference, &mask);

@@ -6,19 +6,22 @@
 //! Models: [`Lambert`]; the Phong family — [`Phong`] (modified form, normalisations in
 //! [`PhongNormalization`], optional Schlick Fresnel) and [`OriginalPhong`] (cos^γ θr / cos θi); the
 //! [`BlinnPhongLobe`]; and [`MicrofacetBrdf`], generic over any [`crate::ndf::Ndf`] (centred NDFs,
-//! non-centred lobes, glint patches) and any [`crate::fresnel::Fresnel`]. Which are reciprocal and which
+//! non-centred lobes, glint patches) and any [`crate::fresnel::Fresnel`]; [`LayeredBrdf`], a microfacet
+//! layer over a Lambertian base. Which are reciprocal and which
 //! conserve or normalise energy: docs/bxdf.md.
 
 use glam::{Vec2, Vec3};
 
 mod blinn_phong;
 mod lambert;
+mod layered;
 mod lobe;
 mod microfacet;
 mod phong;
 
 pub use blinn_phong::{BlinnPhongLobe, BlinnPhongNormalization};
 pub use lambert::Lambert;
+pub use layered::{LayeredBrdf, TRANSMISSION_SAMPLES};
 pub use microfacet::{Masking, MicrofacetBrdf, Sampling};
 pub use phong::{
     ARVO_MAX_GAMMA, OriginalPhong, OriginalPhongNormalization, Phong, PhongNormalization,
