@@ -1,0 +1,124 @@
+//! No heap allocation per shading point: after a warm-up, `patch_in` + `eval` + `sample` + `pdf` of
+//! `MicrofacetBrdf` over every glint model allocate nothing. A counting global allocator (this test
+//! binary's own) counts the allocations made on the test's thread.
+
+mod support;
+
+use brdf::bxdf::{Bxdf, MicrofacetBrdf};
+use brdf::fresnel::SchlickFresnel;
+use brdf::glint::{
+    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintModel, GlintNdf, GlintScratch,
+    MaskingMode, MixtureParams, PatchOptions, PositionNormalMap, PositionNormalParams,
+};
+use brdf::{Vec2, Vec3};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+/// One shading point as a renderer does it: patch, BRDF, a few samples, evaluations and pdfs.
+fn shade(model: &GlintModel, scratch: &mut GlintScratch, fp: &Footprint, k: usize) -> f32 {
+    let fresnel = SchlickFresnel::new(Vec3::splat(0.9)).unwrap();
+    let brdf = MicrofacetBrdf::new(model.patch_in(fp, scratch), fresnel);
+    let wo = support::dir(10.0 + 7.0 * (k % 11) as f64, 37.0 * k as f64);
+    let mut acc = 0.0;
+    for j in 0..4 {
+        let u = Vec2::new((j as f32 + 0.5) / 4.0, ((k + j) % 7) as f32 / 7.0 + 0.05);
+        if let Some(s) = brdf.sample(wo, 0.5, u) {
+            acc += s.weight().x;
+        }
+        let wi = support::dir(20.0 + 10.0 * j as f64, 180.0 + 37.0 * k as f64);
+        let (f, pdf) = brdf.eval_pdf(wo, wi);
+        acc += f.x + pdf + brdf.pdf(wo, wi);
+    }
+    acc
+}
+
+#[test]
+fn shading_allocates_nothing_after_warm_up() {
+    let map = brdf::glint::flakes(64, 64, Default::default(), 3).unwrap();
+    let mixture = |masking| {
+        let params = MixtureParams {
+            samples: 16,
+            patch: PatchOptions {
+                masking,
+                ..PatchOptions::default()
+            },
+            ..MixtureParams::default()
+        };
+        BeckmannMixture::build(&map, params).unwrap()
+    };
+    let bin_map = BinMap::build(&map, BinMapParams::default()).unwrap();
+    let models: Vec<GlintModel> = vec![
+        mixture(MaskingMode::Exact).into(),
+        mixture(MaskingMode::Approximate).into(),
+        bin_map.clone().into(),
+        GlintModel::SmoothedBinMap {
+            map: bin_map,
+            alpha: 0.05,
+        },
+        PositionNormalMap::build(&map, PositionNormalParams::default())
+            .unwrap()
+            .into(),
+    ];
+    let footprints: Vec<Footprint> = [0.3f32, 4.0, 50.0, 700.0, 3000.0]
+        .iter()
+        .enumerate()
+        .map(|(k, &a)| {
+            let c = Vec2::new(0.13 + 0.17 * k as f32, 0.71 - 0.11 * k as f32);
+            Footprint::isotropic_texels(c, a, 64, 64)
+        })
+        .collect();
+    for model in &models {
+        let mut scratch = GlintScratch::default();
+        // Warm-up: the largest footprint first grows every buffer to its size.
+        let mut sink = shade(model, &mut scratch, &footprints[4], 0);
+        let before = allocations();
+        for k in 0..40 {
+            sink += shade(model, &mut scratch, &footprints[k % footprints.len()], k);
+        }
+        let n = allocations() - before;
+        assert!(sink.is_finite());
+        assert_eq!(n, 0, "{}: {n} allocations in 40 shading points", model.name());
+    }
+}
+
+/// The counter counts (a check of the test itself): `patch` without a scratch allocates.
+#[test]
+fn the_counter_sees_the_allocating_path() {
+    let map = brdf::glint::bumpy(16, 16, 0.2, 3.0, 1).unwrap();
+    let model: GlintModel = PositionNormalMap::build(&map, PositionNormalParams::default())
+        .unwrap()
+        .into();
+    let fp = Footprint::isotropic_texels(Vec2::new(0.5, 0.5), 30.0, 16, 16);
+    let before = allocations();
+    let brdf = MicrofacetBrdf::new(model.patch(&fp), SchlickFresnel::new(Vec3::ONE).unwrap());
+    let f = brdf.eval(Vec3::Z, support::dir(20.0, 0.0));
+    assert!(f.is_finite());
+    assert!(allocations() > before);
+}
