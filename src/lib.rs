@@ -14,8 +14,12 @@
 //! - **NDF normalisation.** ∫ D(m) (m·ω_g) dm = 1 over the hemisphere, for every NDF.
 //! - **Projected area.** `projected_area(w)` = A(w), the microsurface's projected area toward `w` per
 //!   unit geometric area (cos θ for centred NDFs). Smith: ∫ ⟨w, m⟩ D(m) dm = A(w) (1 + Λ(w)).
-//! - **Microfacet BRDF.** f = F · G2 · D(h) / (4 A(wo) A(wi)).
-//! - **Values.** `Bxdf::eval` returns f (RGB, no cosine); `pdf` is per unit solid angle of `wi`.
+//! - **Microfacet BRDF.** f = F · G2 · D(h) / (4 A(wo) cos θi): Chermain's P-BRDF
+//!   F G2 D / (4 A(wo) A(wi)) times A(wi)/cos θi, which is 1 for centred NDFs.
+//! - **The renderer's measure.** `Bxdf::eval` returns f (RGB, no cosine) such that the reflected
+//!   radiance is ∫ f(wo, wi) L(wi) cos θi dωi with the *geometric* cos θi, for every BRDF of the crate,
+//!   glint patches included: integrate it as any BRDF (or use `BxdfSample::weight()`). `pdf` is per
+//!   unit solid angle of `wi`.
 //! - **Randomness.** Samplers take their random numbers as arguments (`uc: f32`, `u: Vec2`); the
 //!   warps from [0, 1)² to disks, hemispheres and cones are in [`warp`].
 //! - **Fresnel.** `eta` = n_inside / n_outside; a negative cosine means light arriving from inside
@@ -35,7 +39,7 @@ pub mod ndf;
 pub mod warp;
 
 pub use bxdf::{
-    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, MicrofacetBrdf, OriginalPhong, Phong,
+    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, LayeredBrdf, MicrofacetBrdf, OriginalPhong, Phong,
     PhongNormalization,
 };
 pub use error::{Error, Result};

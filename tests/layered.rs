@@ -12,20 +12,27 @@ use brdf::{Vec2, Vec3};
 use rand::RngExt;
 use support::chi2::Chi2;
 
-/// (mean, standard error) of `sample().weight()` over `n` stratified draws: the renderer's furnace.
+/// Per channel (mean, standard error) of `sample().weight()` over `n` stratified draws: the renderer's
+/// furnace; the channel with the largest mean is returned.
 fn furnace(b: &dyn Bxdf, wo: Vec3, n: usize) -> (f64, f64) {
     let mut rng = support::rng(3);
-    let (mut s, mut s2) = (0.0f64, 0.0f64);
+    let (mut s, mut s2) = ([0.0f64; 3], [0.0f64; 3]);
     for k in 0..n {
         let u = Vec2::new((k as f32 + rng.random::<f32>()) / n as f32, rng.random());
         let w = b
             .sample(wo, rng.random(), u)
-            .map_or(0.0, |x| x.weight().max_element() as f64);
-        s += w;
-        s2 += w * w;
+            .map_or(Vec3::ZERO, |x| x.weight());
+        for c in 0..3 {
+            s[c] += w[c] as f64;
+            s2[c] += (w[c] as f64).powi(2);
+        }
     }
-    let m = s / n as f64;
-    (m, ((s2 / n as f64 - m * m).max(0.0) / n as f64).sqrt())
+    (0..3)
+        .map(|c| {
+            let m = s[c] / n as f64;
+            (m, ((s2[c] / n as f64 - m * m).max(0.0) / n as f64).sqrt())
+        })
+        .fold((f64::MIN, 0.0), |a, b| if b.0 > a.0 { b } else { a })
 }
 
 fn glint_patch_model() -> BeckmannMixture {
@@ -132,8 +139,14 @@ fn glint_over_base_conserves_energy_and_agrees_with_itself() {
     }
 }
 
-/// Chi-square of the layered sampler against its pdf: an analytic coat at four views, and a glint
-/// coat (mixture patch of a few lobes) at two.
+/// Chi-square of the layered sampler against its pdf: an anisotropic analytic coat at three views
+/// and an isotropic one at 89°, and a glint coat (mixture patch of a few lobes) at two.
+///
+/// Why not the anisotropic coat at 89°: at φo = 30° its reflected lobe is a sliver 2-3 cells wide in
+/// φ at the horizon, and the harness's 6 × 6 Gauss-Legendre rule per cell mis-integrates it — the bare
+/// `MicrofacetBrdf` (no layering) fails there the same way (χ² = 3977 for 3085 dof; Beckmann 4:1
+/// worse), while the NDF-level grid of tests/ndf_centred.rs, which warps the lobe onto the cells,
+/// passes. Recorded as a harness limit in the closing note of issue #13.
 #[test]
 fn chi_square_of_the_layered_sampler() {
     let schlick = SchlickFresnel::new(Vec3::splat(0.04)).unwrap();
@@ -142,14 +155,20 @@ fn chi_square_of_the_layered_sampler() {
         Vec3::new(0.7, 0.3, 0.2),
     )
     .unwrap();
+    let ggx_iso = LayeredBrdf::new(
+        MicrofacetBrdf::new(Ggx::isotropic(0.3).unwrap(), schlick),
+        Vec3::new(0.7, 0.3, 0.2),
+    )
+    .unwrap();
     let model = glint_patch_model();
     let fp = Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 4.0, 32, 32);
     let patch = model.patch(&fp);
     let glint = LayeredBrdf::new(MicrofacetBrdf::new(&patch, schlick), Vec3::splat(0.5)).unwrap();
     let mut cases: Vec<(String, &dyn Bxdf, Vec3, usize)> = vec![];
-    for theta in [0.0, 45.0, 75.0, 89.0] {
+    for theta in [0.0, 45.0, 75.0] {
         cases.push((format!("layered ggx θo={theta}"), &ggx, support::dir(theta, 30.0), 1_000_000));
     }
+    cases.push(("layered iso ggx θo=89".into(), &ggx_iso, support::dir(89.0, 30.0), 1_000_000));
     for theta in [20.0, 70.0] {
         cases.push((format!("layered glint θo={theta}"), &glint, support::dir(theta, 30.0), 200_000));
     }
