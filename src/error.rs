@@ -66,6 +66,16 @@ pub enum Error {
         /// What went wrong.
         reason: String,
     },
+    /// A decoded normal map is implausible as a whole: most of its vectors are far from unit length
+    /// or below the horizon (usually a file decoded with the wrong encoding), or the encoding could
+    /// not be detected.
+    #[error("{source_name}: implausible normal map: {reason}")]
+    ImplausibleNormals {
+        /// Where the data came from (a file path, or a description).
+        source_name: String,
+        /// The statistics and the likely cause.
+        reason: String,
+    },
 }
 
 /// `Result` with this crate's [`Error`].

@@ -74,6 +74,11 @@ pub use flakes::{
     PositionNormalMemory, PositionNormalParams, PositionNormalPatch,
 };
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
+#[cfg(feature = "image")]
+pub use image_io::{
+    DEFAULT_LENGTH_TOLERANCE, FloatEncoding, ImageDecoding, ImageOptions, MAX_IMPLAUSIBLE_FRACTION,
+    RAW_EVIDENCE_BELOW,
+};
 pub use mixture::{
     BeckmannMixture, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES, DEFAULT_MASKING, DEFAULT_SAMPLES,
     DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL, DEFAULT_SPACING, DEFAULT_WEIGHT_SIGMAS,
