@@ -62,6 +62,7 @@ mod normal_map;
 mod procedural;
 mod reference;
 mod slope_tree;
+mod store;
 
 pub use binmap::{
     BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, DEFAULT_BINS_PER_AXIS,
