@@ -7,8 +7,8 @@
 mod support;
 
 use brdf::glint::{
-    BeckmannMixture, Footprint, GlintNdf, MaskingMode, MixtureParams, NormalMap, PatchOptions,
-    PositionNormalMap, PositionNormalParams,
+    BeckmannMixture, BinLookup, BinMap, BinMapParams, Footprint, GlintNdf, MaskingMode,
+    MixtureParams, NormalMap, PatchOptions, PositionNormalMap, PositionNormalParams,
 };
 use brdf::ndf::Ndf;
 use brdf::{Error, Vec2, Vec3};
@@ -197,6 +197,119 @@ fn position_normal_round_trip_is_exact() {
     }
 }
 
+#[test]
+fn bin_map_round_trip_is_exact() {
+    let n = 48;
+    let m = map(n);
+    for (bins, leaf, lookup) in [(31, 4, BinLookup::Dense), (15, 1, BinLookup::Hash)] {
+        let params = BinMapParams {
+            bins_per_axis: bins,
+            leaf_size: leaf,
+            lookup,
+            ..BinMapParams::default()
+        };
+        let built = BinMap::build(&m, params).unwrap();
+        assert!(!built.forest().is_empty(), "the test needs trees");
+        let file = saved(|w| built.save(w));
+        let loaded = BinMap::load(&mut file.as_slice()).unwrap();
+        assert_eq!(loaded.params(), built.params());
+        assert_eq!(loaded.memory(), built.memory());
+        assert_eq!(loaded.inverse_bin_map(), built.inverse_bin_map());
+        assert_eq!(loaded.forest(), built.forest());
+        for (k, f) in footprints(n).iter().enumerate() {
+            let what = format!("{lookup:?} fp {k}");
+            assert_same_patch(&built.patch(f), &loaded.patch(f), &what);
+            assert_same_patch(
+                &built.patch_smoothed(f, 0.1),
+                &loaded.patch_smoothed(f, 0.1),
+                &what,
+            );
+        }
+        assert_eq!(saved(|w| loaded.save(w)), file);
+    }
+}
+
+/// Offsets in a bin-map file: width 24, height 32, bins 40, leaf 48, lookup 56, σ 60, 𝓑 count 64,
+/// 𝓑 72.., then 𝓑⁻¹ (count, data), offsets, roots, forest, moments.
+#[test]
+fn inconsistent_bin_maps_are_errors() {
+    let n = 16;
+    let params = BinMapParams {
+        bins_per_axis: 5,
+        leaf_size: 2,
+        ..BinMapParams::default()
+    };
+    let built = BinMap::build(&map(n), params).unwrap();
+    let file = saved(|w| built.save(w));
+    let texels = n * n;
+    let bin_map_at = 72;
+    let inverse_at = bin_map_at + 4 * texels + 8;
+    let offsets_at = inverse_at + 4 * texels + 8;
+    let roots_at = offsets_at + 4 * 26 + 8;
+    let forest_at = roots_at + 4 * 25 + 8;
+    let forest_len =
+        u64::from_le_bytes(file[forest_at - 8..forest_at].try_into().unwrap()) as usize;
+    assert_eq!(forest_len, built.forest().len(), "layout of the test");
+    let u32_at = |f: &[u8], at: usize| u32::from_le_bytes(f[at..at + 4].try_into().unwrap());
+    let with = |at: usize, v: u32| {
+        let mut f = file.clone();
+        f[at..at + 4].copy_from_slice(&v.to_le_bytes());
+        reseal(f)
+    };
+    let swap = |a: usize, b: usize| {
+        let mut f = file.clone();
+        for k in 0..4 {
+            f.swap(a + k, b + k);
+        }
+        reseal(f)
+    };
+    // Two texels of the same bin list swapped: still a permutation with the right bins, but the
+    // forest's split no longer holds (the first tree's root splits x at 8: find a left and a right
+    // texel of its list).
+    let root_bin = (0..25)
+        .find(|&b| built.bin_range(b).is_some_and(|r| r.2.is_some()))
+        .unwrap();
+    let (s, e, _) = built.bin_range(root_bin).unwrap();
+    let mid = built.forest()[0] as usize;
+    assert!(s < mid && mid < e);
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("bin beyond B", with(bin_map_at, 25), "bin_map[0]"),
+        (
+            "offsets not the counts",
+            with(offsets_at + 4, u32_at(&file, offsets_at + 4) + 1),
+            "offsets",
+        ),
+        (
+            "inverse not a permutation",
+            with(inverse_at + 4, u32_at(&file, inverse_at)),
+            "inverse",
+        ),
+        (
+            "texel on the wrong side",
+            swap(inverse_at + 4 * s, inverse_at + 4 * (e - 1)),
+            "wrong side",
+        ),
+        (
+            "root not at the layout's place",
+            with(roots_at + 4 * root_bin, 2),
+            "roots",
+        ),
+        (
+            "mid outside the range",
+            with(forest_at, (e + 1) as u32),
+            "outside",
+        ),
+        ("right link broken", with(forest_at + 4, 0), "right child"),
+    ];
+    for (name, f, needle) in cases {
+        let e = BinMap::load(&mut f.as_slice()).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidFile { .. }) && e.to_string().contains(needle),
+            "{name}: {e}"
+        );
+    }
+}
+
 fn small_mixture_file() -> Vec<u8> {
     let params = MixtureParams {
         samples: 8,
@@ -212,39 +325,71 @@ fn load_mixture(bytes: &[u8]) -> brdf::Result<BeckmannMixture> {
 
 #[test]
 fn every_truncation_is_an_error() {
-    let file = small_mixture_file();
-    for cut in 0..file.len() {
-        let e = load_mixture(&file[..cut]).unwrap_err();
-        assert!(matches!(e, Error::Truncated { .. }), "cut at {cut}: {e}");
+    for (kind, file, load) in small_files() {
+        for cut in 0..file.len() {
+            let e = load(&file[..cut]).unwrap_err();
+            assert!(
+                matches!(e, Error::Truncated { .. }),
+                "{kind}: cut at {cut}: {e}"
+            );
+        }
     }
-    let nm = saved(|w| map(5).save(w));
-    for cut in 0..nm.len() {
-        let e = NormalMap::load_binary(&mut &nm[..cut]).unwrap_err();
-        assert!(matches!(e, Error::Truncated { .. }), "cut at {cut}: {e}");
-    }
+}
+
+/// A small file of every kind, with its loader.
+#[allow(clippy::type_complexity)]
+fn small_files() -> Vec<(&'static str, Vec<u8>, fn(&[u8]) -> brdf::Result<()>)> {
+    let m = map(6);
+    let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
+    let bm_params = BinMapParams {
+        bins_per_axis: 3,
+        leaf_size: 2,
+        ..BinMapParams::default()
+    };
+    let bm = BinMap::build(&m, bm_params).unwrap();
+    vec![
+        ("mixture", small_mixture_file(), |b| {
+            load_mixture(b).map(drop)
+        }),
+        ("normal map", saved(|w| m.save(w)), |b| {
+            NormalMap::load_binary(&mut &b[..]).map(drop)
+        }),
+        ("position-normal", saved(|w| pn.save(w)), |b| {
+            PositionNormalMap::load(&mut &b[..]).map(drop)
+        }),
+        ("bin map", saved(|w| bm.save(w)), |b| {
+            BinMap::load(&mut &b[..]).map(drop)
+        }),
+    ]
 }
 
 #[test]
 fn every_flipped_byte_is_an_error() {
-    let file = small_mixture_file();
-    for k in 0..file.len() {
-        for mask in [0x01u8, 0x80, 0xFF] {
-            let mut f = file.clone();
-            f[k] ^= mask;
-            let e = load_mixture(&f).unwrap_err();
-            let expected = match k {
-                0..8 => matches!(e, Error::BadMagic { .. }),
-                8..12 => matches!(e, Error::UnsupportedVersion { .. }),
-                12..16 => matches!(e, Error::WrongModelKind { .. }),
-                // The payload length: too long leaves bytes over or runs out; too short cuts a field.
-                16..24 => matches!(e, Error::InvalidFile { .. } | Error::Truncated { .. }),
-                // Parameters may be refused before the checksum is read; data are caught by it.
-                _ => matches!(
-                    e,
-                    Error::InvalidFile { .. } | Error::ChecksumMismatch { .. }
-                ),
-            };
-            assert!(expected, "byte {k} ^ {mask:#x}: {e}");
+    for (kind, file, load) in small_files() {
+        assert!(load(&file).is_ok(), "{kind}");
+        for k in 0..file.len() {
+            for mask in [0x01u8, 0x80, 0xFF] {
+                let mut f = file.clone();
+                f[k] ^= mask;
+                let e = load(&f).unwrap_err();
+                let expected = match k {
+                    0..8 => matches!(e, Error::BadMagic { .. }),
+                    8..12 => matches!(e, Error::UnsupportedVersion { .. }),
+                    12..16 => matches!(e, Error::WrongModelKind { .. }),
+                    // The payload length: too long leaves bytes over or runs out; too short cuts a
+                    // field.
+                    16..24 => matches!(e, Error::InvalidFile { .. } | Error::Truncated { .. }),
+                    // Parameters and counts may be refused before the checksum is read (or, for a
+                    // count, run out of data); data are caught by the checksum.
+                    _ => matches!(
+                        e,
+                        Error::InvalidFile { .. }
+                            | Error::ChecksumMismatch { .. }
+                            | Error::Truncated { .. }
+                    ),
+                };
+                assert!(expected, "{kind}: byte {k} ^ {mask:#x}: {e}");
+            }
         }
     }
 }
@@ -419,4 +564,53 @@ fn sizes_beyond_the_file_are_refused_before_allocating() {
     nm[24..32].copy_from_slice(&(1u64 << 31).to_le_bytes());
     let e = NormalMap::load_binary(&mut &reseal(nm)[..]).unwrap_err();
     assert!(e.to_string().contains("width"), "{e}");
+}
+
+/// Writes the seed files of the store fuzz targets (small valid files of each kind):
+/// `cargo test --test store write_fuzz_seeds -- --ignored`.
+#[test]
+#[ignore]
+fn write_fuzz_seeds() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds");
+    let write = |dir: &str, name: &str, bytes: Vec<u8>| {
+        let d = root.join(dir);
+        std::fs::create_dir_all(&d).unwrap();
+        // The store targets read a flag byte, a footprint and a probe before the file: prefix zeros.
+        let mut input = vec![0u8; 1 + 6 * 4 + 9 * 4];
+        input.extend(bytes);
+        std::fs::write(d.join(name), input).unwrap();
+    };
+    for n in [1usize, 3] {
+        let m = map(n);
+        write("store_normal_map", &format!("map{n}"), saved(|w| m.save(w)));
+        let params = MixtureParams {
+            samples: 4,
+            ..MixtureParams::default()
+        };
+        let mx = BeckmannMixture::build(&m, params).unwrap();
+        write(
+            "store_mixture",
+            &format!("mixture{n}"),
+            saved(|w| mx.save(w)),
+        );
+        let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
+        write(
+            "store_position_normal",
+            &format!("pn{n}"),
+            saved(|w| pn.save(w)),
+        );
+        for (bins, leaf) in [(3, 1), (7, 2)] {
+            let params = BinMapParams {
+                bins_per_axis: bins,
+                leaf_size: leaf,
+                ..BinMapParams::default()
+            };
+            let bm = BinMap::build(&map(n + 3), params).unwrap();
+            write(
+                "store_binmap",
+                &format!("bm{n}_{bins}"),
+                saved(|w| bm.save(w)),
+            );
+        }
+    }
 }

@@ -356,6 +356,25 @@ impl<'a> Decoder<'a> {
                 ),
             });
         }
+        self.records(what, expected)
+    }
+
+    /// An array written by [`Encoder::array`] whose element count is free up to `max` (checked, as
+    /// everything else, before allocating).
+    pub(crate) fn array_up_to<T: Scalar + Default, const N: usize>(
+        &mut self,
+        what: &'static str,
+        max: usize,
+    ) -> Result<Vec<[T; N]>> {
+        let n = self.len(what, max)?;
+        self.records(what, n)
+    }
+
+    fn records<T: Scalar + Default, const N: usize>(
+        &mut self,
+        what: &'static str,
+        expected: usize,
+    ) -> Result<Vec<[T; N]>> {
         let record = N * T::BYTES;
         let bytes = expected
             .checked_mul(record)
