@@ -222,8 +222,9 @@ fn check_lists(bin_map: &[u32], inverse: &[u32], offsets: &[u32], nb: usize) -> 
     }
     let mut seen = vec![false; inverse.len()];
     for b in 0..nb {
-        for i in offsets[b] as usize..offsets[b + 1] as usize {
-            let k = inverse[i] as usize;
+        let (start, end) = (offsets[b] as usize, offsets[b + 1] as usize);
+        for (i, &k) in (start..).zip(&inverse[start..end]) {
+            let k = k as usize;
             if k >= seen.len() || seen[k] || bin_map[k] as usize != b {
                 return Err(invalid(format!(
                     "inverse[{i}] = {k} is out of range, repeated, or not a texel of bin {b}"
