@@ -66,6 +66,67 @@ pub enum Error {
         /// What went wrong.
         reason: String,
     },
+    /// A decoded normal map is implausible as a whole: most of its vectors are far from unit length
+    /// or below the horizon (usually a file decoded with the wrong encoding), or the encoding could
+    /// not be detected.
+    #[error("{source_name}: implausible normal map: {reason}")]
+    ImplausibleNormals {
+        /// Where the data came from (a file path, or a description).
+        source_name: String,
+        /// The statistics and the likely cause.
+        reason: String,
+    },
+    /// A stored model's file does not start with the format's magic bytes `BRDFGLNT`.
+    #[error("not a brdf glint file: magic bytes {found:?} instead of \"BRDFGLNT\"")]
+    BadMagic {
+        /// The first 8 bytes found.
+        found: [u8; 8],
+    },
+    /// A stored model's file has a format version this build cannot read.
+    #[error("unsupported file format version {found} (this build reads version {supported})")]
+    UnsupportedVersion {
+        /// The version in the file.
+        found: u32,
+        /// The version this build reads.
+        supported: u32,
+    },
+    /// A stored model's file holds another kind of model than the one asked for.
+    #[error("the file holds a {found}, not a {expected}")]
+    WrongModelKind {
+        /// The type whose loader was called.
+        expected: String,
+        /// The kind stored in the file.
+        found: String,
+    },
+    /// A stored model's file ended early.
+    #[error("truncated file: it ends inside {what}")]
+    Truncated {
+        /// The field being read when the data ran out.
+        what: &'static str,
+    },
+    /// A stored model's checksum does not match its contents (flipped or altered bytes).
+    #[error(
+        "checksum mismatch: stored {stored:#018x}, computed {computed:#018x} (the file is corrupt)"
+    )]
+    ChecksumMismatch {
+        /// The checksum at the end of the file.
+        stored: u64,
+        /// The checksum of the bytes read.
+        computed: u64,
+    },
+    /// A stored model's file is well formed but its contents are inconsistent: lengths that do not
+    /// match the parameters, invalid parameters or values, sizes beyond what the file holds.
+    #[error("invalid file: {reason}")]
+    InvalidFile {
+        /// What is wrong.
+        reason: String,
+    },
+    /// Reading or writing a stream failed (other than by ending early).
+    #[error("stream error: {source}")]
+    Stream {
+        /// The underlying error.
+        source: std::io::Error,
+    },
 }
 
 /// `Result` with this crate's [`Error`].

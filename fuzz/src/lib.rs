@@ -85,3 +85,74 @@ pub fn check_bxdf(bxdf: &dyn Bxdf, probe: &Probe) {
     let (wo, wi, uc, u) = probe.parts();
     totality::check_bxdf(bxdf, wo, wi, uc, u);
 }
+
+/// The file checksum of docs/format.md, written from the documentation (not the crate's code), so
+/// that the store targets can re-seal a mutated file and reach the loaders' content checks.
+pub fn format_checksum(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xCBF2_9CE4_8422_2325;
+    for chunk in bytes.chunks(8) {
+        let mut w = [0u8; 8];
+        w[..chunk.len()].copy_from_slice(chunk);
+        h = (h ^ u64::from_le_bytes(w))
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .rotate_left(29);
+    }
+    h ^= bytes.len() as u64;
+    h ^= h >> 30;
+    h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    h ^= h >> 27;
+    h = h.wrapping_mul(0x94D0_49BB_1331_11EB);
+    h ^ (h >> 31)
+}
+
+/// Input of the store targets: the bytes of a file (re-sealed with a valid checksum when `reseal`,
+/// so that mutations reach the content checks rather than stopping at the checksum), and a footprint
+/// and probe to query a loaded model with.
+///
+/// Layout of the fuzz input: 1 flag byte (bit 0 = reseal), the footprint (24 bytes) and the probe
+/// (36 bytes) as `arbitrary` decodes them, then the file bytes as they are (not through
+/// `Vec<u8>: Arbitrary`, which interleaves a continuation byte per element).
+#[derive(Debug)]
+pub struct StoreInput {
+    pub reseal: bool,
+    pub footprint: FootprintInput,
+    pub probe: Probe,
+    pub file: Vec<u8>,
+}
+
+impl StoreInput {
+    /// Splits raw fuzz bytes as described above (missing bytes read as zeros).
+    pub fn parse(data: &[u8]) -> StoreInput {
+        let mut u = arbitrary::Unstructured::new(data);
+        let reseal = u8::arbitrary(&mut u).unwrap_or(0) & 1 == 1;
+        let footprint = FootprintInput::arbitrary(&mut u).unwrap_or(FootprintInput {
+            uv: (0.0, 0.0),
+            duv_dx: (0.0, 0.0),
+            duv_dy: (0.0, 0.0),
+        });
+        let probe = Probe::arbitrary(&mut u).unwrap_or(Probe {
+            wo: (0.0, 0.0, 1.0),
+            wi: (0.0, 0.0, 1.0),
+            u: (0.5, 0.5),
+            uc: 0.5,
+        });
+        let file = u.take_rest().to_vec();
+        StoreInput {
+            reseal,
+            footprint,
+            probe,
+            file,
+        }
+    }
+
+    /// The file bytes, re-sealed if asked (files shorter than the checksum are left alone).
+    pub fn bytes(&self) -> Vec<u8> {
+        let mut f = self.file.clone();
+        if self.reseal && f.len() >= 8 {
+            let n = f.len() - 8;
+            let sum = format_checksum(&f[..n]);
+            f[n..].copy_from_slice(&sum.to_le_bytes());
+        }
+        f
+    }
+}

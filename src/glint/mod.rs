@@ -64,6 +64,7 @@ mod procedural;
 mod reference;
 mod scratch;
 mod slope_tree;
+mod store;
 
 pub use binmap::{
     BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, DEFAULT_BINS_PER_AXIS,
@@ -76,6 +77,11 @@ pub use flakes::{
     PositionNormalMemory, PositionNormalParams, PositionNormalPatch,
 };
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
+#[cfg(feature = "image")]
+pub use image_io::{
+    DEFAULT_LENGTH_TOLERANCE, FloatEncoding, ImageDecoding, ImageOptions, MAX_IMPLAUSIBLE_FRACTION,
+    RAW_EVIDENCE_BELOW,
+};
 pub use mixture::{
     BeckmannMixture, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES, DEFAULT_MASKING, DEFAULT_SAMPLES,
     DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL, DEFAULT_SPACING, DEFAULT_WEIGHT_SIGMAS,

@@ -85,6 +85,17 @@ impl MomentPyramid {
         }
     }
 
+    /// The chain of stored parts (crate-private, for the bin map's loader): `levels` are levels
+    /// `first..` of the full chain. The caller checks the sizes against [`MomentPyramid::level_sizes`].
+    pub(crate) fn from_parts(first: usize, levels: Vec<MomentLevel>) -> MomentPyramid {
+        MomentPyramid { levels, first }
+    }
+
+    /// Index of the first kept level in the full chain, and the kept levels (for saving).
+    pub(crate) fn parts(&self) -> (usize, &[MomentLevel]) {
+        (self.first, &self.levels)
+    }
+
     /// Bytes held by the moments (20 per level texel).
     pub fn bytes(&self) -> usize {
         self.levels.iter().map(|l| 20 * l.data.len()).sum()

@@ -7,6 +7,7 @@
 //! \[Chermain2019\] §3 (slope representation, interpolated normals); \[Dupuy2013\] (slope moments, mipmaps).
 
 use super::moments::MomentPyramid;
+use super::store::{self, Kind};
 use crate::frame::{normal_to_slope, slope_to_normal};
 use crate::{Error, Result};
 use glam::{Vec2, Vec3};
@@ -448,6 +449,46 @@ impl NormalMap {
     pub fn filtered_moments(&self, center_texel: Vec2, radius_texels: f32) -> [f32; 5] {
         self.pyramid()
             .filtered(self.width, self.height, center_texel, radius_texels)
+    }
+}
+
+impl NormalMap {
+    /// Writes the map in the crate's binary format (docs/format.md): its size and its slopes, exactly
+    /// (f32 bits). The moment pyramid is not stored (it is rebuilt on first use).
+    ///
+    /// This is not an image: [`NormalMap::to_rgb8`] exports a picture. Wrap files in a
+    /// `std::io::BufWriter` or not: the writer already writes in 64 KiB blocks.
+    ///
+    /// # Errors
+    /// [`Error::Stream`] if the writer fails.
+    pub fn save(&self, w: &mut impl std::io::Write) -> Result<()> {
+        store::save(w, Kind::NormalMap, |e| {
+            e.len(self.width)?;
+            e.len(self.height)?;
+            e.array(self.slopes.iter().map(|s| s.to_array()))
+        })
+    }
+
+    /// Reads a map written by [`NormalMap::save`]; the slopes are bit-identical to the saved ones.
+    /// (Named apart from [`NormalMap::load`], which decodes image files.)
+    ///
+    /// # Errors
+    /// [`Error::BadMagic`], [`Error::UnsupportedVersion`], [`Error::WrongModelKind`],
+    /// [`Error::Truncated`], [`Error::ChecksumMismatch`], [`Error::Stream`]; [`Error::InvalidFile`]
+    /// for a size that is zero, too large or does not match the slope count, and for slopes that
+    /// [`NormalMap::from_slopes`] refuses (non-finite or above [`MAX_SLOPE`]).
+    pub fn load_binary(r: &mut impl std::io::Read) -> Result<NormalMap> {
+        let mut d = store::Decoder::open(r, Kind::NormalMap)?;
+        let width = d.len("width", i32::MAX as usize)?;
+        let height = d.len("height", i32::MAX as usize)?;
+        let n = width.checked_mul(height).ok_or_else(|| {
+            store::invalid(format!("width × height = {width} × {height} overflows"))
+        })?;
+        let slopes = d.array::<f32, 2>("slopes", n)?;
+        d.finish()?;
+        let slopes = slopes.into_iter().map(Vec2::from_array).collect();
+        NormalMap::from_slopes(width, height, slopes)
+            .map_err(|e| store::invalid(format!("stored normal map refused: {e}")))
     }
 }
 

@@ -19,6 +19,7 @@ mod clip;
 mod forest;
 mod lookup;
 mod patch;
+mod store;
 
 pub use forest::QueryStats;
 pub use lookup::BinLookup;

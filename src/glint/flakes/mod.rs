@@ -18,6 +18,7 @@
 mod brdf;
 mod build;
 mod patch;
+mod store;
 
 pub use brdf::{DEFAULT_MASKING_ALPHA, PositionNormalBrdf};
 pub use patch::{EXACT_MASKING_ELEMENTS, PositionNormalPatch};
@@ -164,6 +165,20 @@ pub struct PositionNormalMap {
     params: PositionNormalParams,
 }
 
+/// The element grid (width, height) × sampling rate, at most 2³¹ elements.
+fn element_grid(width: usize, height: usize, params: &PositionNormalParams) -> Result<[usize; 2]> {
+    let r = params.sampling_rate;
+    let (nx, ny) = (width.saturating_mul(r), height.saturating_mul(r));
+    if nx.checked_mul(ny).is_none_or(|n| n > (1usize << 31)) {
+        return Err(Error::InvalidSize {
+            width: nx,
+            height: ny,
+            reason: "the element grid (map size × sampling rate) exceeds 2^31 elements",
+        });
+    }
+    Ok([nx, ny])
+}
+
 impl PositionNormalMap {
     /// The positional standard deviation of an element in units of the element spacing h:
     /// σ_h = h / √(8 ln 2) ≈ 0.4247 h, so that the Gaussian's full width at half maximum is h
@@ -179,32 +194,59 @@ impl PositionNormalMap {
     pub fn build(map: &NormalMap, params: PositionNormalParams) -> Result<Self> {
         params.validate()?;
         let (width, height) = (map.width(), map.height());
-        let r = params.sampling_rate;
-        let (nx, ny) = (width.saturating_mul(r), height.saturating_mul(r));
-        if nx.checked_mul(ny).is_none_or(|n| n > (1usize << 31)) {
+        let grid = element_grid(width, height, &params)?;
+        let spacing = 1.0 / params.sampling_rate as f64;
+        let elements = build::elements(map, grid, spacing);
+        Ok(Self::assemble(width, height, grid, params, elements))
+    }
+
+    /// The representation of stored parts (crate-private; see `store.rs`): validates `params`,
+    /// derives the element grid as [`PositionNormalMap::build`] does and checks the element count
+    /// against it, then rebuilds the slope-box hierarchy exactly as the build does. The elements
+    /// themselves are not checked here (the loader bounds them).
+    pub(crate) fn from_parts(
+        width: usize,
+        height: usize,
+        params: PositionNormalParams,
+        elements: Vec<[f32; 6]>,
+    ) -> Result<Self> {
+        params.validate()?;
+        crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))?;
+        let grid = element_grid(width, height, &params)?;
+        if elements.len() != grid[0] * grid[1] {
             return Err(Error::InvalidSize {
-                width: nx,
-                height: ny,
-                reason: "the element grid (map size × sampling rate) exceeds 2^31 elements",
+                width: grid[0],
+                height: grid[1],
+                reason: "the element count does not match the element grid of the map size and rate",
             });
         }
-        let spacing = 1.0 / r as f64;
-        let elements = build::elements(map, [nx, ny], spacing);
+        Ok(Self::assemble(width, height, grid, params, elements))
+    }
+
+    /// The derived parts (slope boxes and their hierarchy) of given elements.
+    fn assemble(
+        width: usize,
+        height: usize,
+        grid: [usize; 2],
+        params: PositionNormalParams,
+        elements: Vec<[f32; 6]>,
+    ) -> Self {
+        let spacing = 1.0 / params.sampling_rate as f64;
         let sigma_h = SIGMA_H_PER_SPACING * spacing;
         let leaf: Vec<[f32; 4]> = elements
             .iter()
             .map(|e| build::slope_box(e, sigma_h, &params))
             .collect();
-        let tree = SlopeTree::build(nx, ny, &leaf);
-        Ok(PositionNormalMap {
+        let tree = SlopeTree::build(grid[0], grid[1], &leaf);
+        PositionNormalMap {
             width,
             height,
-            grid: [nx, ny],
+            grid,
             spacing,
             elements,
             tree,
             params,
-        })
+        }
     }
 
     /// The parameters the representation was built with.

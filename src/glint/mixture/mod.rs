@@ -15,6 +15,7 @@
 mod build;
 mod hierarchy;
 mod patch;
+mod store;
 
 pub use patch::MixturePatch;
 pub(crate) use patch::MixtureScratch;
@@ -238,6 +239,28 @@ pub struct BeckmannMixture {
     box_k: f32,
 }
 
+/// The lobe grid (nx, ny) = max(1, round(size / spacing)) and the spacing actually used per axis.
+fn lobe_grid(
+    width: usize,
+    height: usize,
+    params: &MixtureParams,
+) -> Result<([usize; 2], [f64; 2])> {
+    let h = params.spacing as f64;
+    let nx = ((width as f64 / h).round() as usize).max(1);
+    let ny = ((height as f64 / h).round() as usize).max(1);
+    if nx.checked_mul(ny).is_none_or(|n| n > (1usize << 31)) {
+        return Err(Error::InvalidSize {
+            width: nx,
+            height: ny,
+            reason: "the lobe grid (map size / spacing) exceeds 2^31 lobes",
+        });
+    }
+    Ok((
+        [nx, ny],
+        [width as f64 / nx as f64, height as f64 / ny as f64],
+    ))
+}
+
 impl BeckmannMixture {
     /// Builds the mixture of `map` (parallel, deterministic whatever the thread count).
     ///
@@ -261,36 +284,63 @@ impl BeckmannMixture {
     ) -> Result<Self> {
         params.validate()?;
         let (width, height) = (map.width(), map.height());
-        let h = params.spacing as f64;
-        let nx = ((width as f64 / h).round() as usize).max(1);
-        let ny = ((height as f64 / h).round() as usize).max(1);
-        if nx.checked_mul(ny).is_none_or(|n| n > (1usize << 31)) {
+        let (grid, spacing) = lobe_grid(width, height, &params)?;
+        let lobes = build::all_moments(map, &params, grid, spacing, progress);
+        Ok(Self::assemble(width, height, grid, spacing, params, lobes))
+    }
+
+    /// The mixture of stored parts (crate-private; see `store.rs`): validates `params`, derives the
+    /// lobe grid as [`BeckmannMixture::build`] does and checks the lobe count against it, then
+    /// rebuilds the hierarchy and the mip chain exactly as the build does. The moments themselves are
+    /// not checked here (the loader bounds them).
+    pub(crate) fn from_parts(
+        width: usize,
+        height: usize,
+        params: MixtureParams,
+        lobes: Vec<[f32; 5]>,
+    ) -> Result<Self> {
+        params.validate()?;
+        crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))?;
+        let (grid, spacing) = lobe_grid(width, height, &params)?;
+        if lobes.len() != grid[0] * grid[1] {
             return Err(Error::InvalidSize {
-                width: nx,
-                height: ny,
-                reason: "the lobe grid (map size / spacing) exceeds 2^31 lobes",
+                width: grid[0],
+                height: grid[1],
+                reason: "the lobe count does not match the lobe grid of the map size and spacing",
             });
         }
-        let spacing = [width as f64 / nx as f64, height as f64 / ny as f64];
-        let lobes = build::all_moments(map, &params, [nx, ny], spacing, progress);
+        Ok(Self::assemble(width, height, grid, spacing, params, lobes))
+    }
+
+    /// The derived parts (slope boxes, hierarchy, mip chain) of given lobes.
+    fn assemble(
+        width: usize,
+        height: usize,
+        grid: [usize; 2],
+        spacing: [f64; 2],
+        params: MixtureParams,
+        lobes: Vec<[f32; 5]>,
+    ) -> Self {
+        use rayon::prelude::*;
+        let [nx, ny] = grid;
         let box_k = (-2.0 * (params.slope_tail as f64).ln()).sqrt() as f32;
         let leaf: Vec<[f32; 4]> = lobes
-            .iter()
+            .par_iter()
             .map(|m| lobe_box(&SlopeGaussian::from_moments(*m, params.sigma_min), box_k))
             .collect();
         let tree = SlopeTree::build(nx, ny, &leaf);
         let pyramid = LobePyramid::build(nx, ny, &lobes);
-        Ok(BeckmannMixture {
+        BeckmannMixture {
             width,
             height,
-            grid: [nx, ny],
+            grid,
             spacing,
             lobes,
             tree,
             pyramid,
             params,
             box_k,
-        })
+        }
     }
 
     /// The parameters the mixture was built with.

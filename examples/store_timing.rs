@@ -1,0 +1,151 @@
+//! Build against load: how long each glint model takes to build from a normal map, and to load back
+//! from its saved file (docs/format.md), with the memory it holds per texel and its file size.
+//!
+//! `cargo run --release --example store_timing -- [--size N] [--loads K]` (default 2048² bumpy map,
+//! 5 loads per build). Builds and loads alternate (build, loads, build, loads) so that a change of
+//! machine load hits both; files are saved to and loaded from memory (a `Vec<u8>`), so disk speed is
+//! left out. Prints a Markdown table (docs/results.md, "Saving and loading built maps").
+
+use brdf::glint::{BeckmannMixture, BinMap, BinMapParams, MixtureParams, NormalMap};
+use brdf::glint::{PositionNormalMap, PositionNormalParams, bumpy};
+use std::time::Instant;
+
+fn arg(name: &str) -> Option<usize> {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+struct Row {
+    name: &'static str,
+    builds: Vec<f64>,
+    loads: Vec<f64>,
+    file_bytes: usize,
+    memory_bytes: usize,
+}
+
+/// Times `rounds` × (one build, `loads` loads of its saved file).
+fn measure<M>(
+    name: &'static str,
+    rounds: usize,
+    loads: usize,
+    build: impl Fn() -> M,
+    save: impl Fn(&M, &mut Vec<u8>),
+    load: impl Fn(&[u8]) -> M,
+    memory: impl Fn(&M) -> usize,
+) -> Row {
+    let mut row = Row {
+        name,
+        builds: Vec::new(),
+        loads: Vec::new(),
+        file_bytes: 0,
+        memory_bytes: 0,
+    };
+    for _ in 0..rounds {
+        let t = Instant::now();
+        let model = build();
+        row.builds.push(t.elapsed().as_secs_f64());
+        let mut file = Vec::new();
+        save(&model, &mut file);
+        row.file_bytes = file.len();
+        row.memory_bytes = memory(&model);
+        drop(model);
+        for _ in 0..loads {
+            let t = Instant::now();
+            let m = load(&file);
+            row.loads.push(t.elapsed().as_secs_f64());
+            std::hint::black_box(&m);
+        }
+        eprintln!(
+            "{name}: build {:.3} s, last load {:.4} s",
+            row.builds.last().unwrap(),
+            row.loads.last().unwrap()
+        );
+    }
+    row
+}
+
+fn main() {
+    let n = arg("--size").unwrap_or(2048);
+    let loads = arg("--loads").unwrap_or(5);
+    let map = bumpy(n, n, 0.25, 4.0, 1).unwrap();
+    let texels = (n * n) as f64;
+    let rows = vec![
+        measure(
+            "NormalMap (from slopes)",
+            2,
+            loads,
+            || NormalMap::from_slopes(n, n, map.slopes().to_vec()).unwrap(),
+            |m, f| m.save(f).unwrap(),
+            |f| NormalMap::load_binary(&mut &f[..]).unwrap(),
+            |m| m.slopes().len() * 8,
+        ),
+        measure(
+            "BeckmannMixture",
+            2,
+            loads,
+            || BeckmannMixture::build(&map, MixtureParams::default()).unwrap(),
+            |m, f| m.save(f).unwrap(),
+            |f| BeckmannMixture::load(&mut &f[..]).unwrap(),
+            |m| {
+                let b = m.memory();
+                b.lobe_bytes + b.hierarchy_bytes + b.mip_bytes
+            },
+        ),
+        measure(
+            "PositionNormalMap",
+            2,
+            loads,
+            || PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap(),
+            |m, f| m.save(f).unwrap(),
+            |f| PositionNormalMap::load(&mut &f[..]).unwrap(),
+            |m| {
+                let b = m.memory();
+                b.element_bytes + b.hierarchy_bytes
+            },
+        ),
+        measure(
+            "BinMap",
+            2,
+            loads,
+            || BinMap::build(&map, BinMapParams::default()).unwrap(),
+            |m, f| m.save(f).unwrap(),
+            |f| BinMap::load(&mut &f[..]).unwrap(),
+            |m| m.memory().total(),
+        ),
+    ];
+    println!(
+        "map: bumpy {n}², {} builds and {} loads per model",
+        2,
+        2 * loads
+    );
+    println!();
+    println!(
+        "| model | build (median) | load (median) | build / load | file B/texel | memory B/texel |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for r in &rows {
+        let (b, l) = (median(r.builds.clone()), median(r.loads.clone()));
+        println!(
+            "| {} | {:.3} s | {:.1} ms | {:.0}× | {:.2} | {:.2} |",
+            r.name,
+            b,
+            1e3 * l,
+            b / l,
+            r.file_bytes as f64 / texels,
+            r.memory_bytes as f64 / texels
+        );
+    }
+}

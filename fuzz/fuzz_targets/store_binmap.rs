@@ -1,0 +1,24 @@
+//! `BinMap::load` on arbitrary (optionally re-sealed) bytes: `Ok` or a clear `Err`, never a panic or a
+//! huge allocation; a loaded bin map re-saves byte for byte, and its plain and smoothed patches and
+//! their BRDFs pass the totality checks.
+#![no_main]
+
+use brdf::glint::BinMap;
+use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
+use brdf_fuzz::{StoreInput, check_bxdf, check_ndf};
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let input = StoreInput::parse(data);
+    let bytes = input.bytes();
+    if let Ok(map) = BinMap::load(&mut bytes.as_slice()) {
+        let mut again = Vec::new();
+        map.save(&mut again).unwrap();
+        assert_eq!(&bytes[..again.len()], &again[..]);
+        let footprint = input.footprint.build();
+        for patch in [map.patch(&footprint), map.patch_smoothed(&footprint, 0.1)] {
+            check_ndf(&patch, &input.probe);
+            check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), &input.probe);
+        }
+    }
+});

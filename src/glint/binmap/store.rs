@@ -1,0 +1,354 @@
+//! Saving and loading a built [`BinMap`] (format: docs/format.md, kind 4).
+//!
+//! Stored: the map size, the build parameters, the bin map 𝓑 (u32 per texel), the inverse bin map 𝓑⁻¹
+//! in the forest's order (u32 per texel), the prefix-sum offsets of the bins' lists (B + 1) and their
+//! tree roots (B), the packed forest, and the coarse slope-moment chain of the masking lobe. Rebuilt
+//! on load (cheap, by the build's own routines): the per-bin tables (centre slopes, masking facets) and
+//! the lookup (dense or hash) from the offsets and roots.
+//!
+//! The inverse map and the forest are stored rather than rebuilt because sorting the texels into the
+//! trees is most of the build. The loader therefore validates them completely before use: 𝓑⁻¹ is a
+//! permutation whose lists agree with 𝓑 and the offsets; the forest is exactly the pre-order layout
+//! the builder writes (each internal node where the previous one ends, right-child links consistent,
+//! a list gets a tree exactly when it is longer than the leaf size), and every node's texels lie in
+//! its region with the split the builder uses. A file that passes is a bin map the builder could
+//! have produced.
+
+use super::forest::NO_TREE;
+use super::lookup::Table;
+use super::{BinFacet, BinLookup, BinMap, BinMapParams, MASKING_FIRST_LEVEL, check_params};
+use crate::Result;
+use crate::frame::normal_to_slope;
+use crate::glint::MAX_SLOPE;
+use crate::glint::moments::{MomentLevel, MomentPyramid};
+use crate::glint::store::{self, Decoder, Kind, invalid};
+use glam::Vec2;
+use rayon::prelude::*;
+use std::io::{Read, Write};
+
+impl BinMap {
+    /// Writes the bin map in the crate's binary format (docs/format.md): size, parameters, 𝓑, 𝓑⁻¹,
+    /// bin offsets and roots, forest and coarse moments, exactly (about 8 bytes per texel plus 8 per
+    /// bin). Writes in 64 KiB blocks.
+    ///
+    /// # Errors
+    /// [`crate::Error::Stream`] if the writer fails.
+    pub fn save(&self, w: &mut impl Write) -> Result<()> {
+        let p = &self.params;
+        let nb = self.bins.len();
+        // Offsets and roots of every bin, whatever the lookup (the hash table is rebuilt from them).
+        let entries: Vec<(u32, u32)> = (0..nb)
+            .map(|b| {
+                self.table
+                    .get(b)
+                    .map_or((0, NO_TREE), |e| (e.end - e.start, e.root))
+            })
+            .collect();
+        let mut offsets = Vec::with_capacity(nb + 1);
+        offsets.push(0u32);
+        for &(len, _) in &entries {
+            offsets.push(offsets[offsets.len() - 1] + len);
+        }
+        let (first, levels) = self.moments.parts();
+        store::save(w, Kind::BinMap, |e| {
+            e.len(self.width)?;
+            e.len(self.height)?;
+            e.len(p.bins_per_axis)?;
+            e.len(p.leaf_size)?;
+            e.put(match p.lookup {
+                BinLookup::Dense => 0u32,
+                BinLookup::Hash => 1u32,
+            })?;
+            e.put(p.sigma_min)?;
+            e.array(self.bin_map.iter().map(|&b| [b]))?;
+            e.array(self.inverse.iter().map(|&k| [k]))?;
+            e.array(offsets.iter().map(|&o| [o]))?;
+            e.array(entries.iter().map(|&(_, root)| [root]))?;
+            e.array(self.nodes.iter().map(|&v| [v]))?;
+            e.len(first)?;
+            e.len(levels.len())?;
+            for l in levels {
+                e.len(l.width)?;
+                e.len(l.height)?;
+                e.array(l.data.iter().copied())?;
+            }
+            Ok(())
+        })
+    }
+
+    /// Reads a bin map written by [`BinMap::save`]. Its patches (plain and smoothed) answer `d`,
+    /// `lambda`, `projected_area`, `sample_visible` and `pdf_visible` bit-identically to the saved
+    /// one's.
+    ///
+    /// # Errors
+    /// [`crate::Error::BadMagic`], [`crate::Error::UnsupportedVersion`],
+    /// [`crate::Error::WrongModelKind`], [`crate::Error::Truncated`],
+    /// [`crate::Error::ChecksumMismatch`], [`crate::Error::Stream`]; [`crate::Error::InvalidFile`] for
+    /// parameters the builder refuses, sizes that do not match the map or the bins, and any
+    /// inconsistency of 𝓑, 𝓑⁻¹, the offsets, the forest or the moments (see the module docs).
+    pub fn load(r: &mut impl Read) -> Result<Self> {
+        let mut d = Decoder::open(r, Kind::BinMap)?;
+        let width = d.len("width", i32::MAX as usize)?;
+        let height = d.len("height", i32::MAX as usize)?;
+        let params = BinMapParams {
+            bins_per_axis: d.len("bins_per_axis", usize::MAX)?,
+            leaf_size: d.len("leaf_size", usize::MAX)?,
+            lookup: match d.get::<u32>("lookup")? {
+                0 => BinLookup::Dense,
+                1 => BinLookup::Hash,
+                v => return Err(invalid(format!("lookup {v} (0 or 1 expected)"))),
+            },
+            sigma_min: d.get("sigma_min")?,
+        };
+        let refused = |e: crate::Error| invalid(format!("stored bin map refused: {e}"));
+        let bins = check_params(&params).map_err(refused)?;
+        let texels =
+            crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))
+                .map_err(refused)?;
+        if texels >= u32::MAX as usize {
+            return Err(invalid(format!(
+                "{texels} texels: the bin map needs fewer than 2^32"
+            )));
+        }
+        let nb = bins.len();
+        let bin_map = flat(d.array::<u32, 1>("bin_map", texels)?);
+        let inverse = flat(d.array::<u32, 1>("inverse", texels)?);
+        let offsets = flat(d.array::<u32, 1>("offsets", nb + 1)?);
+        let roots = flat(d.array::<u32, 1>("roots", nb)?);
+        // Internal nodes hold at least 2 texels and those of one depth are disjoint, so a forest has
+        // fewer than texels × (depth ≤ 64) nodes; the bound only limits the count before its check.
+        let nodes = flat(d.array_up_to::<u32, 1>("forest", 128 * texels)?);
+        let sizes = MomentPyramid::level_sizes(width, height);
+        let first = MASKING_FIRST_LEVEL.min(sizes.len() - 1);
+        let stored_first = d.len("moments first level", usize::MAX)?;
+        let level_count = d.len("moment levels", sizes.len())?;
+        if stored_first != first || level_count != sizes.len() - first {
+            return Err(invalid(format!(
+                "moment chain from level {stored_first} with {level_count} levels; a {width}×{height} map \
+                 keeps levels {first}..{}",
+                sizes.len()
+            )));
+        }
+        let mut levels = Vec::with_capacity(level_count);
+        for &(w, h) in &sizes[first..] {
+            let (sw, sh) = (
+                d.len("moment level width", w)?,
+                d.len("moment level height", h)?,
+            );
+            if (sw, sh) != (w, h) {
+                return Err(invalid(format!(
+                    "moment level of {sw}×{sh} texels where the map's chain has {w}×{h}"
+                )));
+            }
+            let data = d.array::<f32, 5>("moments", w * h)?;
+            levels.push(MomentLevel {
+                width: w,
+                height: h,
+                data,
+            });
+        }
+        d.finish()?;
+        let m = 2.0 * MAX_SLOPE;
+        for l in &levels {
+            store::check_range(&l.data, "moments", |c| match c {
+                0 | 1 => (-m, m),
+                2 | 3 => (0.0, m * m),
+                _ => (-m * m, m * m),
+            })?;
+        }
+        check_lists(&bin_map, &inverse, &offsets, nb)?;
+        check_forest(
+            &inverse,
+            &offsets,
+            &roots,
+            &nodes,
+            [width, height],
+            params.leaf_size,
+        )?;
+        let facets = (0..nb)
+            .into_par_iter()
+            .map(|b| {
+                if offsets[b + 1] > offsets[b] {
+                    BinFacet::new(&bins, b)
+                } else {
+                    BinFacet::empty(&bins, b)
+                }
+            })
+            .collect();
+        let center_slope = (0..nb)
+            .map(|b| normal_to_slope(bins.center(b)).unwrap_or(Vec2::ZERO))
+            .collect();
+        Ok(BinMap {
+            width,
+            height,
+            bins,
+            params,
+            bin_map,
+            inverse,
+            nodes,
+            table: Table::new(params.lookup, offsets, roots),
+            center_slope,
+            facets,
+            moments: MomentPyramid::from_parts(first, levels),
+        })
+    }
+}
+
+fn flat(v: Vec<[u32; 1]>) -> Vec<u32> {
+    v.into_iter().map(|[x]| x).collect()
+}
+
+/// 𝓑 holds bins < B; the offsets are prefix sums from 0 to the texel count whose differences are the
+/// bins' texel counts in 𝓑; 𝓑⁻¹ is a permutation of the texels, each in the list of its bin.
+fn check_lists(bin_map: &[u32], inverse: &[u32], offsets: &[u32], nb: usize) -> Result<()> {
+    let mut counts = vec![0u32; nb];
+    for (k, &b) in bin_map.iter().enumerate() {
+        let c = counts
+            .get_mut(b as usize)
+            .ok_or_else(|| invalid(format!("bin_map[{k}] = {b}, beyond the {nb} bins")))?;
+        *c += 1;
+    }
+    if offsets[0] != 0 {
+        return Err(invalid(format!("offsets[0] = {} (0 expected)", offsets[0])));
+    }
+    for b in 0..nb {
+        if offsets[b + 1].checked_sub(offsets[b]) != Some(counts[b]) {
+            return Err(invalid(format!(
+                "offsets[{}] − offsets[{b}] is not bin {b}'s texel count {}",
+                b + 1,
+                counts[b]
+            )));
+        }
+    }
+    let mut seen = vec![false; inverse.len()];
+    for b in 0..nb {
+        let (start, end) = (offsets[b] as usize, offsets[b + 1] as usize);
+        for (i, &k) in (start..).zip(&inverse[start..end]) {
+            let k = k as usize;
+            if k >= seen.len() || seen[k] || bin_map[k] as usize != b {
+                return Err(invalid(format!(
+                    "inverse[{i}] = {k} is out of range, repeated, or not a texel of bin {b}"
+                )));
+            }
+            seen[k] = true;
+        }
+    }
+    Ok(())
+}
+
+/// The forest is exactly the builder's layout (see forest.rs): bins in order, each list longer than
+/// `leaf` has a tree at the current end of the array, nodes in pre-order (a left child that is internal
+/// follows its parent, the stored right-child index is where the left subtree ends), mids within the
+/// node's range, and every texel on the side of the split the builder puts it. (With 𝓑⁻¹ a permutation,
+/// this puts every node's texels inside its region.) Cost O(texels × depth), no allocation.
+fn check_forest(
+    inverse: &[u32],
+    offsets: &[u32],
+    roots: &[u32],
+    nodes: &[u32],
+    size: [usize; 2],
+    leaf: usize,
+) -> Result<()> {
+    let f = Forest {
+        inverse,
+        nodes,
+        width: size[0] as u32,
+        leaf,
+    };
+    let mut cursor = 0usize;
+    for b in 0..roots.len() {
+        let (start, end) = (offsets[b] as usize, offsets[b + 1] as usize);
+        let expected_root = if end - start > leaf {
+            cursor as u32
+        } else {
+            NO_TREE
+        };
+        if roots[b] != expected_root {
+            return Err(invalid(format!(
+                "roots[{b}] = {} where the forest layout needs {expected_root}",
+                roots[b]
+            )));
+        }
+        f.node(
+            b,
+            start,
+            end,
+            [0, 0, size[0] as u32, size[1] as u32],
+            &mut cursor,
+        )?;
+    }
+    if cursor != nodes.len() {
+        return Err(invalid(format!(
+            "the forest holds {} values but its trees use {cursor}",
+            nodes.len()
+        )));
+    }
+    Ok(())
+}
+
+struct Forest<'a> {
+    inverse: &'a [u32],
+    nodes: &'a [u32],
+    width: u32,
+    leaf: usize,
+}
+
+impl Forest<'_> {
+    /// Checks the (sub)tree of the range [s, e) with region [x0, y0, x1, y1] whose first internal node
+    /// must sit at `cursor`; advances `cursor` past it. Depth ≤ 2 + log₂ of the sides (regions halve).
+    fn node(
+        &self,
+        b: usize,
+        s: usize,
+        e: usize,
+        region: [u32; 4],
+        cursor: &mut usize,
+    ) -> Result<()> {
+        if e - s <= self.leaf {
+            return Ok(());
+        }
+        let [x0, y0, x1, y1] = region;
+        let at = *cursor;
+        if at + 2 > self.nodes.len() || (x1 - x0) as u64 * (y1 - y0) as u64 <= 1 {
+            return Err(invalid(format!(
+                "forest of bin {b}: the node at {at} is beyond the array or splits a region of one texel"
+            )));
+        }
+        let mid = self.nodes[at] as usize;
+        if !(s..=e).contains(&mid) {
+            return Err(invalid(format!(
+                "forest[{at}] = {mid} outside its node's range [{s}, {e}]"
+            )));
+        }
+        let along_x = x1 - x0 >= y1 - y0;
+        let split = if along_x {
+            x0 + (x1 - x0) / 2
+        } else {
+            y0 + (y1 - y0) / 2
+        };
+        let w = self.width;
+        let coord = |k: u32| if along_x { k % w } else { k / w };
+        if let Some(i) = (s..e).find(|&i| (coord(self.inverse[i]) < split) != (i < mid)) {
+            return Err(invalid(format!(
+                "forest of bin {b}: texel {} at inverse[{i}] is on the wrong side of its node's split",
+                self.inverse[i]
+            )));
+        }
+        let (left, right) = if along_x {
+            ([x0, y0, split, y1], [split, y0, x1, y1])
+        } else {
+            ([x0, y0, x1, split], [x0, split, x1, y1])
+        };
+        *cursor += 2;
+        self.node(b, s, mid, left, cursor)?;
+        if self.nodes[at + 1] as usize != *cursor {
+            return Err(invalid(format!(
+                "forest[{}] = {} links the right child where the left subtree ends, at {}",
+                at + 1,
+                self.nodes[at + 1],
+                *cursor
+            )));
+        }
+        self.node(b, mid, e, right, cursor)
+    }
+}

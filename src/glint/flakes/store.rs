@@ -1,0 +1,75 @@
+//! Saving and loading a built [`PositionNormalMap`] (format: docs/format.md, kind 3).
+//!
+//! Stored: the map size, the build parameters and the elements (slope and Jacobian, 24 bytes each).
+//! The slope boxes and their hierarchy are rebuilt on load by the same code as the build (O(elements)),
+//! so every query of a loaded map is bit-identical to the built one.
+
+use super::{PositionNormalMap, PositionNormalParams};
+use crate::Result;
+use crate::glint::MAX_SLOPE;
+use crate::glint::store::{self, Decoder, Kind};
+use std::io::{Read, Write};
+
+impl PositionNormalMap {
+    /// Writes the representation in the crate's binary format (docs/format.md): map size, parameters
+    /// and elements, exactly (f32 bits), 24 bytes per element. Writes in 64 KiB blocks.
+    ///
+    /// # Errors
+    /// [`crate::Error::Stream`] if the writer fails.
+    pub fn save(&self, w: &mut impl Write) -> Result<()> {
+        let p = &self.params;
+        store::save(w, Kind::PositionNormalMap, |e| {
+            e.len(self.width)?;
+            e.len(self.height)?;
+            e.len(p.sampling_rate)?;
+            e.put(p.sigma_r)?;
+            e.put(p.weight_sigmas)?;
+            e.put(p.slope_sigmas)?;
+            e.put(p.max_query_texels)?;
+            e.array(self.elements.iter().copied())
+        })
+    }
+
+    /// Reads a representation written by [`PositionNormalMap::save`]. Its patches answer `d`,
+    /// `lambda`, `projected_area`, `sample_visible` and `pdf_visible` bit-identically to the saved
+    /// one's.
+    ///
+    /// # Errors
+    /// [`crate::Error::BadMagic`], [`crate::Error::UnsupportedVersion`],
+    /// [`crate::Error::WrongModelKind`], [`crate::Error::Truncated`],
+    /// [`crate::Error::ChecksumMismatch`], [`crate::Error::Stream`]; [`crate::Error::InvalidFile`] for
+    /// parameters the builder refuses, a map size out of range, an element count that does not match
+    /// the grid, or elements that no build produces (non-finite, slopes beyond 2 · `MAX_SLOPE`,
+    /// Jacobian entries beyond 4 · `MAX_SLOPE` · rate).
+    pub fn load(r: &mut impl Read) -> Result<Self> {
+        let mut d = Decoder::open(r, Kind::PositionNormalMap)?;
+        let width = d.len("width", i32::MAX as usize)?;
+        let height = d.len("height", i32::MAX as usize)?;
+        let params = PositionNormalParams {
+            sampling_rate: d.len("sampling_rate", usize::MAX)?,
+            sigma_r: d.get("sigma_r")?,
+            weight_sigmas: d.get("weight_sigmas")?,
+            slope_sigmas: d.get("slope_sigmas")?,
+            max_query_texels: d.get("max_query_texels")?,
+        };
+        let refused = |e: crate::Error| store::invalid(format!("stored map refused: {e}"));
+        params.validate().map_err(refused)?;
+        crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))
+            .map_err(refused)?;
+        let [nx, ny] = super::element_grid(width, height, &params).map_err(refused)?;
+        let elements = d.array::<f32, 6>("elements", nx * ny)?;
+        d.finish()?;
+        // Built elements: interpolated slopes (≤ MAX_SLOPE up to rounding) and central differences of
+        // them over 1/rate texels (≤ 2 · MAX_SLOPE · rate); a factor 2 to spare on both.
+        let s = 2.0 * MAX_SLOPE;
+        let j = 4.0 * MAX_SLOPE * params.sampling_rate as f32;
+        store::check_range(
+            &elements,
+            "elements",
+            |c| {
+                if c < 2 { (-s, s) } else { (-j, j) }
+            },
+        )?;
+        PositionNormalMap::from_parts(width, height, params, elements).map_err(refused)
+    }
+}

@@ -1,0 +1,503 @@
+//! The binary file format of built glint maps (and of normal maps): primitives shared by every model.
+//!
+//! A file is a 24-byte header, a payload, and an 8-byte checksum, all little-endian:
+//!
+//! | offset | size | field |
+//! |---|---|---|
+//! | 0 | 8 | magic `BRDFGLNT` |
+//! | 8 | 4 | format version ([`VERSION`]) |
+//! | 12 | 4 | model kind ([`Kind`]) |
+//! | 16 | 8 | payload length P in bytes |
+//! | 24 | P | payload: the model's parameters, then its arrays, each preceded by its element count |
+//! | 24 + P | 8 | checksum ([`Checksum`]) of bytes [0, 24 + P) |
+//!
+//! The full description, payload by payload, is docs/format.md. The reader trusts nothing: every
+//! length is checked against the model's parameters and against what the declared payload can hold
+//! before anything is allocated, and arrays are read in bounded chunks, so a file that claims more
+//! than it holds fails with [`Error::Truncated`] having allocated at most about what it did hold.
+
+use crate::{Error, Result};
+use std::io::{Read, Write};
+
+/// The first 8 bytes of every file.
+pub(crate) const MAGIC: [u8; 8] = *b"BRDFGLNT";
+
+/// The format version written, and the only one read.
+pub(crate) const VERSION: u32 = 1;
+
+/// Bytes of the header (magic, version, kind, payload length).
+const HEADER_BYTES: usize = 24;
+
+/// Arrays are converted and hashed through a buffer of this many bytes (and grown by at most this
+/// much per read), so a lying length costs at most one chunk beyond the bytes actually present.
+const CHUNK_BYTES: usize = 1 << 16;
+
+/// The model stored in a file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Kind {
+    /// [`crate::glint::NormalMap`].
+    NormalMap = 1,
+    /// [`crate::glint::BeckmannMixture`].
+    BeckmannMixture = 2,
+    /// [`crate::glint::PositionNormalMap`].
+    PositionNormalMap = 3,
+    /// [`crate::glint::BinMap`].
+    BinMap = 4,
+}
+
+impl Kind {
+    fn name(code: u32) -> String {
+        match code {
+            1 => "NormalMap".into(),
+            2 => "BeckmannMixture".into(),
+            3 => "PositionNormalMap".into(),
+            4 => "BinMap".into(),
+            c => format!("unknown kind {c}"),
+        }
+    }
+}
+
+/// The file checksum: a 64-bit multiply-rotate hash over little-endian 64-bit words.
+///
+/// h₀ = 0xCBF2_9CE4_8422_2325; for each 8-byte word w (the last one zero-padded):
+/// h ← rotl₂₉((h ⊕ w) · 0x9E37_79B9_7F4A_7C15); then h ← h ⊕ (byte count) and the SplitMix64
+/// finaliser (h ⊕= h ≫ 30; h ·= 0xBF58_476D_1CE4_E5B9; h ⊕= h ≫ 27; h ·= 0x94D0_49BB_1331_11EB;
+/// h ⊕= h ≫ 31). Every step is a bijection of h for a fixed word, so any change of one word changes
+/// the result; it detects corruption, it is not a cryptographic signature. ~1 cycle per byte.
+#[derive(Clone, Debug)]
+pub(crate) struct Checksum {
+    state: u64,
+    pending: [u8; 8],
+    pending_len: usize,
+    total: u64,
+}
+
+impl Checksum {
+    const SEED: u64 = 0xCBF2_9CE4_8422_2325;
+    const MUL: u64 = 0x9E37_79B9_7F4A_7C15;
+
+    pub(crate) fn new() -> Checksum {
+        Checksum {
+            state: Self::SEED,
+            pending: [0; 8],
+            pending_len: 0,
+            total: 0,
+        }
+    }
+
+    #[inline]
+    fn word(&mut self, w: u64) {
+        self.state = (self.state ^ w).wrapping_mul(Self::MUL).rotate_left(29);
+    }
+
+    pub(crate) fn update(&mut self, mut bytes: &[u8]) {
+        self.total += bytes.len() as u64;
+        if self.pending_len > 0 {
+            let take = (8 - self.pending_len).min(bytes.len());
+            self.pending[self.pending_len..self.pending_len + take].copy_from_slice(&bytes[..take]);
+            self.pending_len += take;
+            bytes = &bytes[take..];
+            if self.pending_len < 8 {
+                return;
+            }
+            self.word(u64::from_le_bytes(self.pending));
+            self.pending_len = 0;
+        }
+        let mut words = bytes.chunks_exact(8);
+        for w in &mut words {
+            self.word(u64::from_le_bytes(w.try_into().unwrap_or([0; 8])));
+        }
+        let rest = words.remainder();
+        self.pending[..rest.len()].copy_from_slice(rest);
+        self.pending_len = rest.len();
+    }
+
+    pub(crate) fn finish(mut self) -> u64 {
+        if self.pending_len > 0 {
+            let mut last = [0u8; 8];
+            last[..self.pending_len].copy_from_slice(&self.pending[..self.pending_len]);
+            self.word(u64::from_le_bytes(last));
+        }
+        let mut h = self.state ^ self.total;
+        h ^= h >> 30;
+        h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        h ^= h >> 27;
+        h = h.wrapping_mul(0x94D0_49BB_1331_11EB);
+        h ^ (h >> 31)
+    }
+}
+
+/// The checksum of a byte string (what [`Checksum`] computes over a whole file but its last 8 bytes).
+#[cfg(test)]
+pub(crate) fn checksum(bytes: &[u8]) -> u64 {
+    let mut c = Checksum::new();
+    c.update(bytes);
+    c.finish()
+}
+
+fn stream(source: std::io::Error) -> Error {
+    Error::Stream { source }
+}
+
+/// A value that can be written to and read from a file as fixed-size little-endian bytes.
+pub(crate) trait Scalar: Copy {
+    const BYTES: usize;
+    fn put(self, out: &mut Vec<u8>);
+    fn get(b: &[u8]) -> Self;
+}
+
+macro_rules! scalar {
+    ($t:ty, $n:expr) => {
+        impl Scalar for $t {
+            const BYTES: usize = $n;
+            #[inline]
+            fn put(self, out: &mut Vec<u8>) {
+                out.extend_from_slice(&self.to_le_bytes());
+            }
+            #[inline]
+            fn get(b: &[u8]) -> Self {
+                let mut a = [0u8; $n];
+                a.copy_from_slice(&b[..$n]);
+                <$t>::from_le_bytes(a)
+            }
+        }
+    };
+}
+scalar!(u32, 4);
+scalar!(u64, 8);
+scalar!(f32, 4);
+scalar!(f64, 8);
+
+/// Writes one file: a counting pass (to put the payload length in the header) and a writing pass
+/// run the same `payload` function.
+pub(crate) struct Encoder<'a> {
+    out: Option<&'a mut dyn Write>,
+    sum: Checksum,
+    buf: Vec<u8>,
+    count: u64,
+}
+
+impl Encoder<'_> {
+    fn flush_buf(&mut self) -> Result<()> {
+        if let Some(w) = self.out.as_mut() {
+            self.sum.update(&self.buf);
+            w.write_all(&self.buf).map_err(stream)?;
+        }
+        self.buf.clear();
+        Ok(())
+    }
+
+    /// One scalar.
+    pub(crate) fn put<T: Scalar>(&mut self, v: T) -> Result<()> {
+        self.count += T::BYTES as u64;
+        if self.out.is_some() {
+            v.put(&mut self.buf);
+            if self.buf.len() >= CHUNK_BYTES {
+                self.flush_buf()?;
+            }
+        }
+        Ok(())
+    }
+
+    /// A `usize` as `u64`.
+    pub(crate) fn len(&mut self, n: usize) -> Result<()> {
+        self.put(n as u64)
+    }
+
+    /// An array of fixed-size records: its element count (u64), then the records' scalars in order.
+    pub(crate) fn array<T: Scalar, const N: usize>(
+        &mut self,
+        items: impl ExactSizeIterator<Item = [T; N]>,
+    ) -> Result<()> {
+        self.len(items.len())?;
+        self.count += (items.len() * N * T::BYTES) as u64;
+        if self.out.is_none() {
+            return Ok(());
+        }
+        for item in items {
+            for v in item {
+                v.put(&mut self.buf);
+            }
+            if self.buf.len() >= CHUNK_BYTES {
+                self.flush_buf()?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Writes a whole file of model `kind` whose payload `payload` writes (called twice: counting, then
+/// writing; it must write the same fields both times).
+pub(crate) fn save(
+    w: &mut dyn Write,
+    kind: Kind,
+    payload: impl Fn(&mut Encoder<'_>) -> Result<()>,
+) -> Result<()> {
+    let mut counter = Encoder {
+        out: None,
+        sum: Checksum::new(),
+        buf: Vec::new(),
+        count: 0,
+    };
+    payload(&mut counter)?;
+    let mut enc = Encoder {
+        out: Some(w),
+        sum: Checksum::new(),
+        buf: Vec::with_capacity(CHUNK_BYTES + 64),
+        count: 0,
+    };
+    enc.buf.extend_from_slice(&MAGIC);
+    enc.buf.extend_from_slice(&VERSION.to_le_bytes());
+    enc.buf.extend_from_slice(&(kind as u32).to_le_bytes());
+    enc.buf.extend_from_slice(&counter.count.to_le_bytes());
+    payload(&mut enc)?;
+    debug_assert_eq!(enc.count, counter.count);
+    enc.flush_buf()?;
+    let sum = std::mem::replace(&mut enc.sum, Checksum::new()).finish();
+    if let Some(w) = enc.out.as_mut() {
+        w.write_all(&sum.to_le_bytes()).map_err(stream)?;
+        w.flush().map_err(stream)?;
+    }
+    Ok(())
+}
+
+/// Reads one file: header checked on creation, fields in order, checksum checked by
+/// [`Decoder::finish`].
+pub(crate) struct Decoder<'a> {
+    r: &'a mut dyn Read,
+    sum: Checksum,
+    /// Payload bytes not read yet (as declared by the header).
+    remaining: u64,
+}
+
+impl<'a> Decoder<'a> {
+    /// Reads and checks the header: magic, version, kind.
+    ///
+    /// # Errors
+    /// [`Error::Truncated`], [`Error::BadMagic`], [`Error::UnsupportedVersion`],
+    /// [`Error::WrongModelKind`], [`Error::Stream`].
+    pub(crate) fn open(r: &'a mut dyn Read, expected: Kind) -> Result<Decoder<'a>> {
+        let mut head = [0u8; HEADER_BYTES];
+        read_exact(r, &mut head, "the header")?;
+        let mut magic = [0u8; 8];
+        magic.copy_from_slice(&head[..8]);
+        if magic != MAGIC {
+            return Err(Error::BadMagic { found: magic });
+        }
+        let version = u32::get(&head[8..]);
+        if version != VERSION {
+            return Err(Error::UnsupportedVersion {
+                found: version,
+                supported: VERSION,
+            });
+        }
+        let kind = u32::get(&head[12..]);
+        if kind != expected as u32 {
+            return Err(Error::WrongModelKind {
+                expected: Kind::name(expected as u32),
+                found: Kind::name(kind),
+            });
+        }
+        let mut sum = Checksum::new();
+        sum.update(&head);
+        Ok(Decoder {
+            r,
+            sum,
+            remaining: u64::get(&head[16..]),
+        })
+    }
+
+    fn take(&mut self, n: usize, what: &'static str) -> Result<()> {
+        if (n as u64) > self.remaining {
+            return Err(Error::InvalidFile {
+                reason: format!(
+                    "{what} needs {n} more bytes but the header declares only {} left in the payload",
+                    self.remaining
+                ),
+            });
+        }
+        self.remaining -= n as u64;
+        Ok(())
+    }
+
+    /// One scalar.
+    pub(crate) fn get<T: Scalar>(&mut self, what: &'static str) -> Result<T> {
+        self.take(T::BYTES, what)?;
+        let mut b = [0u8; 8];
+        read_exact(self.r, &mut b[..T::BYTES], what)?;
+        self.sum.update(&b[..T::BYTES]);
+        Ok(T::get(&b))
+    }
+
+    /// A count stored as u64, which must fit a `usize` and not exceed `max`.
+    pub(crate) fn len(&mut self, what: &'static str, max: usize) -> Result<usize> {
+        let n: u64 = self.get(what)?;
+        match usize::try_from(n) {
+            Ok(n) if n <= max => Ok(n),
+            _ => Err(Error::InvalidFile {
+                reason: format!("{what} = {n} exceeds the limit {max}"),
+            }),
+        }
+    }
+
+    /// An array written by [`Encoder::array`] whose element count must equal `expected` (derived
+    /// from the parameters already read). The count is checked against `expected` and against the
+    /// declared payload before anything is allocated; records are read in chunks.
+    pub(crate) fn array<T: Scalar + Default, const N: usize>(
+        &mut self,
+        what: &'static str,
+        expected: usize,
+    ) -> Result<Vec<[T; N]>> {
+        let n: u64 = self.get(what)?;
+        if n != expected as u64 {
+            return Err(Error::InvalidFile {
+                reason: format!(
+                    "{what} holds {n} elements but the parameters read so far need {expected}"
+                ),
+            });
+        }
+        self.records(what, expected)
+    }
+
+    /// An array written by [`Encoder::array`] whose element count is free up to `max` (checked, as
+    /// everything else, before allocating).
+    pub(crate) fn array_up_to<T: Scalar + Default, const N: usize>(
+        &mut self,
+        what: &'static str,
+        max: usize,
+    ) -> Result<Vec<[T; N]>> {
+        let n = self.len(what, max)?;
+        self.records(what, n)
+    }
+
+    fn records<T: Scalar + Default, const N: usize>(
+        &mut self,
+        what: &'static str,
+        expected: usize,
+    ) -> Result<Vec<[T; N]>> {
+        let record = N * T::BYTES;
+        let bytes = expected
+            .checked_mul(record)
+            .ok_or_else(|| Error::InvalidFile {
+                reason: format!("{what}: {expected} elements overflow the address space"),
+            })?;
+        self.take(bytes, what)?;
+        let per_chunk = (CHUNK_BYTES / record).max(1);
+        let mut out: Vec<[T; N]> = Vec::with_capacity(expected.min(per_chunk));
+        let mut buf = vec![0u8; per_chunk * record];
+        let mut left = expected;
+        while left > 0 {
+            let k = left.min(per_chunk);
+            let chunk = &mut buf[..k * record];
+            read_exact(self.r, chunk, what)?;
+            self.sum.update(chunk);
+            out.extend(chunk.chunks_exact(record).map(|rec| {
+                std::array::from_fn(|i| T::get(&rec[i * T::BYTES..(i + 1) * T::BYTES]))
+            }));
+            left -= k;
+        }
+        Ok(out)
+    }
+
+    /// Checks that the payload was read exactly and that the checksum matches.
+    ///
+    /// # Errors
+    /// [`Error::InvalidFile`] if payload bytes are left over, [`Error::Truncated`] if the checksum is
+    /// missing, [`Error::ChecksumMismatch`].
+    pub(crate) fn finish(self) -> Result<()> {
+        if self.remaining != 0 {
+            return Err(Error::InvalidFile {
+                reason: format!(
+                    "the header declares {} payload bytes more than the model's fields hold",
+                    self.remaining
+                ),
+            });
+        }
+        let mut b = [0u8; 8];
+        read_exact(self.r, &mut b, "the checksum")?;
+        let stored = u64::from_le_bytes(b);
+        let computed = self.sum.finish();
+        if stored != computed {
+            return Err(Error::ChecksumMismatch { stored, computed });
+        }
+        Ok(())
+    }
+}
+
+fn read_exact(r: &mut dyn Read, buf: &mut [u8], what: &'static str) -> Result<()> {
+    r.read_exact(buf).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::UnexpectedEof {
+            Error::Truncated { what }
+        } else {
+            stream(e)
+        }
+    })
+}
+
+/// An [`Error::InvalidFile`] with a formatted reason.
+pub(crate) fn invalid(reason: String) -> Error {
+    Error::InvalidFile { reason }
+}
+
+/// Checks that every value is finite and within [lo, hi]; `what` names the array in the error.
+pub(crate) fn check_range<const N: usize>(
+    items: &[[f32; N]],
+    what: &str,
+    bound: impl Fn(usize) -> (f32, f32),
+) -> Result<()> {
+    for (k, item) in items.iter().enumerate() {
+        for (c, &v) in item.iter().enumerate() {
+            let (lo, hi) = bound(c);
+            if !(v >= lo && v <= hi) {
+                return Err(invalid(format!(
+                    "{what}[{k}][{c}] = {v} is outside [{lo}, {hi}] (or not finite)"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checksum_is_independent_of_chunking() {
+        let data: Vec<u8> = (0..1000u32).map(|k| (k * 7 + 3) as u8).collect();
+        let whole = checksum(&data);
+        for split in [1, 3, 7, 8, 9, 500, 999] {
+            let mut c = Checksum::new();
+            for part in data.chunks(split) {
+                c.update(part);
+            }
+            assert_eq!(c.finish(), whole, "chunks of {split}");
+        }
+        // Any single flipped bit, and an appended zero byte, change it.
+        for bit in [0usize, 7, 63, 64, 4000, 7999] {
+            let mut d = data.clone();
+            d[bit / 8] ^= 1 << (bit % 8);
+            assert_ne!(checksum(&d), whole, "bit {bit}");
+        }
+        let mut d = data.clone();
+        d.push(0);
+        assert_ne!(checksum(&d), whole);
+    }
+
+    /// The reference value of the documented algorithm, computed by hand-written steps here.
+    #[test]
+    fn checksum_matches_the_documented_steps() {
+        let bytes = b"BRDFGLNT\x01";
+        let mut h: u64 = 0xCBF2_9CE4_8422_2325;
+        for w in [u64::from_le_bytes(*b"BRDFGLNT"), 1u64] {
+            h = (h ^ w).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(29);
+        }
+        h ^= 9;
+        h ^= h >> 30;
+        h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        h ^= h >> 27;
+        h = h.wrapping_mul(0x94D0_49BB_1331_11EB);
+        h ^= h >> 31;
+        assert_eq!(checksum(bytes), h);
+    }
+}

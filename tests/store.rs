@@ -1,0 +1,616 @@
+//! Saving and loading built glint maps and normal maps (docs/format.md): exact round trips (every query
+//! of a loaded model bit-identical to the built one) and a clear `Err` for every class of bad file.
+//!
+//! The checksum used to forge files with valid checksums is written here from the format's
+//! documentation, independently of the crate's code (a mismatch would fail the forged-file tests).
+
+mod support;
+
+use brdf::glint::{
+    BeckmannMixture, BinLookup, BinMap, BinMapParams, Footprint, GlintNdf, MaskingMode,
+    MixtureParams, NormalMap, PatchOptions, PositionNormalMap, PositionNormalParams,
+};
+use brdf::ndf::Ndf;
+use brdf::{Error, Vec2, Vec3};
+
+/// The documented checksum (docs/format.md).
+fn doc_checksum(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xCBF2_9CE4_8422_2325;
+    for chunk in bytes.chunks(8) {
+        let mut w = [0u8; 8];
+        w[..chunk.len()].copy_from_slice(chunk);
+        h = (h ^ u64::from_le_bytes(w))
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .rotate_left(29);
+    }
+    h ^= bytes.len() as u64;
+    h ^= h >> 30;
+    h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    h ^= h >> 27;
+    h = h.wrapping_mul(0x94D0_49BB_1331_11EB);
+    h ^ (h >> 31)
+}
+
+/// Replaces the last 8 bytes of a file by the checksum of the others.
+fn reseal(mut file: Vec<u8>) -> Vec<u8> {
+    let n = file.len() - 8;
+    let sum = doc_checksum(&file[..n]);
+    file[n..].copy_from_slice(&sum.to_le_bytes());
+    file
+}
+
+/// White-noise slopes in [−0.6, 0.6]²: every lobe and element different.
+fn map(n: usize) -> NormalMap {
+    use rand::RngExt;
+    let mut rng = support::rng(n as u64);
+    let slopes = (0..n * n)
+        .map(|_| Vec2::new(rng.random_range(-0.6..0.6), rng.random_range(-0.6..0.6)))
+        .collect();
+    NormalMap::from_slopes(n, n, slopes).unwrap()
+}
+
+/// Directions for the queries: normal incidence, moderate, grazing, below the horizon.
+fn dirs() -> Vec<Vec3> {
+    let mut v = Vec::new();
+    for th in [0.0, 30.0, 60.0, 85.0, 89.9] {
+        for ph in [0.0, 75.0, 200.0] {
+            v.push(support::dir(th, ph));
+        }
+    }
+    v.push(Vec3::new(0.3, 0.1, -0.9).normalize());
+    v
+}
+
+/// Asserts that two patches answer every query with the same bits.
+fn assert_same_patch(a: &impl Ndf, b: &impl Ndf, what: &str) {
+    let ds = dirs();
+    let us = [
+        Vec2::new(0.1, 0.2),
+        Vec2::new(0.5, 0.5),
+        Vec2::new(0.93, 0.07),
+    ];
+    for &w in &ds {
+        assert_eq!(a.d(w).to_bits(), b.d(w).to_bits(), "{what}: d({w})");
+        assert_eq!(
+            a.lambda(w).to_bits(),
+            b.lambda(w).to_bits(),
+            "{what}: lambda({w})"
+        );
+        assert_eq!(
+            a.projected_area(w).to_bits(),
+            b.projected_area(w).to_bits(),
+            "{what}: A({w})"
+        );
+        for &u in &us {
+            let (ma, mb) = (a.sample_visible(w, u), b.sample_visible(w, u));
+            assert_eq!(
+                ma.to_array().map(f32::to_bits),
+                mb.to_array().map(f32::to_bits)
+            );
+            assert_eq!(a.sample_normal(u), b.sample_normal(u), "{what}");
+            for &m in &[ma, Vec3::Z] {
+                assert_eq!(
+                    a.pdf_visible(w, m).to_bits(),
+                    b.pdf_visible(w, m).to_bits(),
+                    "{what}: pdf_visible({w}, {m})"
+                );
+            }
+        }
+    }
+}
+
+/// Footprints from sub-texel to most of the map, isotropic and anisotropic, at several centres.
+fn footprints(n: usize) -> Vec<Footprint> {
+    let mut f = Vec::new();
+    for (k, area) in [0.5f32, 4.0, 64.0, 900.0].into_iter().enumerate() {
+        let c = Vec2::new(3.3 + 7.1 * k as f32, 11.7 + 2.9 * k as f32);
+        f.push(Footprint::isotropic_texels(c, area, n, n));
+        f.push(Footprint::anisotropic_texels(c, area, 4.0, 0.6, n, n));
+    }
+    f
+}
+
+fn saved(save: impl FnOnce(&mut Vec<u8>) -> brdf::Result<()>) -> Vec<u8> {
+    let mut v = Vec::new();
+    save(&mut v).unwrap();
+    v
+}
+
+#[test]
+fn normal_map_round_trip_is_exact() {
+    let m = map(24);
+    let file = saved(|w| m.save(w));
+    // 24-byte header + width, height, count (8 each) + 8 bytes per texel + checksum.
+    assert_eq!(file.len(), 24 + 24 + 8 * 24 * 24 + 8);
+    let back = NormalMap::load_binary(&mut file.as_slice()).unwrap();
+    assert_eq!((back.width(), back.height()), (24, 24));
+    let bits = |m: &NormalMap| -> Vec<[u32; 2]> {
+        m.slopes()
+            .iter()
+            .map(|s| s.to_array().map(f32::to_bits))
+            .collect()
+    };
+    assert_eq!(bits(&m), bits(&back));
+    let p = Vec2::new(0.37, 0.81);
+    assert_eq!(m.normal_at(p), back.normal_at(p));
+    assert_eq!(
+        m.filtered_moments(p * 24.0, 3.0),
+        back.filtered_moments(p * 24.0, 3.0)
+    );
+}
+
+#[test]
+fn mixture_round_trip_is_exact() {
+    let n = 32;
+    let m = map(n);
+    for (masking, lod) in [
+        (MaskingMode::Exact, f32::INFINITY),
+        (MaskingMode::Approximate, 64.0),
+    ] {
+        let params = MixtureParams {
+            samples: 32,
+            patch: PatchOptions {
+                masking,
+                lod_lobes: lod,
+            },
+            ..MixtureParams::default()
+        };
+        let built = BeckmannMixture::build(&m, params).unwrap();
+        let file = saved(|w| built.save(w));
+        let loaded = BeckmannMixture::load(&mut file.as_slice()).unwrap();
+        assert_eq!(loaded.params(), built.params());
+        assert_eq!(loaded.memory(), built.memory());
+        for (k, f) in footprints(n).iter().enumerate() {
+            assert_same_patch(
+                &built.patch(f),
+                &loaded.patch(f),
+                &format!("{masking:?} fp {k}"),
+            );
+        }
+        // Saving the loaded model gives the same bytes.
+        assert_eq!(saved(|w| loaded.save(w)), file);
+    }
+}
+
+#[test]
+fn position_normal_round_trip_is_exact() {
+    let n = 24;
+    let m = map(n);
+    for rate in [1, 2] {
+        let params = PositionNormalParams {
+            sampling_rate: rate,
+            ..PositionNormalParams::default()
+        };
+        let built = PositionNormalMap::build(&m, params).unwrap();
+        let file = saved(|w| built.save(w));
+        let loaded = PositionNormalMap::load(&mut file.as_slice()).unwrap();
+        assert_eq!(loaded.params(), built.params());
+        assert_eq!(loaded.memory(), built.memory());
+        for (k, f) in footprints(n).iter().enumerate() {
+            assert_same_patch(
+                &built.patch(f),
+                &loaded.patch(f),
+                &format!("rate {rate} fp {k}"),
+            );
+        }
+        assert_eq!(saved(|w| loaded.save(w)), file);
+    }
+}
+
+#[test]
+fn bin_map_round_trip_is_exact() {
+    let n = 48;
+    let m = map(n);
+    for (bins, leaf, lookup) in [(31, 4, BinLookup::Dense), (15, 1, BinLookup::Hash)] {
+        let params = BinMapParams {
+            bins_per_axis: bins,
+            leaf_size: leaf,
+            lookup,
+            ..BinMapParams::default()
+        };
+        let built = BinMap::build(&m, params).unwrap();
+        assert!(!built.forest().is_empty(), "the test needs trees");
+        let file = saved(|w| built.save(w));
+        let loaded = BinMap::load(&mut file.as_slice()).unwrap();
+        assert_eq!(loaded.params(), built.params());
+        assert_eq!(loaded.memory(), built.memory());
+        assert_eq!(loaded.inverse_bin_map(), built.inverse_bin_map());
+        assert_eq!(loaded.forest(), built.forest());
+        for (k, f) in footprints(n).iter().enumerate() {
+            let what = format!("{lookup:?} fp {k}");
+            assert_same_patch(&built.patch(f), &loaded.patch(f), &what);
+            assert_same_patch(
+                &built.patch_smoothed(f, 0.1),
+                &loaded.patch_smoothed(f, 0.1),
+                &what,
+            );
+        }
+        assert_eq!(saved(|w| loaded.save(w)), file);
+    }
+}
+
+/// Offsets in a bin-map file: width 24, height 32, bins 40, leaf 48, lookup 56, σ 60, 𝓑 count 64,
+/// 𝓑 72.., then 𝓑⁻¹ (count, data), offsets, roots, forest, moments.
+#[test]
+fn inconsistent_bin_maps_are_errors() {
+    let n = 16;
+    let params = BinMapParams {
+        bins_per_axis: 5,
+        leaf_size: 2,
+        ..BinMapParams::default()
+    };
+    let built = BinMap::build(&map(n), params).unwrap();
+    let file = saved(|w| built.save(w));
+    let texels = n * n;
+    let bin_map_at = 72;
+    let inverse_at = bin_map_at + 4 * texels + 8;
+    let offsets_at = inverse_at + 4 * texels + 8;
+    let roots_at = offsets_at + 4 * 26 + 8;
+    let forest_at = roots_at + 4 * 25 + 8;
+    let forest_len =
+        u64::from_le_bytes(file[forest_at - 8..forest_at].try_into().unwrap()) as usize;
+    assert_eq!(forest_len, built.forest().len(), "layout of the test");
+    let u32_at = |f: &[u8], at: usize| u32::from_le_bytes(f[at..at + 4].try_into().unwrap());
+    let with = |at: usize, v: u32| {
+        let mut f = file.clone();
+        f[at..at + 4].copy_from_slice(&v.to_le_bytes());
+        reseal(f)
+    };
+    let swap = |a: usize, b: usize| {
+        let mut f = file.clone();
+        for k in 0..4 {
+            f.swap(a + k, b + k);
+        }
+        reseal(f)
+    };
+    // Two texels of the same bin list swapped: still a permutation with the right bins, but the
+    // forest's split no longer holds (the first tree's root splits x at 8: find a left and a right
+    // texel of its list).
+    let root_bin = (0..25)
+        .find(|&b| built.bin_range(b).is_some_and(|r| r.2.is_some()))
+        .unwrap();
+    let (s, e, _) = built.bin_range(root_bin).unwrap();
+    let mid = built.forest()[0] as usize;
+    assert!(s < mid && mid < e);
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("bin beyond B", with(bin_map_at, 25), "bin_map[0]"),
+        (
+            "offsets not the counts",
+            with(offsets_at + 4, u32_at(&file, offsets_at + 4) + 1),
+            "offsets",
+        ),
+        (
+            "inverse not a permutation",
+            with(inverse_at + 4, u32_at(&file, inverse_at)),
+            "inverse",
+        ),
+        (
+            "texel on the wrong side",
+            swap(inverse_at + 4 * s, inverse_at + 4 * (e - 1)),
+            "wrong side",
+        ),
+        (
+            "root not at the layout's place",
+            with(roots_at + 4 * root_bin, 2),
+            "roots",
+        ),
+        (
+            "mid outside the range",
+            with(forest_at, (e + 1) as u32),
+            "outside",
+        ),
+        ("right link broken", with(forest_at + 4, 0), "right child"),
+    ];
+    for (name, f, needle) in cases {
+        let e = BinMap::load(&mut f.as_slice()).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidFile { .. }) && e.to_string().contains(needle),
+            "{name}: {e}"
+        );
+    }
+}
+
+fn small_mixture_file() -> Vec<u8> {
+    let params = MixtureParams {
+        samples: 8,
+        ..MixtureParams::default()
+    };
+    let built = BeckmannMixture::build(&map(6), params).unwrap();
+    saved(|w| built.save(w))
+}
+
+fn load_mixture(bytes: &[u8]) -> brdf::Result<BeckmannMixture> {
+    BeckmannMixture::load(&mut &bytes[..])
+}
+
+#[test]
+fn every_truncation_is_an_error() {
+    for (kind, file, load) in small_files() {
+        for cut in 0..file.len() {
+            let e = load(&file[..cut]).unwrap_err();
+            assert!(
+                matches!(e, Error::Truncated { .. }),
+                "{kind}: cut at {cut}: {e}"
+            );
+        }
+    }
+}
+
+/// A small file of every kind, with its loader.
+#[allow(clippy::type_complexity)]
+fn small_files() -> Vec<(&'static str, Vec<u8>, fn(&[u8]) -> brdf::Result<()>)> {
+    let m = map(6);
+    let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
+    let bm_params = BinMapParams {
+        bins_per_axis: 3,
+        leaf_size: 2,
+        ..BinMapParams::default()
+    };
+    let bm = BinMap::build(&m, bm_params).unwrap();
+    vec![
+        ("mixture", small_mixture_file(), |b| {
+            load_mixture(b).map(drop)
+        }),
+        ("normal map", saved(|w| m.save(w)), |b| {
+            NormalMap::load_binary(&mut &b[..]).map(drop)
+        }),
+        ("position-normal", saved(|w| pn.save(w)), |b| {
+            PositionNormalMap::load(&mut &b[..]).map(drop)
+        }),
+        ("bin map", saved(|w| bm.save(w)), |b| {
+            BinMap::load(&mut &b[..]).map(drop)
+        }),
+    ]
+}
+
+#[test]
+fn every_flipped_byte_is_an_error() {
+    for (kind, file, load) in small_files() {
+        assert!(load(&file).is_ok(), "{kind}");
+        for k in 0..file.len() {
+            for mask in [0x01u8, 0x80, 0xFF] {
+                let mut f = file.clone();
+                f[k] ^= mask;
+                let e = load(&f).unwrap_err();
+                let expected = match k {
+                    0..8 => matches!(e, Error::BadMagic { .. }),
+                    8..12 => matches!(e, Error::UnsupportedVersion { .. }),
+                    12..16 => matches!(e, Error::WrongModelKind { .. }),
+                    // The payload length: too long leaves bytes over or runs out; too short cuts a
+                    // field.
+                    16..24 => matches!(e, Error::InvalidFile { .. } | Error::Truncated { .. }),
+                    // Parameters and counts may be refused before the checksum is read (or, for a
+                    // count, run out of data); data are caught by the checksum.
+                    _ => matches!(
+                        e,
+                        Error::InvalidFile { .. }
+                            | Error::ChecksumMismatch { .. }
+                            | Error::Truncated { .. }
+                    ),
+                };
+                assert!(expected, "{kind}: byte {k} ^ {mask:#x}: {e}");
+            }
+        }
+    }
+}
+
+#[test]
+fn header_errors_name_what_is_wrong() {
+    let file = small_mixture_file();
+    let mut f = file.clone();
+    f[..8].copy_from_slice(b"NOTGLINT");
+    let e = load_mixture(&f).unwrap_err();
+    assert!(e.to_string().contains("BRDFGLNT"), "{e}");
+    let mut f = file.clone();
+    f[8..12].copy_from_slice(&2u32.to_le_bytes());
+    let e = load_mixture(&reseal(f)).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::UnsupportedVersion {
+                found: 2,
+                supported: 1
+            }
+        ),
+        "{e}"
+    );
+    // A mixture file handed to the other loaders.
+    let e = PositionNormalMap::load(&mut file.as_slice()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(e, Error::WrongModelKind { .. })
+            && msg.contains("BeckmannMixture")
+            && msg.contains("PositionNormalMap"),
+        "{msg}"
+    );
+    assert!(matches!(
+        NormalMap::load_binary(&mut file.as_slice()),
+        Err(Error::WrongModelKind { .. })
+    ));
+    // A good file with trailing bytes after the checksum: read exactly, the rest left to the caller.
+    let mut f = file.clone();
+    f.extend_from_slice(b"next");
+    let mut r = f.as_slice();
+    assert!(BeckmannMixture::load(&mut r).is_ok());
+    assert_eq!(r, b"next");
+}
+
+/// Offsets in a mixture file (docs/format.md): header 24, width 24, height 32, spacing 40,
+/// sigma_min 44, samples 48, kernel_sigmas 56, weight_sigmas 60, slope_tail 64, masking 68,
+/// lod_lobes 72, lobe count 76, lobes 84.
+mod at {
+    pub const WIDTH: usize = 24;
+    pub const SPACING: usize = 40;
+    pub const MASKING: usize = 68;
+    pub const LOBE_COUNT: usize = 76;
+    pub const LOBES: usize = 84;
+}
+
+#[test]
+fn inconsistent_contents_with_valid_checksums_are_errors() {
+    let file = small_mixture_file();
+    let set =
+        |f: &mut Vec<u8>, at: usize, bytes: &[u8]| f[at..at + bytes.len()].copy_from_slice(bytes);
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        (
+            "lobe count off by one",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::LOBE_COUNT, &35u64.to_le_bytes());
+                f
+            },
+            "lobes",
+        ),
+        (
+            "width changes the grid",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::WIDTH, &7u64.to_le_bytes());
+                f
+            },
+            "lobes",
+        ),
+        (
+            "zero width",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::WIDTH, &0u64.to_le_bytes());
+                f
+            },
+            "map size",
+        ),
+        (
+            "spacing below MIN_SPACING",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::SPACING, &0.01f32.to_le_bytes());
+                f
+            },
+            "spacing",
+        ),
+        (
+            "unknown masking mode",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::MASKING, &7u32.to_le_bytes());
+                f
+            },
+            "masking",
+        ),
+        (
+            "NaN moment",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::LOBES + 8, &f32::NAN.to_le_bytes());
+                f
+            },
+            "lobes[0][2]",
+        ),
+        (
+            "negative second moment",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::LOBES + 20 * 3 + 12, &(-1.0f32).to_le_bytes());
+                f
+            },
+            "lobes[3][3]",
+        ),
+        (
+            "huge mean",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::LOBES, &1e30f32.to_le_bytes());
+                f
+            },
+            "lobes[0][0]",
+        ),
+    ];
+    for (name, f, needle) in cases {
+        let e = load_mixture(&reseal(f)).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidFile { .. }) && e.to_string().contains(needle),
+            "{name}: {e}"
+        );
+    }
+    // The payload length declaring more than the fields hold.
+    let mut f = file.clone();
+    let declared = u64::from_le_bytes(f[16..24].try_into().unwrap());
+    f[16..24].copy_from_slice(&(declared + 8).to_le_bytes());
+    let n = f.len() - 8;
+    f.splice(n..n, [0u8; 8]);
+    let e = load_mixture(&reseal(f)).unwrap_err();
+    assert!(
+        matches!(e, Error::InvalidFile { .. }) && e.to_string().contains("payload"),
+        "{e}"
+    );
+}
+
+#[test]
+fn sizes_beyond_the_file_are_refused_before_allocating() {
+    // A 40000² map (1.6·10⁹ lobes, 32 GB) declared in a file of a few hundred bytes: refused from the
+    // declared payload length before any allocation (the allocation-bound test is tests/store_limits.rs).
+    let mut f = small_mixture_file();
+    f[at::WIDTH..at::WIDTH + 8].copy_from_slice(&40000u64.to_le_bytes());
+    f[at::WIDTH + 8..at::WIDTH + 16].copy_from_slice(&40000u64.to_le_bytes());
+    f[at::LOBE_COUNT..at::LOBE_COUNT + 8].copy_from_slice(&1_600_000_000u64.to_le_bytes());
+    let e = load_mixture(&reseal(f.clone())).unwrap_err();
+    assert!(e.to_string().contains("declares only"), "{e}");
+    // The same with a payload length that claims it all: the data run out (Truncated).
+    f[16..24].copy_from_slice(&(60 + 32_000_000_000u64).to_le_bytes());
+    let e = load_mixture(&reseal(f)).unwrap_err();
+    assert!(matches!(e, Error::Truncated { what: "lobes" }), "{e}");
+    // A normal map of 2^31 × 2^31 texels: beyond the size limit.
+    let mut nm = saved(|w| map(2).save(w));
+    nm[24..32].copy_from_slice(&(1u64 << 31).to_le_bytes());
+    let e = NormalMap::load_binary(&mut &reseal(nm)[..]).unwrap_err();
+    assert!(e.to_string().contains("width"), "{e}");
+}
+
+/// Writes the seed files of the store fuzz targets (small valid files of each kind):
+/// `cargo test --test store write_fuzz_seeds -- --ignored`.
+#[test]
+#[ignore]
+fn write_fuzz_seeds() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds");
+    let write = |dir: &str, name: &str, bytes: Vec<u8>| {
+        let d = root.join(dir);
+        std::fs::create_dir_all(&d).unwrap();
+        // The store targets read a flag byte, a footprint and a probe before the file: prefix zeros.
+        let mut input = vec![0u8; 1 + 6 * 4 + 9 * 4];
+        input.extend(bytes);
+        std::fs::write(d.join(name), input).unwrap();
+    };
+    for n in [1usize, 3] {
+        let m = map(n);
+        write("store_normal_map", &format!("map{n}"), saved(|w| m.save(w)));
+        let params = MixtureParams {
+            samples: 4,
+            ..MixtureParams::default()
+        };
+        let mx = BeckmannMixture::build(&m, params).unwrap();
+        write(
+            "store_mixture",
+            &format!("mixture{n}"),
+            saved(|w| mx.save(w)),
+        );
+        let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
+        write(
+            "store_position_normal",
+            &format!("pn{n}"),
+            saved(|w| pn.save(w)),
+        );
+        for (bins, leaf) in [(3, 1), (7, 2)] {
+            let params = BinMapParams {
+                bins_per_axis: bins,
+                leaf_size: leaf,
+                ..BinMapParams::default()
+            };
+            let bm = BinMap::build(&map(n + 3), params).unwrap();
+            write(
+                "store_binmap",
+                &format!("bm{n}_{bins}"),
+                saved(|w| bm.save(w)),
+            );
+        }
+    }
+}

@@ -1,0 +1,105 @@
+//! A file that declares far more data than it holds costs at most about what it holds: the loaders
+//! allocate as data arrive (64 KiB steps), never from the declared sizes.
+//!
+//! Its own test binary because it measures the heap with a counting global allocator (one test, so
+//! no other thread allocates meanwhile).
+
+use brdf::Error;
+use brdf::glint::{BeckmannMixture, MixtureParams, NormalMap};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+static CURRENT: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            let now = CURRENT.fetch_add(layout.size(), Ordering::SeqCst) + layout.size();
+            PEAK.fetch_max(now, Ordering::SeqCst);
+        }
+        p
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) };
+        CURRENT.fetch_sub(layout.size(), Ordering::SeqCst);
+    }
+}
+
+#[global_allocator]
+static A: Counting = Counting;
+
+/// The documented checksum (docs/format.md), as in tests/store.rs.
+fn reseal(mut file: Vec<u8>) -> Vec<u8> {
+    let n = file.len() - 8;
+    let mut h: u64 = 0xCBF2_9CE4_8422_2325;
+    for chunk in file[..n].chunks(8) {
+        let mut w = [0u8; 8];
+        w[..chunk.len()].copy_from_slice(chunk);
+        h = (h ^ u64::from_le_bytes(w))
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .rotate_left(29);
+    }
+    h ^= n as u64;
+    h ^= h >> 30;
+    h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    h ^= h >> 27;
+    h = h.wrapping_mul(0x94D0_49BB_1331_11EB);
+    h ^= h >> 31;
+    file[n..].copy_from_slice(&h.to_le_bytes());
+    file
+}
+
+/// Peak heap growth (bytes) while running `f`.
+fn peak_during<T>(f: impl FnOnce() -> T) -> (T, usize) {
+    let base = CURRENT.load(Ordering::SeqCst);
+    PEAK.store(base, Ordering::SeqCst);
+    let out = f();
+    (out, PEAK.load(Ordering::SeqCst) - base)
+}
+
+#[test]
+fn lying_sizes_allocate_no_more_than_the_file_holds() {
+    let map = NormalMap::from_slopes(4, 4, vec![brdf::Vec2::new(0.1, -0.2); 16]).unwrap();
+    let params = MixtureParams {
+        samples: 4,
+        ..MixtureParams::default()
+    };
+    let mut file = Vec::new();
+    BeckmannMixture::build(&map, params)
+        .unwrap()
+        .save(&mut file)
+        .unwrap();
+    // Declare a 40000² map (1.6·10⁹ lobes, 32 GB) and a payload that claims it all; keep 1 MiB of
+    // real lobe data (zeros are valid moments) so that the loader reads some before running out.
+    file[24..32].copy_from_slice(&40000u64.to_le_bytes());
+    file[32..40].copy_from_slice(&40000u64.to_le_bytes());
+    file[76..84].copy_from_slice(&1_600_000_000u64.to_le_bytes());
+    file[16..24].copy_from_slice(&(60 + 32_000_000_000u64).to_le_bytes());
+    file.truncate(84);
+    file.resize(84 + (1 << 20) + 8, 0);
+    let file = reseal(file);
+    let (r, peak) = peak_during(|| BeckmannMixture::load(&mut file.as_slice()));
+    assert!(
+        matches!(r, Err(Error::Truncated { what: "lobes" })),
+        "{r:?}"
+    );
+    // At most what was read (1 MiB) plus one 64 KiB chunk, times 2 for Vec's doubling growth.
+    assert!(
+        peak <= 2 * ((1 << 20) + (1 << 16)) + 4096,
+        "peak {peak} bytes"
+    );
+
+    // A normal map header declaring 2^30 × 2 texels (16 GiB of slopes) with nothing behind it.
+    let mut nm = Vec::new();
+    map.save(&mut nm).unwrap();
+    nm[24..32].copy_from_slice(&(1u64 << 30).to_le_bytes());
+    nm[32..40].copy_from_slice(&2u64.to_le_bytes());
+    nm[40..48].copy_from_slice(&(1u64 << 31).to_le_bytes());
+    nm[16..24].copy_from_slice(&(24 + (1u64 << 34)).to_le_bytes());
+    let (r, peak) = peak_during(|| NormalMap::load_binary(&mut reseal(nm).as_slice()));
+    assert!(matches!(r, Err(Error::Truncated { .. })), "{r:?}");
+    assert!(peak <= 4 * (1 << 16) + 4096, "peak {peak} bytes");
+}
