@@ -2,7 +2,7 @@
 //!
 //! Each iteration evaluates a batch of 1024 precomputed inputs (directions from a seeded RNG,
 //! cosine-distributed so that grazing angles appear as often as in a renderer), and criterion's
-//! `Throughput::Elements(1024)` reports the time per call. Every input passes through `black_box`
+//! `Throughput::Elements(1024)` reports the time per call. Every input component passes through `black_box` (`table::bb3`)
 //! and every result is stored to an output buffer (itself passed to `black_box`), so the figure is
 //! the throughput of independent calls, as in a renderer's loop over pixels, not the latency of a
 //! chain of additions into one accumulator (which capped the cheapest functions at one `f32` add
@@ -64,7 +64,7 @@ fn bench_ndf<N: Ndf>(c: &mut Criterion, family: &str, make: impl Fn(f32) -> N) {
             let mut out = vec![0.0f32; BATCH];
             b.iter(|| {
                 for (o, &m) in out.iter_mut().zip(&inp.m) {
-                    *o = ndf.d(black_box(m));
+                    *o = ndf.d(table::bb3(m));
                 }
                 black_box(&mut out);
             })
@@ -80,7 +80,7 @@ fn bench_ndf<N: Ndf>(c: &mut Criterion, family: &str, make: impl Fn(f32) -> N) {
             let mut out = vec![0.0f32; BATCH];
             b.iter(|| {
                 for (o, (&w, &m)) in out.iter_mut().zip(inp.w.iter().zip(&inp.m)) {
-                    *o = ndf.g1(black_box(w), black_box(m));
+                    *o = ndf.g1(table::bb3(w), table::bb3(m));
                 }
                 black_box(&mut out);
             })
@@ -96,7 +96,7 @@ fn bench_ndf<N: Ndf>(c: &mut Criterion, family: &str, make: impl Fn(f32) -> N) {
             let mut out = vec![0.0f32; BATCH];
             b.iter(|| {
                 for (o, (&w, &m)) in out.iter_mut().zip(inp.w.iter().zip(&inp.m)) {
-                    *o = ndf.pdf_visible(black_box(w), black_box(m));
+                    *o = ndf.pdf_visible(table::bb3(w), table::bb3(m));
                 }
                 black_box(&mut out);
             })
@@ -112,7 +112,7 @@ fn bench_ndf<N: Ndf>(c: &mut Criterion, family: &str, make: impl Fn(f32) -> N) {
             let mut out = vec![Vec3::ZERO; BATCH];
             b.iter(|| {
                 for (o, (&w, &u)) in out.iter_mut().zip(inp.w.iter().zip(&inp.u)) {
-                    *o = ndf.sample_visible(black_box(w), black_box(u));
+                    *o = ndf.sample_visible(table::bb3(w), table::bb2(u));
                 }
                 black_box(&mut out);
             })
@@ -138,25 +138,25 @@ fn table_rows<N: Ndf>(family: &str, alpha: f32, ndf: &N) {
     let mut ov = vec![Vec3::ZERO; table::N];
     table::time_it(&format!("{family}/d"), alpha, || {
         for (o, &m) in of.iter_mut().zip(m) {
-            *o = ndf.d(black_box(m));
+            *o = ndf.d(table::bb3(m));
         }
         black_box(&mut of);
     });
     table::time_it(&format!("{family}/g1"), alpha, || {
         for (o, (&w, &m)) in of.iter_mut().zip(w.iter().zip(m)) {
-            *o = ndf.g1(black_box(w), black_box(m));
+            *o = ndf.g1(table::bb3(w), table::bb3(m));
         }
         black_box(&mut of);
     });
     table::time_it(&format!("{family}/pdf_visible"), alpha, || {
         for (o, (&w, &m)) in of.iter_mut().zip(w.iter().zip(m)) {
-            *o = ndf.pdf_visible(black_box(w), black_box(m));
+            *o = ndf.pdf_visible(table::bb3(w), table::bb3(m));
         }
         black_box(&mut of);
     });
     table::time_it(&format!("{family}/sample_visible"), alpha, || {
         for (o, (&w, &u)) in ov.iter_mut().zip(w.iter().zip(u)) {
-            *o = ndf.sample_visible(black_box(w), black_box(u));
+            *o = ndf.sample_visible(table::bb3(w), table::bb2(u));
         }
         black_box(&mut ov);
     });

@@ -2,7 +2,7 @@
 // Beckmann, which v4 dropped) and Mitsuba 3, timed the way `benches/ndf.rs` and
 // `benches/fresnel.rs` time the crate in their table mode (BRDF_TABLE=1): the same inputs (same
 // generator, checked by a printed hash), batches of 1024 independent calls whose results are
-// stored, every input passed through an optimisation barrier, minimum and median over
+// stored, every input component passed through an optimisation barrier, minimum and median over
 // ROUNDS x BATCHES batches.
 //
 // Written for this comparison from the published formulas (pbrt-v4 `util/scattering.h`,
@@ -41,13 +41,17 @@ inline float sqr(float x) { return x * x; }
 inline float safe_sqrt(float x) { return std::sqrt(std::max(x, 0.0f)); }
 inline float clampf(float x, float lo, float hi) { return std::min(std::max(x, lo), hi); }
 
-// The optimisation barrier of Rust's std::hint::black_box: the value goes through memory that
-// the compiler must assume read and written.
-template <class T>
-inline T opaque(T v) {
-    asm volatile("" : : "r"(&v) : "memory");
+// A register-only optimisation barrier (the Rust side's `opaque`): the value passes through an empty
+// asm in an SSE register, so the compiler can neither vectorise across calls nor hoist work out of
+// the loop, and nothing is stored or reloaded. A barrier with a memory clobber (Rust's black_box,
+// benchmark::DoNotOptimize) costs a store and reload per value, and LLVM and GCC pay for it
+// differently.
+inline float opaque(float v) {
+    asm volatile("" : "+x"(v));
     return v;
 }
+inline V3 opaque3(V3 v) { return {opaque(v.x), opaque(v.y), opaque(v.z)}; }
+inline V2 opaque2(V2 v) { return {opaque(v.x), opaque(v.y)}; }
 
 // ---------------------------------------------------------------- inputs (same as the Rust side)
 struct SplitMix {
@@ -455,8 +459,8 @@ int main(int argc, char** argv) {
 #define ROW(NAME, VARIANT, OUT, EXPR)                                      \
     time_it(NAME, VARIANT, alpha, [&] {                                     \
         for (int i = 0; i < N; ++i) {                                       \
-            V3 wi = opaque(w[i]), mi = opaque(m[i]);                        \
-            V2 ui = opaque(u[i]);                                           \
+            V3 wi = opaque3(w[i]), mi = opaque3(m[i]);                        \
+            V2 ui = opaque2(u[i]);                                           \
             (void)wi, (void)mi, (void)ui;                                   \
             OUT[i] = EXPR;                                                  \
         }                                                                   \

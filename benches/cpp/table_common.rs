@@ -4,7 +4,7 @@
 //!
 //! Inputs come from SplitMix64 (identical on both sides; each side prints a hash of its inputs so
 //! that the identity can be checked). A batch is 1024 independent calls, each input passed through
-//! `black_box` and each result stored; the figure is the wall time of one batch / 1024, and a row
+//! a register-only optimisation barrier on each component ([`opaque`]) and each result stored; the figure is the wall time of one batch / 1024, and a row
 //! reports the minimum and the median over `ROUNDS × BATCHES` batches (after 200 warm-up batches).
 
 #![allow(dead_code)] // each bench uses part of it
@@ -87,6 +87,40 @@ pub fn hash(inp: &Inputs) -> u64 {
         mix(inp.cos_unit[i]);
     }
     h
+}
+
+/// An optimisation barrier on one `f32` that costs nothing: an empty `asm!` that takes and returns
+/// the value in an SSE register (no memory clobber, unlike `black_box`, whose store/reload per call
+/// and whose clobber of all memory change the code under test, and differently in LLVM and GCC).
+/// It stops the compiler from vectorising across calls or hoisting work out of the loop. The C++
+/// harness uses the same asm (`asm volatile("" : "+x"(v))`). Elsewhere than x86-64: `black_box`.
+#[inline(always)]
+pub fn opaque(x: f32) -> f32 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let mut x = x;
+        // SAFETY: an empty asm block; it reads and writes only the register holding x.
+        unsafe {
+            std::arch::asm!("/* {0} */", inout(xmm_reg) x, options(nomem, nostack, preserves_flags));
+        }
+        x
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        std::hint::black_box(x)
+    }
+}
+
+/// [`opaque`] on each component of a `Vec3`.
+#[inline(always)]
+pub fn bb3(v: Vec3) -> Vec3 {
+    Vec3::new(opaque(v.x), opaque(v.y), opaque(v.z))
+}
+
+/// [`opaque`] on each component of a `Vec2`.
+#[inline(always)]
+pub fn bb2(v: Vec2) -> Vec2 {
+    Vec2::new(opaque(v.x), opaque(v.y))
 }
 
 /// Rounds and batches per row: `BRDF_TABLE_ROUNDS`, `BRDF_TABLE_BATCHES` (default 5 × 1000).
