@@ -101,7 +101,8 @@ pub fn dielectric(cos_theta_i: f32, eta: f32) -> f32 {
 /// form as written in \[Pharr2016\], §8.2.1 (`FrConductor`).
 #[inline]
 pub fn conductor(cos_theta_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
-    // NaN → 0 here; the result is zeroed for a NaN cosine below.
+    // NaN → 0 here (`clamp` would keep it); the result is zeroed for a NaN cosine below.
+    #[allow(clippy::manual_clamp)]
     let c = cos_theta_i.max(0.0).min(1.0);
     let cos2 = c * c;
     let sin2 = 1.0 - cos2;
