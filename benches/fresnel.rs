@@ -1,15 +1,26 @@
 //! Fresnel terms and warps: time per call, on 1024 inputs generated before timing.
 //!
+//! Every input passes through `black_box` and every result is stored to an output buffer, so the
+//! figure is the throughput of independent calls (as in a renderer), not the latency of a chain of
+//! additions into one accumulator.
+//!
 //! Run: `cargo bench --bench fresnel -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 //! (the figures in docs/results.md, section "Fresnel and warps", come from this command).
+//!
+//! Table mode (the Fresnel rows of the C++ comparison in docs/results.md, "Analytic NDFs"):
+//! `BRDF_TABLE=1 cargo bench --bench fresnel` prints the minimum and median ns per call over
+//! 5 × 1000 batches of 1024 calls on the inputs of `benches/cpp/analytic.cpp`.
 
 use brdf::Vec3;
 use brdf::fresnel::{ConductorFresnel, conductor, dielectric, schlick};
 use brdf::warp::*;
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use glam::Vec2;
 use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
+
+#[path = "cpp/table_common.rs"]
+mod table;
 
 const N: usize = 1024;
 
@@ -27,28 +38,60 @@ fn fresnel(c: &mut Criterion) {
     let (cos, _, _) = inputs();
     let mut g = c.benchmark_group("fresnel");
     g.throughput(Throughput::Elements(N as u64));
+    let mut of = vec![0.0f32; N];
+    let mut ov = vec![Vec3::ZERO; N];
     for eta in [1.5f32, 1.0 / 1.5] {
         g.bench_with_input(BenchmarkId::new("dielectric", eta), &eta, |b, &eta| {
             b.iter(|| {
-                cos.iter()
-                    .map(|&c| dielectric(black_box(c), eta))
-                    .sum::<f32>()
+                for (o, &c) in of.iter_mut().zip(&cos) {
+                    *o = dielectric(table::opaque(c), eta);
+                }
+                black_box(&mut of);
             })
         });
     }
     let gold = ConductorFresnel::GOLD;
     g.bench_function("conductor/gold", |b| {
         b.iter(|| {
-            cos.iter()
-                .map(|&c| conductor(black_box(c), gold.eta, gold.k))
-                .sum::<Vec3>()
+            for (o, &c) in ov.iter_mut().zip(&cos) {
+                *o = conductor(table::opaque(c), gold.eta, gold.k);
+            }
+            black_box(&mut ov);
         })
     });
     let f0 = gold.f0();
     g.bench_function("schlick/gold", |b| {
-        b.iter(|| cos.iter().map(|&c| schlick(f0, black_box(c))).sum::<Vec3>())
+        b.iter(|| {
+            for (o, &c) in ov.iter_mut().zip(&cos) {
+                *o = schlick(f0, table::opaque(c));
+            }
+            black_box(&mut ov);
+        })
     });
     g.finish();
+}
+
+/// The table mode: the Fresnel rows of the C++ comparison, timed as `benches/cpp/analytic.cpp`
+/// times pbrt's and Mitsuba's versions (η = 1.5 with cos uniform in [−1, 1); gold with cos uniform
+/// in [0, 1)).
+fn table_mode() {
+    let inp = table::inputs(1.0);
+    println!("# inputs hash {:016x}", table::hash(&inp));
+    let mut of = vec![0.0f32; table::N];
+    let mut ov = vec![Vec3::ZERO; table::N];
+    table::time_it("fresnel/dielectric", 1.5, || {
+        for (o, &c) in of.iter_mut().zip(&inp.cos_signed) {
+            *o = dielectric(table::opaque(c), 1.5);
+        }
+        black_box(&mut of);
+    });
+    let gold = ConductorFresnel::GOLD;
+    table::time_it("fresnel/conductor", 0.0, || {
+        for (o, &c) in ov.iter_mut().zip(&inp.cos_unit) {
+            *o = conductor(table::opaque(c), gold.eta, gold.k);
+        }
+        black_box(&mut ov);
+    });
 }
 
 fn warps(c: &mut Criterion) {
@@ -88,4 +131,12 @@ fn warps(c: &mut Criterion) {
 }
 
 criterion_group!(benches, fresnel, warps);
-criterion_main!(benches);
+
+fn main() {
+    if std::env::var_os("BRDF_TABLE").is_some() {
+        table_mode();
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -2,19 +2,27 @@
 //!
 //! Each iteration evaluates a batch of 1024 precomputed inputs (directions from a seeded RNG,
 //! cosine-distributed so that grazing angles appear as often as in a renderer), and criterion's
-//! `Throughput::Elements(1024)` reports the time per call. Every input passes through `black_box`
+//! `Throughput::Elements(1024)` reports the time per call. Every input component passes through `black_box` (`table::bb3`)
 //! and every result is stored to an output buffer (itself passed to `black_box`), so the figure is
 //! the throughput of independent calls, as in a renderer's loop over pixels, not the latency of a
 //! chain of additions into one accumulator (which capped the cheapest functions at one `f32` add
 //! latency per call before 2026-11).
 //!
 //! `cargo bench --bench ndf -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+//!
+//! Table mode (the crate's column of the C++ comparison in docs/results.md, "Analytic NDFs"):
+//! `BRDF_TABLE=1 cargo bench --bench ndf` prints, for α ∈ {0.1, 0.5, 1}, the minimum and median
+//! ns per call over 5 × 1000 batches of 1024 calls on the inputs of `benches/cpp/analytic.cpp`
+//! (see benches/cpp/README.md; `benches/cpp/run.sh` runs both sides alternately).
 
 use brdf::ndf::{Beckmann, BlinnPhong, Ggx, Ndf, shininess_from_beckmann_alpha};
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use glam::{Vec2, Vec3};
 use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
+
+#[path = "cpp/table_common.rs"]
+mod table;
 
 const BATCH: usize = 1024;
 const ALPHAS: [f32; 4] = [0.05, 0.125, 0.5, 1.0];
@@ -56,7 +64,7 @@ fn bench_ndf<N: Ndf>(c: &mut Criterion, family: &str, make: impl Fn(f32) -> N) {
             let mut out = vec![0.0f32; BATCH];
             b.iter(|| {
                 for (o, &m) in out.iter_mut().zip(&inp.m) {
-                    *o = ndf.d(black_box(m));
+                    *o = ndf.d(table::bb3(m));
                 }
                 black_box(&mut out);
             })
@@ -72,13 +80,29 @@ fn bench_ndf<N: Ndf>(c: &mut Criterion, family: &str, make: impl Fn(f32) -> N) {
             let mut out = vec![0.0f32; BATCH];
             b.iter(|| {
                 for (o, (&w, &m)) in out.iter_mut().zip(inp.w.iter().zip(&inp.m)) {
-                    *o = ndf.g1(black_box(w), black_box(m));
+                    *o = ndf.g1(table::bb3(w), table::bb3(m));
                 }
                 black_box(&mut out);
             })
         });
     }
     g.finish();
+
+    let mut p = c.benchmark_group(format!("{family}/pdf_visible"));
+    p.throughput(Throughput::Elements(BATCH as u64));
+    for &a in &ALPHAS {
+        let (ndf, inp) = (make(a), inputs(a));
+        p.bench_with_input(BenchmarkId::from_parameter(a), &inp, |b, inp| {
+            let mut out = vec![0.0f32; BATCH];
+            b.iter(|| {
+                for (o, (&w, &m)) in out.iter_mut().zip(inp.w.iter().zip(&inp.m)) {
+                    *o = ndf.pdf_visible(table::bb3(w), table::bb3(m));
+                }
+                black_box(&mut out);
+            })
+        });
+    }
+    p.finish();
 
     let mut v = c.benchmark_group(format!("{family}/sample_visible"));
     v.throughput(Throughput::Elements(BATCH as u64));
@@ -88,7 +112,7 @@ fn bench_ndf<N: Ndf>(c: &mut Criterion, family: &str, make: impl Fn(f32) -> N) {
             let mut out = vec![Vec3::ZERO; BATCH];
             b.iter(|| {
                 for (o, (&w, &u)) in out.iter_mut().zip(inp.w.iter().zip(&inp.u)) {
-                    *o = ndf.sample_visible(black_box(w), black_box(u));
+                    *o = ndf.sample_visible(table::bb3(w), table::bb2(u));
                 }
                 black_box(&mut out);
             })
@@ -105,5 +129,55 @@ fn benches(c: &mut Criterion) {
     });
 }
 
+/// The table mode: GGX and Beckmann D, G1, pdf_visible, sample_visible, timed as the C++ harness
+/// times pbrt's and Mitsuba's versions.
+fn table_rows<N: Ndf>(family: &str, alpha: f32, ndf: &N) {
+    let inp = table::inputs(alpha);
+    let (w, m, u) = (&inp.w, &inp.m, &inp.u);
+    let mut of = vec![0.0f32; table::N];
+    let mut ov = vec![Vec3::ZERO; table::N];
+    table::time_it(&format!("{family}/d"), alpha, || {
+        for (o, &m) in of.iter_mut().zip(m) {
+            *o = ndf.d(table::bb3(m));
+        }
+        black_box(&mut of);
+    });
+    table::time_it(&format!("{family}/g1"), alpha, || {
+        for (o, (&w, &m)) in of.iter_mut().zip(w.iter().zip(m)) {
+            *o = ndf.g1(table::bb3(w), table::bb3(m));
+        }
+        black_box(&mut of);
+    });
+    table::time_it(&format!("{family}/pdf_visible"), alpha, || {
+        for (o, (&w, &m)) in of.iter_mut().zip(w.iter().zip(m)) {
+            *o = ndf.pdf_visible(table::bb3(w), table::bb3(m));
+        }
+        black_box(&mut of);
+    });
+    table::time_it(&format!("{family}/sample_visible"), alpha, || {
+        for (o, (&w, &u)) in ov.iter_mut().zip(w.iter().zip(u)) {
+            *o = ndf.sample_visible(table::bb3(w), table::bb2(u));
+        }
+        black_box(&mut ov);
+    });
+}
+
+fn table_mode() {
+    println!("# function               variant  alpha   min_ns  median_ns");
+    for alpha in [0.1f32, 0.5, 1.0] {
+        println!("# inputs hash {:016x}", table::hash(&table::inputs(alpha)));
+        table_rows("ggx", alpha, &Ggx::isotropic(alpha).unwrap());
+        table_rows("beckmann", alpha, &Beckmann::isotropic(alpha).unwrap());
+    }
+}
+
 criterion_group!(ndf, benches);
-criterion_main!(ndf);
+
+fn main() {
+    if std::env::var_os("BRDF_TABLE").is_some() {
+        table_mode();
+        return;
+    }
+    ndf();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -12,7 +12,8 @@
 //! 0, as documented on each function; the constructors of the [`Fresnel`] types reject them instead.
 
 use crate::error::{Error, Result, finite, non_negative, positive};
-use glam::Vec3;
+use glam::{BVec3A, Vec3, Vec3A};
+use std::hint::select_unpredictable;
 
 /// Schlick's approximation of Fresnel reflectance: F = F0 + (1 − F0)(1 − cos θ)⁵.
 ///
@@ -38,72 +39,44 @@ pub fn schlick(f0: Vec3, cos_theta: f32) -> Vec3 {
 /// Exact unpolarised Fresnel reflectance of a smooth interface between two dielectrics.
 ///
 /// With cos θ_i ≥ 0 (incident from outside) and relative index η = n_inside / n_outside, Snell's law
-/// gives sin²θ_t = sin²θ_i / η² and
-/// r_∥ = (η cos θ_i − cos θ_t) / (η cos θ_i + cos θ_t),
-/// r_⊥ = (cos θ_i − η cos θ_t) / (cos θ_i + η cos θ_t),
+/// gives η cos θ_t = g = √(η² − 1 + cos²θ_i) and
+/// r_∥ = (η cos θ_i − cos θ_t) / (η cos θ_i + cos θ_t) = (η² cos θ_i − g) / (η² cos θ_i + g),
+/// r_⊥ = (cos θ_i − η cos θ_t) / (cos θ_i + η cos θ_t) = (cos θ_i − g) / (cos θ_i + g),
 /// F = (r_∥² + r_⊥²) / 2.
 /// For cos θ_i < 0 (incident from inside) the same formula is used with |cos θ_i| and 1/η.
+/// Total internal reflection (g² < 0) needs no branch: g is taken as 0 and both ratios are 1.
 ///
-/// Degenerate cases: total internal reflection (sin²θ_t ≥ 1) gives exactly 1; grazing incidence
-/// (cos θ_i = 0) gives 1; `cos_theta_i` is clamped into [−1, 1]; a NaN cosine, or `eta` NaN, infinite
-/// or ≤ 0, gives 0 (the constructors reject such an `eta`). Huge or tiny finite `eta` give the limit 1.
+/// Degenerate cases: total internal reflection gives exactly 1; grazing incidence (cos θ_i = 0)
+/// gives 1, except for the index-matched interface η = 1, which gives 0 at every angle (there is no
+/// interface); `cos_theta_i` is clamped into [−1, 1]; a NaN cosine, or `eta` NaN, infinite or ≤ 0,
+/// gives 0 (the constructors reject such an `eta`). Huge or tiny finite `eta` give values in [0, 1]
+/// (the limit 1 where η² over- or underflows).
 ///
 /// # Reference
 /// \[BornWolf1999\], §1.5.2 (Fresnel formulae; the cosine form as in \[Pharr2023\], §9.3, "The Fresnel
-/// Equations").
+/// Equations"; the g form as in \[Walter2007\] eq. 22).
 #[inline]
 pub fn dielectric(cos_theta_i: f32, eta: f32) -> f32 {
-    if !(eta > 0.0 && eta.is_finite()) || cos_theta_i.is_nan() {
-        return 0.0;
-    }
-    let (cos_i, eta) = if cos_theta_i < 0.0 {
-        // From inside: flip to the other side; 1/η may overflow for subnormal η, keep it finite.
-        ((-cos_theta_i).min(1.0), (1.0 / eta).min(f32::MAX))
+    // From inside: flip to the other side. The side is a coin flip for a renderer's random
+    // directions: a select, not a branch (the division is cheaper than a misprediction).
+    let e = select_unpredictable(cos_theta_i < 0.0, 1.0 / eta, eta);
+    let c = cos_theta_i.abs().min(1.0);
+    let e2 = e * e;
+    // g² = η² cos²θ_t; negative beyond the critical angle, where g = 0 gives r_∥ = r_⊥ = 1.
+    let g = ((e2 - 1.0) + c * c).max(0.0).sqrt();
+    let ec = e2 * c;
+    let r_perp = (c - g) / (c + g);
+    let r_parl = (ec - g) / (ec + g);
+    let f = 0.5 * (r_parl * r_parl + r_perp * r_perp);
+    // `min` maps NaN to 1: 0/0 at grazing incidence with g = 0 (η < 1, whose limit is total
+    // reflection), and ∞/∞ or 0/0 where η² over- or underflows (limit 1 as well). One test
+    // covers the invalid inputs and the index-matched interface (η = 1 → 0 exactly, which the
+    // formula gives anyway except where c² underflows).
+    if eta > 0.0 && eta < f32::INFINITY && eta != 1.0 && !cos_theta_i.is_nan() {
+        f.min(1.0)
     } else {
-        (cos_theta_i.min(1.0), eta)
-    };
-    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
-    let sin2_t = sin2_i / (eta * eta);
-    // Total internal reflection. The NaN test catches 0/0 (η² underflowed at normal incidence),
-    // whose limit is 1 as well.
-    if sin2_t >= 1.0 || sin2_t.is_nan() {
-        return 1.0;
+        0.0
     }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    (0.5 * (r_parl * r_parl + r_perp * r_perp)).clamp(0.0, 1.0)
-}
-
-/// Unpolarised reflectance of one channel of a conductor, in the a², b² closed form (see
-/// [`conductor`]). `cos_i` is already in [0, 1].
-#[inline]
-fn conductor_channel(cos_i: f32, eta: f32, k: f32) -> f32 {
-    if !(eta > 0.0 && eta.is_finite() && k >= 0.0 && k.is_finite()) {
-        return 0.0;
-    }
-    let cos2 = cos_i * cos_i;
-    let sin2 = (1.0 - cos2).max(0.0);
-    let (eta2, k2) = (eta * eta, k * k);
-    let t0 = eta2 - k2 - sin2;
-    let a2_plus_b2 = (t0 * t0 + 4.0 * eta2 * k2).sqrt();
-    // a² = (a² + b² + t0)/2, rewritten as 2η²κ² / (a² + b² − t0) when t0 < 0 to avoid cancellation.
-    let a2 = if t0 >= 0.0 {
-        0.5 * (a2_plus_b2 + t0)
-    } else {
-        2.0 * eta2 * k2 / (a2_plus_b2 - t0)
-    };
-    let a = a2.max(0.0).sqrt();
-    let t1 = a2_plus_b2 + cos2;
-    let t2 = 2.0 * cos_i * a;
-    let rs = (t1 - t2) / (t1 + t2);
-    let t3 = cos2 * a2_plus_b2 + sin2 * sin2;
-    let t4 = t2 * sin2;
-    let rp = rs * (t3 - t4) / (t3 + t4);
-    let r = 0.5 * (rs + rp);
-    // NaN only from 0/0 at grazing incidence with a² + b² = 0 (κ = 0, η = 1) or from overflow of the
-    // squares for |η + iκ| ≳ 1e19: both have the limit 1.
-    if r.is_nan() { 1.0 } else { r.clamp(0.0, 1.0) }
 }
 
 /// Exact unpolarised Fresnel reflectance of a conductor with complex index η + iκ per channel.
@@ -113,9 +86,11 @@ fn conductor_channel(cos_i: f32, eta: f32, k: f32) -> f32 {
 /// a² + b² = √((η² − κ² − sin²θ)² + 4η²κ²), a² = (a² + b² + η² − κ² − sin²θ) / 2,
 /// R_s = (a² + b² − 2a cos θ + cos²θ) / (a² + b² + 2a cos θ + cos²θ),
 /// R_p = R_s (cos²θ (a² + b²) − 2a cos θ sin²θ + sin⁴θ) / (cos²θ (a² + b²) + 2a cos θ sin²θ + sin⁴θ),
-/// F = (R_s + R_p) / 2.
-/// a² is evaluated without cancellation when η² − κ² − sin²θ < 0. With κ = 0 this equals
-/// [`dielectric`] for incidence from outside.
+/// F = (R_s + R_p) / 2 = R_s · (cos²θ (a² + b²) + sin⁴θ) / (cos²θ (a² + b²) + 2a cos θ sin²θ + sin⁴θ).
+/// a² is evaluated without cancellation when η² − κ² − sin²θ < 0 (as 2η²κ² / (a² + b² − η² + κ² +
+/// sin²θ)). The three channels are computed together in SIMD lanes (`Vec3A`), so each division and
+/// square root is one instruction for all three. With κ = 0 this equals [`dielectric`] for incidence
+/// from outside.
 ///
 /// Degenerate cases: `cos_theta_i` is clamped into [0, 1] (light cannot arrive from inside a
 /// conductor; a negative cosine counts as grazing, F = 1); grazing incidence gives 1; a NaN cosine
@@ -126,15 +101,53 @@ fn conductor_channel(cos_i: f32, eta: f32, k: f32) -> f32 {
 /// form as written in \[Pharr2016\], §8.2.1 (`FrConductor`).
 #[inline]
 pub fn conductor(cos_theta_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
-    if cos_theta_i.is_nan() {
-        return Vec3::ZERO;
+    // NaN → 0 here (`clamp` would keep it); the result is zeroed for a NaN cosine below.
+    #[allow(clippy::manual_clamp)]
+    let c = cos_theta_i.max(0.0).min(1.0);
+    let cos2 = c * c;
+    let sin2 = 1.0 - cos2;
+    let (eta, k) = (Vec3A::from(eta), Vec3A::from(k));
+    let (eta2, k2) = (eta * eta, k * k);
+    let ek2 = eta2 * k2;
+    let t0 = eta2 - k2 - Vec3A::splat(sin2);
+    let a2_plus_b2 = sqrt3(t0 * t0 + 4.0 * ek2);
+    // a² = (a² + b² + t0)/2, as 2η²κ² / (a² + b² − t0) when t0 < 0 (no cancellation).
+    let a2 = Vec3A::select(
+        t0.cmpge(Vec3A::ZERO),
+        0.5 * (a2_plus_b2 + t0),
+        2.0 * ek2 / (a2_plus_b2 - t0),
+    );
+    let t2 = (2.0 * c) * sqrt3(a2);
+    let t1 = a2_plus_b2 + Vec3A::splat(cos2);
+    let t3 = a2_plus_b2 * cos2 + Vec3A::splat(sin2 * sin2);
+    let t4 = t2 * sin2;
+    let r = (t1 - t2) / (t1 + t2) * (t3 / (t3 + t4));
+    // NaN only from 0/0 at grazing incidence with a² + b² = 0 (κ = 0, η = 1) or from overflow of
+    // the squares for |η + iκ| ≳ 1e19: both have the limit 1.
+    let r = Vec3A::select(r.cmpeq(r), r, Vec3A::ONE);
+    let r = r.max(Vec3A::ZERO).min(Vec3A::ONE);
+    let valid = eta.cmpgt(Vec3A::ZERO)
+        & eta.cmplt(Vec3A::INFINITY)
+        & k.cmpge(Vec3A::ZERO)
+        & k.cmplt(Vec3A::INFINITY)
+        & BVec3A::splat(!cos_theta_i.is_nan());
+    Vec3::from(Vec3A::select(valid, r, Vec3A::ZERO))
+}
+
+/// Square roots of the three lanes in one instruction (SSE's `sqrtps` on x86-64; glam's
+/// `Vec3A::sqrt` takes three scalar roots).
+#[inline(always)]
+fn sqrt3(v: Vec3A) -> Vec3A {
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+    {
+        use std::arch::x86_64::{__m128, _mm_sqrt_ps};
+        // SAFETY: the cfg guarantees SSE2 (part of the x86-64 baseline), all `_mm_sqrt_ps` needs.
+        Vec3A::from(unsafe { _mm_sqrt_ps(__m128::from(v)) })
     }
-    let c = cos_theta_i.clamp(0.0, 1.0);
-    Vec3::new(
-        conductor_channel(c, eta.x, k.x),
-        conductor_channel(c, eta.y, k.y),
-        conductor_channel(c, eta.z, k.z),
-    )
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+    {
+        v.sqrt()
+    }
 }
 
 /// Normal-incidence reflectance of a dielectric: F0 = ((η − 1) / (η + 1))².

@@ -169,9 +169,41 @@ fn brewster_angle_is_half_the_s_reflectance() {
     }
 }
 
+/// Regression (issue 18): an index-matched interface (η = 1) has no interface to reflect from,
+/// F = 0 at every angle, grazing incidence (±0) and cosines whose square underflows included;
+/// `dielectric(0.0, 1.0)` used to return 1.
+#[test]
+fn index_matched_dielectric_reflects_nothing() {
+    let mut cosines = vec![
+        0.0f32,
+        -0.0,
+        1.0,
+        -1.0,
+        1e-20,
+        -1e-20,
+        1e-45,
+        f32::MIN_POSITIVE,
+    ];
+    cosines.extend((1..=1000).map(|i| i as f32 / 1000.0));
+    cosines.extend((1..=1000).map(|i| -(i as f32) / 1000.0));
+    for c in cosines {
+        assert_eq!(dielectric(c, 1.0), 0.0, "cos {c}");
+        assert_eq!(
+            DielectricFresnel::new(1.0).unwrap().eval(c),
+            Vec3::ZERO,
+            "cos {c}"
+        );
+    }
+    // Next to η = 1 the grazing value is the limit 1 again (on both sides of 1).
+    for eta in [1.0 - f32::EPSILON / 2.0, 1.0 + f32::EPSILON] {
+        assert_eq!(dielectric(0.0, eta), 1.0, "η {eta}");
+    }
+}
+
 #[test]
 fn grazing_incidence_gives_one() {
-    for eta in [1e-3f32, 0.5, 1.0, 1.0001, 1.5, 3.0, 1e3] {
+    // η = 1 excepted: see `index_matched_dielectric_reflects_nothing`.
+    for eta in [1e-3f32, 0.5, 1.0001, 1.5, 3.0, 1e3] {
         assert_eq!(dielectric(0.0, eta), 1.0, "{eta}");
         assert_eq!(dielectric(-0.0, eta), 1.0, "{eta}");
     }
@@ -357,8 +389,9 @@ fn dielectric_matches_the_complex_reference() {
             let c = i as f32 / 200.0;
             let got = dielectric(c, eta) as f64;
             if c == 0.0 {
-                // Grazing: the reference is 0/0 for η = 1; the crate's value is the limit 1.
-                assert_eq!(got, 1.0, "η {eta}");
+                // Grazing: the reference is 0/0 for η = 1, where the crate gives the limit of the
+                // index-matched interface, 0 (issue 18); every other η gives the limit 1.
+                assert_eq!(got, if eta == 1.0 { 0.0 } else { 1.0 }, "η {eta}");
                 continue;
             }
             let want = reference_dielectric(c as f64, eta as f64);

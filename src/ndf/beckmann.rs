@@ -122,6 +122,13 @@ impl Beckmann {
         self.alpha_y
     }
 
+    /// n = α(φ) sin θ = |(α_x x, α_y y)| for w = (x, y, z), unchecked (callers test the result).
+    #[inline(always)]
+    fn stretched_sin(&self, w: Vec3) -> f32 {
+        let (x, y) = (self.alpha_x * w.x, self.alpha_y * w.y);
+        (x * x + y * y).sqrt()
+    }
+
     /// a = 1 / (α(φ) tan θ) = z / |(α_x x, α_y y)| for w = (x, y, z): the argument of Λ.
     /// `None` below the horizon or for non-finite input; +∞ at normal incidence.
     #[inline]
@@ -214,18 +221,93 @@ fn horner<const N: usize>(x: f32, c: &[f32; N]) -> f32 {
     c.iter().rev().fold(0.0, |acc, &ci| acc * x + ci)
 }
 
-/// The visible projected area V = cos θ (1 + Λ) = ∫⟨w, m⟩⁺ D dm from a and the two parts of w.
+/// End of the rational fit [`g1_over_a`]: from a = 3.6 on, the exact G1 rounds to 1.0 in f32 (for
+/// every f32 a in [3.6, 10), checked in `tests::g1_cutoff_is_exact`; beyond, Λ only decreases), and
+/// V = cos θ.
+const G1_END: f32 = 3.6;
+
+/// (P(a), Q(a)) with P/Q ≈ G1(a)/a = 2√π / (2a√π + e^(−a²) − a√π erfc(a)) for 0 ≤ a < 3.6, the
+/// Beckmann masking divided by its argument (smooth and positive: 2√π at a = 0, 1/3.6 at the end).
 ///
-/// For a ≥ 1 the product form is accurate; for a < 1 (grazing) it is evaluated as
-/// cos θ (1 + erf a)/2 + α(φ) sin θ e^(−a²)/(2√π), a sum of positive terms that stays finite as
-/// cos θ → 0 (where the product would multiply 0 by an overflowing Λ).
-#[inline]
-fn visible_area_of(a: f32, z: f32, n: f32) -> f32 {
-    if a >= 1.0 {
-        z * (1.0 + lambda_of_a(a))
-    } else {
-        0.5 * z * (1.0 + erf(a)) + 0.5 * INV_SQRT_PI * n * exp_neg_sq(a)
-    }
+/// A degree-(6, 6) rational function, Q > 0 on [0, 3.6]: fitted (linearised least squares with
+/// Lawson reweighting toward the minimax, in f64, from libm's `erfc`), coefficients rounded to f32.
+/// Relative error 3.7·10⁻⁸ in exact arithmetic with the rounded coefficients; both polynomials by
+/// Estrin's scheme (no `exp`, no branch, one division left to the caller). Measured against f64 in
+/// `tests::g1_of_a_error` and `tests/ndf_centred.rs` (`beckmann_g1_against_f64`).
+///
+/// # Reference
+/// \[Walter2007\] §5.1 and \[Heitz2014\] eq. 72 (Λ of the Beckmann distribution); the fit is ours,
+/// of the same form as Walter's degree-(2, 2) one (3·10⁻³) with four more degrees.
+#[inline(always)]
+fn g1_over_a(a: f32) -> (f32, f32) {
+    let a2 = a * a;
+    let a4 = a2 * a2;
+    let [p0, p1, p2, p3, p4, p5, p6] = G1_P;
+    let [q0, q1, q2, q3, q4, q5, q6] = G1_Q;
+    let p = (p0 + p1 * a) + (p2 + p3 * a) * a2 + ((p4 + p5 * a) + p6 * a2) * a4;
+    let q = (q0 + q1 * a) + (q2 + q3 * a) * a2 + ((q4 + q5 * a) + q6 * a2) * a4;
+    (p, q)
+}
+
+/// Numerator of [`g1_over_a`], ascending powers of a.
+#[allow(clippy::excessive_precision)]
+const G1_P: [f32; 7] = [
+    3.544_907_570,
+    -9.162_767_529e-1,
+    1.165_587_068,
+    -1.447_398_663e-1,
+    1.006_292_999e-1,
+    6.740_196_608e-3,
+    2.116_951_946e-4,
+];
+/// Denominator of [`g1_over_a`], ascending powers of a.
+#[allow(clippy::excessive_precision)]
+const G1_Q: [f32; 7] = [
+    1.0,
+    1.513_973_594,
+    8.707_229_495e-1,
+    2.831_415_832e-1,
+    1.191_850_007e-1,
+    5.285_961_553e-2,
+    1.158_101_764e-2,
+];
+
+/// Smith G1 = 1/(1 + Λ(a)) of the Beckmann NDF, a = 1/(α(φ) tan θ) ≥ 0: a P(a)/Q(a) (see
+/// [`g1_over_a`]) for a < 3.6, 1 from there on (where the exact value rounds to 1) and for a = +∞.
+///
+/// Exact to f32 accuracy: relative error ≤ 1e-6 against f64 (fit 3.7·10⁻⁸ plus f32 roundings).
+/// 0 at a = 0; for NaN, 1 (callers reject NaN directions themselves). One division; capped at 1.
+///
+/// # Reference
+/// \[Walter2007\] §5.1 (Beckmann G1), \[Heitz2014\] eq. 72 (Λ).
+#[inline(always)]
+fn g1_of_a(a: f32) -> f32 {
+    let (p, q) = g1_over_a(a);
+    let (num, den) = if a < G1_END { (a * p, q) } else { (1.0, 1.0) };
+    // The fit may exceed 1 by its error just below the cut-off; the truth is < 1.
+    (num / den).min(1.0)
+}
+
+/// The visible projected area V = cos θ (1 + Λ) = ∫⟨w, m⟩⁺ D dm = cos θ / G1 from z = cos θ and
+/// n = α(φ) sin θ, a = z/n: n Q(a)/P(a) for a < 3.6 (cos θ / G1 with a = z/n cancelled, so it stays
+/// accurate down to z → 0, where V → n/(2√π)), z from there on (and at normal incidence, n = 0).
+/// Relative error that of [`g1_over_a`]. One division.
+///
+/// # Reference
+/// \[Heitz2014\] eq. 17 and §5.1 (the projected area of the visible microfacets).
+#[inline(always)]
+fn visible_area_zn(z: f32, n: f32) -> f32 {
+    let (num, den) = visible_area_ratio(z, n);
+    num / den
+}
+
+/// V = num/den as in [`visible_area_zn`], the division left to the caller (the pdf divides by V:
+/// it multiplies by den/num and saves one division).
+#[inline(always)]
+fn visible_area_ratio(z: f32, n: f32) -> (f32, f32) {
+    let a = z / n;
+    let (p, q) = g1_over_a(a);
+    if a < G1_END { (n * q, p) } else { (z, 1.0) }
 }
 
 /// Draws the standard (α = 1) visible slope for a direction at polar angle θ in the xz-plane
@@ -346,27 +428,49 @@ impl Ndf for Beckmann {
         }
     }
 
-    /// ∫⟨w, m⟩⁺ D dm = cos θ (1 + Λ), evaluated in a form that stays accurate down to cos θ → 0.
+    /// ∫⟨w, m⟩⁺ D dm = cos θ (1 + Λ) = cos θ / G1 (see `visible_area_zn`): accurate down to
+    /// cos θ → 0. 0 below the horizon and where the sum is not finite (NaN
+    /// components, or a huge non-unit w); checked once, on the result.
     #[inline]
     fn visible_area(&self, w: Vec3) -> f32 {
-        if !(w.z > 0.0 && w.is_finite()) {
-            return 0.0;
+        let n = self.stretched_sin(w);
+        let v = visible_area_zn(w.z, n);
+        // `n >= 0` rejects a NaN x or y (which `visible_area_zn` maps to V = z).
+        if w.z > 0.0 && n >= 0.0 && v <= f32::MAX {
+            v
+        } else {
+            0.0
         }
-        let n = Vec2::new(self.alpha_x * w.x, self.alpha_y * w.y).length();
-        // Finite for unit w; the check keeps an overflowing non-unit w at 0.
-        let v = visible_area_of(w.z / n, w.z, n);
-        if v.is_finite() { v } else { 0.0 }
     }
 
-    /// G1(w, m) = χ⁺(w·m) / (1 + Λ(w)).
+    /// G1(w, m) = χ⁺(w·m) / (1 + Λ(w)), exact to f32 accuracy (see `g1_of_a`). 0 below the horizon, for w·m ≤ 0, and where w·m is not finite (a NaN or
+    /// infinite component in w or m).
     #[inline]
     fn g1(&self, w: Vec3, m: Vec3) -> f32 {
-        if !(w.dot(m) > 0.0 && m.is_finite()) {
-            return 0.0;
+        let c = w.dot(m);
+        let g = g1_of_a(w.z / self.stretched_sin(w));
+        if w.z > 0.0 && c > 0.0 && c <= f32::MAX {
+            g
+        } else {
+            0.0
         }
-        match self.a_of(w) {
-            Some(a) => 1.0 / (1.0 + lambda_of_a(a)),
-            None => 0.0,
+    }
+
+    /// D_wo(m) = χ⁺(wo·m) ⟨wo, m⟩ D(m) / V(wo), V = cos θo (1 + Λ(wo)) (see `visible_area_zn`):
+    /// one `exp` (in D), no branch, exact to f32 accuracy. 0 for degenerate input (below-horizon wo or m, wo·m ≤ 0, NaN
+    /// or infinite components); checked once, on the result.
+    ///
+    /// # Reference
+    /// \[Heitz2014\] eq. 16 (the distribution of visible normals).
+    #[inline]
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        let c = wo.dot(m);
+        let (num, den) = visible_area_ratio(wo.z, self.stretched_sin(wo));
+        let p = c * self.d(m) * den / num;
+        if wo.z > 0.0 && c > 0.0 && num > 0.0 && p <= f32::MAX {
+            p
+        } else {
+            0.0
         }
     }
 
@@ -441,6 +545,57 @@ mod tests {
         // Bound 4·10⁻⁶: ~3 bits of cancellation just below a = 2 on erfc's 5·10⁻⁷ (see
         // lambda_of_a); elsewhere the error is a few f32 roundings.
         assert!(worst < 4e-6, "{worst:e} at {at}");
+    }
+
+    /// G1(a) = 1/(1 + Λ(a)) in f64 from libm's erfc (h = e^(−a²) − a√π erfc(a) = 2a√π Λ loses
+    /// no digit that matters against the 10⁻⁷ under test for a ≤ 10).
+    fn g1_f64(a: f64) -> f64 {
+        let sp = std::f64::consts::PI.sqrt();
+        let h = (-a * a).exp() - a * sp * libm::erfc(a);
+        2.0 * a * sp / (2.0 * a * sp + h)
+    }
+
+    #[test]
+    fn g1_of_a_error() {
+        let (mut worst_g, mut worst_v) = ((0.0f64, 0.0f32), (0.0f64, 0.0f32));
+        let n = 400_000;
+        for i in 0..=n {
+            let a = (4.0 * i as f64 / n as f64) as f32;
+            if a == 0.0 {
+                continue;
+            }
+            let truth = g1_f64(a as f64);
+            let err = (g1_of_a(a) as f64 / truth - 1.0).abs();
+            if err > worst_g.0 {
+                worst_g = (err, a);
+            }
+            // V/n = (1/a)/G1 at n = 1, z = a.
+            let err = (visible_area_zn(a, 1.0) as f64 * truth / a as f64 - 1.0).abs();
+            if err > worst_v.0 {
+                worst_v = (err, a);
+            }
+        }
+        println!("g1_of_a: max relative error {worst_g:?}; visible_area_zn: {worst_v:?}");
+        // Bound 4e-7: the fit's 3.7e-8 plus six f32 roundings of 2⁻²⁴ = 6e-8 each on the path
+        // to the result (the last two of each Estrin sum, whose condition is ≤ 1.5; the product
+        // a·P or n·Q; the division). Measured: 3.1e-7 near a = 0.05.
+        assert!(worst_g.0 <= 4e-7, "{worst_g:?}");
+        assert!(worst_v.0 <= 4e-7, "{worst_v:?}");
+        assert_eq!(g1_of_a(0.0), 0.0);
+        assert_eq!(g1_of_a(f32::INFINITY), 1.0);
+        assert_eq!(visible_area_zn(0.5, 0.0), 0.5);
+    }
+
+    /// The cut-off of `g1_of_a` changes no bit: for every f32 a in [3.6, 10) the exact G1
+    /// (in f64) rounds to 1.0f, which is what the cut-off returns; Λ decreases beyond.
+    #[test]
+    fn g1_cutoff_is_exact() {
+        let mut a = G1_END;
+        while a < 10.0 {
+            assert_eq!(g1_f64(a as f64) as f32, 1.0, "a = {a}");
+            assert_eq!(g1_of_a(a), 1.0);
+            a = f32::from_bits(a.to_bits() + 1);
+        }
     }
 
     #[test]

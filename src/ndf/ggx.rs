@@ -117,18 +117,44 @@ impl Ndf for Ggx {
         }
     }
 
-    /// G1(w, m) = χ⁺(w·m) / (1 + Λ(w)) = χ⁺(w·m) 2z / (z + √(z² + n²)).
+    /// G1(w, m) = χ⁺(w·m) / (1 + Λ(w)) = χ⁺(w·m) 2z / (z + √(z² + n²)), n² = (α_x x)² + (α_y y)²
+    /// under one square root. 0 below the horizon, for w·m ≤ 0 and where w·m is not finite (a NaN
+    /// or infinite component in w or m); capped at 1 (z² may underflow for z < 10⁻¹⁹), which also
+    /// maps the NaN of an infinite z to a finite value.
+    ///
+    /// # Reference
+    /// \[Walter2007\] eq. 34, \[Heitz2014\] eq. 72 (anisotropic form).
     #[inline]
     fn g1(&self, w: Vec3, m: Vec3) -> f32 {
-        if !(w.dot(m) > 0.0 && m.is_finite()) {
-            return 0.0;
+        let c = w.dot(m);
+        let (x, y) = (self.alpha_x * w.x, self.alpha_y * w.y);
+        let g = 2.0 * w.z / (w.z + (w.z * w.z + x * x + y * y).sqrt());
+        if w.z > 0.0 && c > 0.0 && c <= f32::MAX {
+            g.min(1.0)
+        } else {
+            0.0
         }
-        match self.stretched_sin(w) {
-            Some(n) => {
-                let g = 2.0 * w.z / (w.z + Vec2::new(w.z, n).length());
-                if g.is_finite() { g.min(1.0) } else { 0.0 }
-            }
-            None => 0.0,
+    }
+
+    /// D_wo(m) = χ⁺(wo·m) ⟨wo, m⟩ D(m) / V(wo) = 2 ⟨wo, m⟩ / (π α_x α_y t² (z + √(z² + n²))),
+    /// t = (m_x/α_x)² + (m_y/α_y)² + m_z² (D = 1/(π α_x α_y t²), V = (z + √(z² + n²))/2): one
+    /// square root and one division. 0 for degenerate input (below-horizon wo or m, wo·m ≤ 0, NaN
+    /// or infinite components, a non-finite result); checked once, on the result.
+    ///
+    /// # Reference
+    /// \[Heitz2014\] eq. 16 (the distribution of visible normals).
+    #[inline]
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        let c = wo.dot(m);
+        let (x, y) = (self.alpha_x * wo.x, self.alpha_y * wo.y);
+        let s = (wo.z * wo.z + x * x + y * y).sqrt();
+        let (sx, sy) = (m.x * self.inv_alpha_x, m.y * self.inv_alpha_y);
+        let t = sx * sx + sy * sy + m.z * m.z;
+        let p = (2.0 * self.norm) * c / (t * t * (wo.z + s));
+        if wo.z > 0.0 && m.z > 0.0 && c > 0.0 && p <= f32::MAX {
+            p
+        } else {
+            0.0
         }
     }
 
@@ -169,6 +195,7 @@ impl Ndf for Ggx {
     /// # Reference
     /// \[DupuyBenyoub2023\] listing 3 (spherical caps), \[Heitz2018\] (stretch / unstretch).
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(z > 0)` also rejects NaN
+    #[inline]
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
         if !(wo.z > 0.0) {
             return self.sample_normal(u);
@@ -213,6 +240,8 @@ impl Ggx {
     ///
     /// # Reference
     /// \[Heitz2018\] listing 1.
+    #[cold]
+    #[inline(never)]
     fn sample_visible_disk(&self, wo: Vec3, u: Vec2) -> Vec3 {
         if !(wo.z > 0.0 && wo.is_finite()) {
             return self.sample_normal(u);

@@ -1,0 +1,24 @@
+#!/bin/sh
+# Builds the C++ transcriptions with g++ -O3 and runs them and the crate's table mode alternately
+# (C++, crate, C++, crate), printing ns per call (minimum and median over batches of 1024 calls).
+# Run from the crate root: `sh benches/cpp/run.sh [ROUNDS [BATCHES]]` (default 5 1000).
+# Not part of CI: needs g++; the crate side builds with `cargo bench --no-run`.
+set -e
+ROUNDS=${1:-5}
+BATCHES=${2:-1000}
+OUT=target/cpp
+mkdir -p "$OUT"
+g++ -O3 -fno-math-errno -std=c++17 -o "$OUT/analytic" benches/cpp/analytic.cpp
+cargo bench --bench ndf --bench fresnel --no-run 2>/dev/null
+NDF=$(ls -t target/release/deps/ndf-* | grep -v '\.d$' | head -1)
+FRESNEL=$(ls -t target/release/deps/fresnel-* | grep -v '\.d$' | head -1)
+echo "# $(uptime)"
+echo "# g++ $(g++ -dumpfullversion) -O3 -fno-math-errno; crate: cargo bench (release)"
+for pass in 1 2; do
+  echo "## pass $pass: C++"
+  "$OUT/analytic" "$ROUNDS" "$BATCHES"
+  echo "## pass $pass: crate"
+  BRDF_TABLE=1 BRDF_TABLE_ROUNDS=$ROUNDS BRDF_TABLE_BATCHES=$BATCHES "$NDF"
+  BRDF_TABLE=1 BRDF_TABLE_ROUNDS=$ROUNDS BRDF_TABLE_BATCHES=$BATCHES "$FRESNEL"
+done
+echo "# $(uptime)"
