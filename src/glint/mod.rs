@@ -64,9 +64,9 @@ mod reference;
 mod slope_tree;
 
 pub use binmap::{
-    BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, DEFAULT_BINS_PER_AXIS,
-    DEFAULT_LEAF_SIZE, DEFAULT_LOOKUP, DEFAULT_MASKING_SIGMA_MIN, EXACT_MASKING_TEXELS,
-    MASKING_FIRST_LEVEL, QueryStats,
+    BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, BinMapScratch,
+    DEFAULT_BINS_PER_AXIS, DEFAULT_LEAF_SIZE, DEFAULT_LOOKUP, DEFAULT_MASKING_SIGMA_MIN,
+    DEFAULT_SUBDIVISIONS, EXACT_MASKING_TEXELS, MASKING_FIRST_LEVEL, MAX_SUBDIVISIONS, QueryStats,
 };
 pub use bins::HemisphereBins;
 pub use flakes::{
