@@ -832,8 +832,8 @@ fn furnace_stats(patch: &impl Ndf, wo: Vec3, n: usize) -> (f64, f64, f64, f64) {
 #[ignore]
 fn grazing_table() {
     let maps = support::procedural_maps(256);
-    println!("| map | bins | θo | furnace | ± | σ_w/E | lost |");
-    println!("|---|---|---|---|---|---|---|");
+    println!("| map | bins | θo | furnace | ± | σ_w/E | lost | V / V_ref |");
+    println!("|---|---|---|---|---|---|---|---|");
     for (name, map) in maps.iter().filter(|(n, _)| *n == "bumpy" || *n == "scratched") {
         for n in [63usize, 127] {
             let bm = BinMap::build(
@@ -854,9 +854,28 @@ fn grazing_table() {
                         continue;
                     }
                     let (e, se, spread, lost) = furnace_stats(&patch, wo, 1 << 15);
+                    // V_ref = ∫⟨wo, m⟩⁺ D dm by the normal sampler (2¹⁸ R2 points).
+                    let k = 1usize << 18;
+                    let v_ref = (0..k)
+                        .map(|i| {
+                            let u = Vec2::new(
+                                (0.5 + i as f64 * 0.754_877_666_246_692_7).fract() as f32,
+                                (0.5 + i as f64 * 0.569_840_290_998_053_2).fract() as f32,
+                            );
+                            let m = patch.sample_normal(u);
+                            let p = patch.pdf_normal(m) as f64;
+                            if p > 0.0 {
+                                wo.dot(m).max(0.0) as f64 * patch.d(m) as f64 / p
+                            } else {
+                                0.0
+                            }
+                        })
+                        .sum::<f64>()
+                        / k as f64;
                     println!(
-                        "| {name} | {n}² | {theta}, φ {phi} | {e:.3} | {se:.3} | {spread:.2} | {:.1} % |",
-                        100.0 * lost
+                        "| {name} | {n}² | {theta}, φ {phi} | {e:.3} | {se:.3} | {spread:.2} | {:.1} % | {:.3} |",
+                        100.0 * lost,
+                        patch.visible_area(wo) as f64 / v_ref
                     );
                 }
             }
@@ -1021,5 +1040,80 @@ fn furnace_up_to_grazing_stays_below_one() {
                 }
             }
         }
+    }
+}
+
+/// Accuracy against memory for the sub-texel resolution s = 1, 2, 4 (docs/results.md, "Sub-texel
+/// binning"): TV against the parallelogram-kernel ground truth (256² procedural maps, 64² reference
+/// bins, 4·10⁶ positions, the accuracy table's settings) and bytes per texel at 1024² (bumpy).
+/// Command: `cargo test --test binmap -- --ignored subtexel_table --nocapture`
+#[test]
+#[ignore]
+fn subtexel_table() {
+    let n = 256;
+    let maps = support::procedural_maps(n);
+    let ref_bins = HemisphereBins::new(64).unwrap();
+    // (s, bins per axis): the sub-texel sweep at the default 127² bins, then s = 1, 2 at 255².
+    let configs = [(1usize, 127usize), (2, 127), (4, 127), (1, 255), (2, 255)];
+    let models: Vec<Vec<BinMap>> = maps
+        .iter()
+        .map(|(_, map)| {
+            configs
+                .iter()
+                .map(|&(s, n)| {
+                    let p = BinMapParams {
+                        subdivisions: s,
+                        bins_per_axis: n,
+                        ..BinMapParams::default()
+                    };
+                    BinMap::build(map, p).unwrap()
+                })
+                .collect()
+        })
+        .collect();
+    println!(
+        "| map | footprint (texels) | s = 1 | s = 2 | s = 4 | s = 1, 255² | s = 2, 255² | reference noise |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for ((name, map), bms) in maps.iter().zip(&models) {
+        for area in [1.0f32, 16.0, 256.0, 4096.0] {
+            let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
+            let para = binned_pndf(map, &fp, Kernel::Parallelogram, &ref_bins, 4_000_000, 17);
+            let tvs: Vec<String> = bms
+                .iter()
+                .map(|bm| format!("{:.3}", tv_distance(&bm.patch(&fp), &para, 64)))
+                .collect();
+            println!(
+                "| {name} | {area} | {} | {:.3} |",
+                tvs.join(" | "),
+                para.tv_error()
+            );
+        }
+    }
+    let big = bumpy(1024, 1024, 0.25, 4.0, 1).unwrap();
+    println!("| s | bins | 𝓑 | 𝓑⁻¹ | forest | other | total (B/texel) | build (s) |");
+    println!("|---|---|---|---|---|---|---|---|");
+    for (s, n) in configs {
+        let t = std::time::Instant::now();
+        let bm = BinMap::build(
+            &big,
+            BinMapParams {
+                subdivisions: s,
+                bins_per_axis: n,
+                ..BinMapParams::default()
+            },
+        )
+        .unwrap();
+        let dt = t.elapsed().as_secs_f64();
+        let m = bm.memory();
+        let tex = (1024 * 1024) as f64;
+        println!(
+            "| {s} | {n}² | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {dt:.2} |",
+            m.bin_map as f64 / tex,
+            m.inverse as f64 / tex,
+            m.forest as f64 / tex,
+            (m.lookup + m.bin_tables + m.moments) as f64 / tex,
+            m.total() as f64 / tex
+        );
     }
 }

@@ -52,8 +52,10 @@ const SMOOTH_TAIL: f64 = 1e-6;
 ///
 /// with |H| = 2π/B and c̄_j the bin's mean cosine. The talk's D_A^H = mass_j/|H| integrates to 1
 /// against dω; dividing by c̄_j makes ∫_{H_j} D cos θ dω = mass_j, hence ∫ D cos θ dω = Σ mass_j = 1
-/// (the crate's convention), D being constant per bin. |A ∩ T_k| sums over the periodic images of
-/// texel k (the map tiles), so footprints crossing the border or larger than the map are exact.
+/// (the crate's convention), D being constant per bin. T_k are the sub-texels of the map's s × s
+/// subdivision ([`BinMapParams::subdivisions`](super::BinMapParams::subdivisions); the texels when
+/// s = 1) and t_k their normals; |A ∩ T_k| sums over the periodic images of T_k (the map tiles), so
+/// footprints crossing the border or larger than the map are exact.
 ///
 /// **Smoothed variant** ([`BinMap::patch_smoothed`]): D(h) = Σ_j mass_j D_j(h) with D_j the
 /// Beckmann lobe of slope σ = α/√2 centred on the slope of bin j's centre (D_j = P22_j / cos⁴θ,
@@ -62,12 +64,13 @@ const SMOOTH_TAIL: f64 = 1e-6;
 ///
 /// **Masking** (the talk defines none). For footprints of at most [`EXACT_MASKING_TEXELS`] texels,
 /// Smith terms of the bin-map D itself, from the footprint's bins enumerated once per patch
-/// (O(|A|), through 𝓑). Each bin's D is constant, so with m̄_j = (1/|H|) ∫_{H_j} m dω the bin's mean
+/// (O(s² |A|), through 𝓑). Each bin's D is constant, so with m̄_j = (1/|H|) ∫_{H_j} m dω the bin's mean
 /// direction vector (tabulated per bin at build), the projected area A(w) = max(Σ_j mass_j ⟨w, m̄_j⟩
 /// / c̄_j, 0) is exact, and so is V(w) = ∫⟨w, m⟩⁺ D dm = Σ_j (mass_j / c̄_j) (1/|H|) ∫_{H_j} ⟨w, m⟩⁺ dω
 /// for every bin that faces w entirely; for a bin cut by w's horizon (within about one bin width of
-/// grazing) the bin's term is replaced by an upper bound, so that G1 = A/V can only err low and the
-/// BRDF never gains energy (see `visible_part`).
+/// grazing) the bin's term is replaced by an upper bound (a sub-bin quadrature bound built on a
+/// proven Lipschitz constant of the equal-area map, about 11× tighter than a whole-bin bound), so
+/// that G1 = A/V can only err low and the BRDF never gains energy (see `visible_part`).
 /// Λ = V/A − 1, the same construction as the mixture's exact terms (\[Chermain2019\] eq. 13-17).
 /// For the smoothed variant the sums run over the smoothing lobes instead, exactly as for a mixture:
 /// V(w) = Σ_j mass_j V_j(w) and A(w) = max(Σ_j mass_j (cos θ − w_xy·μ_j), 0), μ_j the centre slope
@@ -81,14 +84,24 @@ const SMOOTH_TAIL: f64 = 1e-6;
 /// ([`BinMapPatch::moment_bound_visible_area`]) and A by its signed projected area, so Λ is
 /// conservative (a Gaussian's V can be below a spiky distribution's with the same moments).
 ///
-/// **Sampling.** [`Ndf::sample_normal`]: a uniform point y of A from u, its texel (wrapped), the
-/// texel's bin through 𝓑, then a uniform direction in that bin (or a draw of the bin's smoothing
-/// lobe) from a second pair of numbers hashed from the bits of u. Its density is mass_j/|H| (or
-/// Σ mass_j D_j cos θ), returned by [`Ndf::pdf_normal`]; for the unsmoothed patch it differs from
-/// D(m) cos θ_m by the factor c̄_j / cos θ_m (1 on average over the bin). The bin map has no
-/// visible-normal sampler: [`Ndf::sample_visible`] draws from `sample_normal` and
-/// [`Ndf::pdf_visible`] returns `pdf_normal`, so a `MicrofacetBrdf` stays unbiased with either
-/// sampling mode (docs/binmap.md).
+/// **Sampling.** [`Ndf::sample_normal`]: a uniform point y of A from u, its sub-texel (wrapped),
+/// the sub-texel's bin through 𝓑, then a uniform direction in that bin (or a draw of the bin's
+/// smoothing lobe) from a second pair of numbers hashed from the bits of u. Its density is
+/// mass_j/|H| (or Σ mass_j D_j cos θ), returned by [`Ndf::pdf_normal`]; for the unsmoothed patch it
+/// differs from D(m) cos θ_m by the factor c̄_j / cos θ_m (1 on average over the bin).
+///
+/// [`Ndf::sample_visible`] (footprints with exact masking terms): the unsmoothed patch chooses bin j
+/// with probability s_j ν_j(wo) / Σ_k s_k ν_k(wo), s_j = mass_j / c̄_j, where ν_j is the mean of the
+/// bin's four corner values v = ⟨wo, corner⟩⁺ + ε (ε = 5 % of the bin's proven radius, so that the
+/// density is positive wherever ⟨wo, m⟩ > 0; bins with no direction facing wo get 0), then a point
+/// of the bin's cell with the bilinear density of v (the equal-area map turns it into a density per
+/// steradian by 1/|H|). ν_j approximates the bin's visible projected area (1/|H|) ∫⟨wo, m⟩⁺ to
+/// second order in the bin's size and the bilinear density approximates ⟨wo, m⟩⁺ within it, so the
+/// sample weight D ⟨wo, m⟩ / pdf is nearly constant; [`Ndf::pdf_visible`] returns this density
+/// exactly. The smoothed patch chooses lobe j ∝ mass_j V_j(wo) and draws its visible normal:
+/// density ⟨wo, m⟩⁺ Σ_j mass_j D_j(m) / Σ_j mass_j V_j(wo). Footprints above
+/// [`EXACT_MASKING_TEXELS`] (no bin list) and views nothing faces draw from `sample_normal`, with
+/// `pdf_normal` as their density. Cost O(bins of the footprint) per call. docs/binmap.md.
 ///
 /// Total: invalid directions give 0; a degenerate footprint falls back to a square of side
 /// [`MIN_WIDTH_TEXELS`].
