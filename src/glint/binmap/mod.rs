@@ -2,15 +2,18 @@
 //! bins, the inverse map bin → texels sorted into a forest of 2D kd-trees, and the P-NDF of a
 //! parallelogram footprint with constant filtering in texture and half-vector space.
 //!
-//! - [`BinMap::build`] assigns every texel the bin of its (texel-centre) normal (the bin map 𝓑),
-//!   counting-sorts the texels by bin into one array (the inverse bin map 𝓑⁻¹), builds one kd-tree per
-//!   list longer than the leaf size L, packed into one `u32` array, and a lookup bin → list
-//!   ([`BinLookup`]: dense offsets or a hash table of the non-empty bins).
+//! - [`BinMap::build`] splits every texel into s × s sub-texels ([`BinMapParams::subdivisions`]),
+//!   assigns every sub-texel the bin of the interpolated normal at its centre (the bin map 𝓑; s = 1:
+//!   the texel-centre normal, as in the talk), counting-sorts the sub-texels by bin into one array
+//!   (the inverse bin map 𝓑⁻¹), builds one kd-tree per list longer than the leaf size L, packed into
+//!   one `u32` array, and a lookup bin → list ([`BinLookup`]: dense offsets or a hash table of the
+//!   non-empty bins).
 //! - [`BinMap::patch`] turns a [`Footprint`] into a [`BinMapPatch`], an [`Ndf`](crate::ndf::Ndf) whose
 //!   D(h) = mass_j / (|H| · c̄_j) for the bin j ∋ h, where mass_j = Σ_k I_{H_j}(t_k) |A ∩ T_k| / |A| is
 //!   found through the bin's tree (whole nodes inside A count at once, boundary texels get their exact
 //!   clipped area) and c̄_j is the bin's mean cosine. [`BinMap::patch_smoothed`] spreads every bin's
-//!   mass with a Beckmann lobe.
+//!   mass with a Beckmann lobe. [`BinMap::patch_in`] builds the same patch in a reusable
+//!   [`BinMapScratch`] (no allocation per shading point).
 //!
 //! The conventions (mean cosine, periodic images, masking lobe, samplers) and the measurements are in
 //! docs/binmap.md.
@@ -62,9 +65,10 @@ pub const DEFAULT_LOOKUP: BinLookup = BinLookup::Dense;
 pub const MASKING_FIRST_LEVEL: usize = 2;
 
 /// Largest footprint (texels²) whose patch computes its masking terms from its own bins (one
-/// O(|A|) pass over the footprint's texels at patch construction, then O(bins in A) per direction);
-/// larger footprints use the filtered-moment lobe (O(1)). 4096 texels: measured in docs/results.md
-/// (white furnace with both, cost of the pass).
+/// O(s² |A|) pass over the footprint's sub-texels at patch construction, then O(bins in A) per
+/// direction) and has the visible-normal sampler; larger footprints use the filtered-moment lobe
+/// (O(1)) and the normal sampler. 4096 texels: measured in docs/results.md (white furnace with both,
+/// cost of the pass).
 pub const EXACT_MASKING_TEXELS: f32 = 4096.0;
 
 /// Build parameters of a [`BinMap`]. `Default` gives the documented `DEFAULT_*` values.
@@ -131,7 +135,8 @@ impl BinMapMemory {
 /// footprint A covered by texels whose normal t_k lies in the bin H ∋ h, per unit solid angle; the
 /// patches divide it by the bin's mean cosine so that ∫ D cos θ dω = 1 (docs/binmap.md).
 ///
-/// Stored: 𝓑 and 𝓑⁻¹ (4 + 4 bytes per texel), the forest (two `u32` per internal node), the lookup,
+/// Stored: 𝓑 and 𝓑⁻¹ (2 or 4 + 4 bytes per sub-texel, s² sub-texels per texel), the forest (two
+/// `u32` per internal node), the lookup,
 /// per-bin mean cosines and centre slopes, and the slope-moment mip chain from level
 /// [`MASKING_FIRST_LEVEL`] for the masking lobe (≈ 1.7 bytes per texel). The normal map itself is not
 /// kept. See [`BinMap::memory`].
