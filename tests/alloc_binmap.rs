@@ -96,7 +96,10 @@ fn patch_in_and_its_ndf_calls_allocate_nothing_after_warm_up() {
     // The counter works: the allocating path is seen.
     let before = allocations();
     sink += shade(&bm.patch(&footprints[1]));
-    assert!(allocations() > before, "the counter missed patch()'s allocations");
+    assert!(
+        allocations() > before,
+        "the counter missed patch()'s allocations"
+    );
     std::hint::black_box(sink);
 }
 

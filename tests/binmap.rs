@@ -65,10 +65,7 @@ fn expected_bin(map: &NormalMap, bins: &HemisphereBins, s: usize, k: usize) -> u
     }
     let gw = map.width() * s;
     let (i, j) = (k % gw, k / gw);
-    let p = Vec2::new(
-        (i as f32 + 0.5) / s as f32,
-        (j as f32 + 0.5) / s as f32,
-    );
+    let p = Vec2::new((i as f32 + 0.5) / s as f32, (j as f32 + 0.5) / s as f32);
     bins.bin_of(map.normal_at_texel(p)).unwrap()
 }
 
@@ -90,10 +87,7 @@ fn every_texel_in_exactly_one_bin_list() {
             )
             .unwrap();
             let texels = map.width() * map.height() * sub * sub;
-            assert_eq!(
-                bm.grid_size(),
-                (map.width() * sub, map.height() * sub)
-            );
+            assert_eq!(bm.grid_size(), (map.width() * sub, map.height() * sub));
             let mut seen = vec![0u32; texels];
             let mut total = 0;
             for bin in 0..bm.bins().len() {
@@ -834,7 +828,10 @@ fn grazing_table() {
     let maps = support::procedural_maps(256);
     println!("| map | bins | θo | furnace | ± | σ_w/E | lost | V / V_ref |");
     println!("|---|---|---|---|---|---|---|---|");
-    for (name, map) in maps.iter().filter(|(n, _)| *n == "bumpy" || *n == "scratched") {
+    for (name, map) in maps
+        .iter()
+        .filter(|(n, _)| *n == "bumpy" || *n == "scratched")
+    {
         for n in [63usize, 127] {
             let bm = BinMap::build(
                 map,
@@ -899,7 +896,10 @@ fn subtexel_binning_converges_to_the_interpolated_surface() {
         let bm = BinMap::build(&map, p).unwrap();
         let reference = binned_pndf(&map, &fp, Kernel::Parallelogram, bm.bins(), 1_000_000, 3);
         let tv = tv_distance(&bm.patch(&fp), &reference, 8);
-        println!("s = {sub}: TV {tv:.4} (reference noise {:.4})", reference.tv_error());
+        println!(
+            "s = {sub}: TV {tv:.4} (reference noise {:.4})",
+            reference.tv_error()
+        );
         tvs.push((tv, reference.tv_error()));
     }
     for w in tvs.windows(2) {
@@ -923,7 +923,13 @@ fn subtexel_binning_converges_to_the_interpolated_surface() {
 #[test]
 fn chi_square_of_the_visible_sampler() {
     let map = bumpy(64, 64, 0.25, 4.0, 1).unwrap();
-    let views = [(0.0, 0.0), (60.0, 210.0), (85.0, 210.0), (89.0, 210.0), (89.0, 30.0)];
+    let views = [
+        (0.0, 0.0),
+        (60.0, 210.0),
+        (85.0, 210.0),
+        (89.0, 210.0),
+        (89.0, 30.0),
+    ];
     let cases = [(63usize, 64.0f32, 1usize), (15, 16.0, 2)];
     let alpha = 1.0 - 0.99f64.powf(1.0 / (views.len() * cases.len()) as f64);
     for (n, area, sub) in cases {
@@ -933,7 +939,12 @@ fn chi_square_of_the_visible_sampler() {
         };
         let bm = BinMap::build(&map, p).unwrap();
         let bins = *bm.bins();
-        let patch = bm.patch(&Footprint::isotropic_texels(Vec2::new(0.37, 0.61), area, 64, 64));
+        let patch = bm.patch(&Footprint::isotropic_texels(
+            Vec2::new(0.37, 0.61),
+            area,
+            64,
+            64,
+        ));
         let g = 4usize;
         let side = n * g;
         for (theta, phi) in views {
@@ -945,10 +956,7 @@ fn chi_square_of_the_visible_sampler() {
                 let m = patch.sample_visible(wo, Vec2::new(rng.random(), rng.random()));
                 assert!(m.is_finite() && m.z > 0.0, "{m}");
                 let u = brdf::warp::hemisphere_to_square_equal_area(m) * side as f32;
-                let (i, j) = (
-                    (u.x as usize).min(side - 1),
-                    (u.y as usize).min(side - 1),
-                );
+                let (i, j) = ((u.x as usize).min(side - 1), (u.y as usize).min(side - 1));
                 counts[j * side + i] += 1.0;
             }
             let cell = bins.solid_angle() / (g * g) as f64;
@@ -965,7 +973,10 @@ fn chi_square_of_the_visible_sampler() {
                 .collect();
             let total: f64 = expected.iter().sum::<f64>() / draws as f64;
             // The pdf integrates to 1 (f32 pdf values summed over ≤ 10⁵ cells: 1e-4).
-            assert!((total - 1.0).abs() < 1e-4, "n={n} θo={theta}: ∫ pdf = {total}");
+            assert!(
+                (total - 1.0).abs() < 1e-4,
+                "n={n} θo={theta}: ∫ pdf = {total}"
+            );
             let p = chi2_pvalue(&counts, &expected);
             assert!(p > alpha, "n={n} θo={theta} φ={phi}: p = {p}");
         }
@@ -1003,7 +1014,11 @@ fn chi_square_of_the_smoothed_visible_sampler() {
 #[test]
 fn furnace_up_to_grazing_stays_below_one() {
     let maps = vec![
-        ("flat", NormalMap::from_slopes(1, 1, vec![Vec2::ZERO]).unwrap(), 16.0),
+        (
+            "flat",
+            NormalMap::from_slopes(1, 1, vec![Vec2::ZERO]).unwrap(),
+            16.0,
+        ),
         ("bumpy", bumpy(64, 64, 0.25, 4.0, 1).unwrap(), 64.0),
         (
             "scratched",
