@@ -93,19 +93,30 @@ fn patch_construction(c: &mut Criterion) {
     g.finish();
 }
 
-/// sample_visible + pdf_visible at a 64-texel footprint, against θo (azimuth 210°, where the
-/// benchmark patch faces the view); 1024 calls per iteration.
+/// sample_visible + pdf_visible against θo at a 64-texel footprint and against the footprint at
+/// θo = 60° (azimuth 210°, where the benchmark patch faces the view); 1024 calls per iteration. The
+/// sampler is O(bins of the footprint) per call.
 fn visible(c: &mut Criterion) {
     let map = bumpy(SIZE, SIZE, 0.25, 4.0, 1).unwrap();
     let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
-    let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), 64.0, SIZE, SIZE);
-    let patch = bm.patch(&fp);
-    let mut g = c.benchmark_group("binmap_sample_visible_2048_64texels");
-    g.throughput(Throughput::Elements(1024));
-    for theta in [0.0f32, 60.0, 89.0] {
+    let dir = |theta: f32| {
         let (t, p) = (theta.to_radians(), 210f32.to_radians());
-        let wo = Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
-        g.bench_with_input(BenchmarkId::from_parameter(theta), &wo, |b, &wo| {
+        Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+    };
+    let mut g = c.benchmark_group("binmap_sample_visible_2048");
+    g.throughput(Throughput::Elements(1024));
+    for (area, theta) in [
+        (64.0f32, 0.0f32),
+        (64.0, 60.0),
+        (64.0, 89.0),
+        (1024.0, 60.0),
+        (4096.0, 60.0),
+    ] {
+        let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, SIZE, SIZE);
+        let patch = bm.patch(&fp);
+        let wo = dir(theta);
+        let id = BenchmarkId::from_parameter(format!("{area}texels_{theta}deg"));
+        g.bench_with_input(id, &wo, |b, &wo| {
             b.iter(|| {
                 (0..1024)
                     .map(|k| {
