@@ -943,7 +943,7 @@ mod tests {
             let rho_q = EQUAL_AREA_LIPSCHITZ * std::f32::consts::FRAC_1_SQRT_2 / (n * q) as f32;
             let (mut ex_fine, mut ex_coarse, mut cut) = (0.0f64, 0.0f64, 0usize);
             while cut < 150 {
-                let theta = rng.random_range(1.2f32..1.5707);
+                let theta = rng.random_range(1.2f32..std::f32::consts::FRAC_PI_2);
                 let phi = rng.random_range(0.0f32..std::f32::consts::TAU);
                 let w = Vec3::new(
                     theta.sin() * phi.cos(),
