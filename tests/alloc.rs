@@ -10,6 +10,7 @@ use brdf::glint::{
     BeckmannMixture, BinMap, BinMapParams, Footprint, GlintModel, GlintNdf, GlintScratch,
     MaskingMode, MixtureParams, PatchOptions, PositionNormalMap, PositionNormalParams,
 };
+use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -20,10 +21,16 @@ thread_local! {
     static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
 }
 
+// SAFETY: forwards every call to the system allocator unchanged; only counts (a `const`
+// thread-local, which never allocates, so only this thread's allocations are seen).
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
         unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc_zeroed(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         unsafe { System.dealloc(ptr, layout) }
@@ -55,6 +62,12 @@ fn shade(model: &GlintModel, scratch: &mut GlintScratch, fp: &Footprint, k: usiz
         let wi = support::dir(20.0 + 10.0 * j as f64, 180.0 + 37.0 * k as f64);
         let (f, pdf) = brdf.eval_pdf(wo, wi);
         acc += f.x + pdf + brdf.pdf(wo, wi);
+        // Every `Ndf` call of the patch itself.
+        let ndf = brdf.ndf();
+        let (h, m) = (ndf.sample_visible(wo, u), ndf.sample_normal(u));
+        acc += ndf.d(h) + ndf.d(m) + ndf.pdf_visible(wo, h) + ndf.pdf_normal(m);
+        acc += ndf.lambda(wi).min(1e3) + ndf.projected_area(wi) + ndf.visible_area(wi);
+        acc += ndf.g1(wo, h) + ndf.g2(wo, wi, h) + ndf.g2_height_correlated(wo, wi, h);
     }
     acc
 }

@@ -132,10 +132,10 @@ struct BinMapMethod {
 
 impl Method for BinMapMethod {
     fn label(&self) -> String {
-        let n = self.map.params().bins_per_axis;
+        let (n, s) = (self.map.params().bins_per_axis, self.map.subdivisions());
         match self.smoothing {
-            None => format!("bin map (B = {n}²)"),
-            Some(a) => format!("bin map (B = {n}², smoothed α = {a})"),
+            None => format!("bin map (B = {n}², s = {s})"),
+            Some(a) => format!("bin map (B = {n}², s = {s}, smoothed α = {a})"),
         }
     }
     fn bytes_per_texel(&self) -> f64 {
@@ -155,12 +155,14 @@ impl Method for BinMapMethod {
     }
 }
 
-/// The bin map at B = 63², 127² (the default) and 255², and the default smoothed by α = 0.02.
+/// The bin map at B = 63², 127² (the default) and 255² with the default sub-texel resolution
+/// (s = 2), the talk's one normal per texel (127², s = 1), and the default smoothed by α = 0.02.
 fn binmap_methods(map: &NormalMap, _: &Settings) -> Res<Vec<Box<dyn Method>>> {
     let mut methods: Vec<Box<dyn Method>> = Vec::new();
-    for n in [63, 127, 255] {
+    for (n, s) in [(63, 2), (127, 1), (127, 2), (255, 2)] {
         let params = BinMapParams {
             bins_per_axis: n,
+            subdivisions: s,
             ..BinMapParams::default()
         };
         let bm = Arc::new(BinMap::build(map, params)?);
@@ -168,7 +170,7 @@ fn binmap_methods(map: &NormalMap, _: &Settings) -> Res<Vec<Box<dyn Method>>> {
             map: bm.clone(),
             smoothing: None,
         }));
-        if n == 127 {
+        if n == 127 && s == 2 {
             methods.push(Box::new(BinMapMethod {
                 map: bm,
                 smoothing: Some(0.02),

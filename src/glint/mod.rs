@@ -67,9 +67,9 @@ mod slope_tree;
 mod store;
 
 pub use binmap::{
-    BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, DEFAULT_BINS_PER_AXIS,
-    DEFAULT_LEAF_SIZE, DEFAULT_LOOKUP, DEFAULT_MASKING_SIGMA_MIN, EXACT_MASKING_TEXELS,
-    MASKING_FIRST_LEVEL, QueryStats,
+    BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch,
+    DEFAULT_BINS_PER_AXIS, DEFAULT_LEAF_SIZE, DEFAULT_LOOKUP, DEFAULT_MASKING_SIGMA_MIN,
+    DEFAULT_SUBDIVISIONS, EXACT_MASKING_TEXELS, MASKING_FIRST_LEVEL, MAX_SUBDIVISIONS, QueryStats,
 };
 pub use bins::HemisphereBins;
 pub use flakes::{

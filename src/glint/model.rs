@@ -102,10 +102,9 @@ impl GlintNdf for GlintModel {
     fn patch_in<'a>(&'a self, footprint: &Footprint, scratch: &'a mut GlintScratch) -> GlintPatch<'a> {
         match self {
             GlintModel::Mixture(m) => GlintPatch::Mixture(m.patch_in(footprint, scratch)),
-            // TODO(merge issue 17): the bin map's allocation-free patch.
-            GlintModel::BinMap(m) => GlintPatch::BinMap(m.patch(footprint)),
+            GlintModel::BinMap(m) => GlintPatch::BinMap(m.patch_in(footprint, scratch)),
             GlintModel::SmoothedBinMap { map, alpha } => {
-                GlintPatch::BinMap(map.patch_smoothed(footprint, *alpha))
+                GlintPatch::BinMap(map.patch_smoothed_in(footprint, *alpha, scratch))
             }
             GlintModel::PositionNormal(m) => {
                 GlintPatch::PositionNormal(m.patch_in(footprint, scratch))

@@ -34,6 +34,7 @@ use std::sync::{Mutex, OnceLock};
 #[derive(Debug, Default)]
 pub struct GlintScratch {
     pub(crate) mixture: crate::glint::mixture::MixtureScratch,
+    pub(crate) bin_map: crate::glint::binmap::BinMapScratch,
     pub(crate) position_normal: crate::glint::flakes::PositionNormalScratch,
 }
 

@@ -2,15 +2,18 @@
 //! bins, the inverse map bin → texels sorted into a forest of 2D kd-trees, and the P-NDF of a
 //! parallelogram footprint with constant filtering in texture and half-vector space.
 //!
-//! - [`BinMap::build`] assigns every texel the bin of its (texel-centre) normal (the bin map 𝓑),
-//!   counting-sorts the texels by bin into one array (the inverse bin map 𝓑⁻¹), builds one kd-tree per
-//!   list longer than the leaf size L, packed into one `u32` array, and a lookup bin → list
-//!   ([`BinLookup`]: dense offsets or a hash table of the non-empty bins).
+//! - [`BinMap::build`] splits every texel into s × s sub-texels ([`BinMapParams::subdivisions`]),
+//!   assigns every sub-texel the bin of the interpolated normal at its centre (the bin map 𝓑; s = 1:
+//!   the texel-centre normal, as in the talk), counting-sorts the sub-texels by bin into one array
+//!   (the inverse bin map 𝓑⁻¹), builds one kd-tree per list longer than the leaf size L, packed into
+//!   one `u32` array, and a lookup bin → list ([`BinLookup`]: dense offsets or a hash table of the
+//!   non-empty bins).
 //! - [`BinMap::patch`] turns a [`Footprint`] into a [`BinMapPatch`], an [`Ndf`](crate::ndf::Ndf) whose
 //!   D(h) = mass_j / (|H| · c̄_j) for the bin j ∋ h, where mass_j = Σ_k I_{H_j}(t_k) |A ∩ T_k| / |A| is
 //!   found through the bin's tree (whole nodes inside A count at once, boundary texels get their exact
 //!   clipped area) and c̄_j is the bin's mean cosine. [`BinMap::patch_smoothed`] spreads every bin's
-//!   mass with a Beckmann lobe.
+//!   mass with a Beckmann lobe. [`BinMap::patch_in`] builds the same patch in a caller's reusable
+//!   [`GlintScratch`](crate::glint::GlintScratch) (no allocation per shading point).
 //!
 //! The conventions (mean cosine, periodic images, masking lobe, samplers) and the measurements are in
 //! docs/binmap.md.
@@ -24,11 +27,12 @@ mod store;
 pub use forest::QueryStats;
 pub use lookup::BinLookup;
 pub use patch::BinMapPatch;
+pub(crate) use patch::BinMapScratch;
 
 use super::moments::MomentPyramid;
 use crate::error::{Error, Result};
 use crate::frame::{normal_to_slope, slope_to_normal};
-use crate::glint::{Footprint, GlintNdf, HemisphereBins, NormalMap};
+use crate::glint::{Footprint, GlintNdf, GlintScratch, HemisphereBins, NormalMap};
 use forest::{NO_TREE, TreeView};
 use glam::{Vec2, Vec3};
 use lookup::Table;
@@ -45,6 +49,15 @@ pub const DEFAULT_LEAF_SIZE: usize = 16;
 /// Default floor σ_ε of the masking lobe's slope standard deviation (see [`BinMapParams::sigma_min`]).
 pub const DEFAULT_MASKING_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
 
+/// Default sub-texel resolution s: each texel is binned as s × s sub-texels of the interpolated
+/// surface. 2 was chosen from accuracy against memory on the procedural maps (docs/results.md,
+/// "Sub-texel binning"): at ≥ 256 texels it lowers the TV distance to the ground truth 1.5-3× for
+/// 2.6× the memory; s = 4 gains less again for 9× the memory.
+pub const DEFAULT_SUBDIVISIONS: usize = 2;
+
+/// Largest accepted sub-texel resolution s (s² sub-texels per texel).
+pub const MAX_SUBDIVISIONS: usize = 16;
+
 /// Default lookup: measured faster than the hash table at 2048² (docs/results.md).
 pub const DEFAULT_LOOKUP: BinLookup = BinLookup::Dense;
 
@@ -54,9 +67,10 @@ pub const DEFAULT_LOOKUP: BinLookup = BinLookup::Dense;
 pub const MASKING_FIRST_LEVEL: usize = 2;
 
 /// Largest footprint (texels²) whose patch computes its masking terms from its own bins (one
-/// O(|A|) pass over the footprint's texels at patch construction, then O(bins in A) per direction);
-/// larger footprints use the filtered-moment lobe (O(1)). 4096 texels: measured in docs/results.md
-/// (white furnace with both, cost of the pass).
+/// O(s² |A|) pass over the footprint's sub-texels at patch construction, then O(bins in A) per
+/// direction) and has the visible-normal sampler; larger footprints use the filtered-moment lobe
+/// (O(1)) and the normal sampler. 4096 texels: measured in docs/results.md (white furnace with both,
+/// cost of the pass).
 pub const EXACT_MASKING_TEXELS: f32 = 4096.0;
 
 /// Build parameters of a [`BinMap`]. `Default` gives the documented `DEFAULT_*` values.
@@ -72,6 +86,12 @@ pub struct BinMapParams {
     /// Floor σ_ε (> 0) of the slope standard deviation of the masking lobe (the footprint's
     /// filtered-moment Beckmann lobe, see [`BinMapPatch`]).
     pub sigma_min: f32,
+    /// Sub-texel resolution s, 1 ≤ s ≤ [`MAX_SUBDIVISIONS`]: every texel is split into s × s
+    /// sub-texels, each a flat facet carrying the interpolated surface's normal at its centre
+    /// ([`NormalMap::normal_at_texel`]); the bin map, the inverse map and the forest work on the
+    /// (s·width) × (s·height) sub-texel grid. s = 1 is the talk's one-normal-per-texel map. Memory
+    /// of 𝓑, 𝓑⁻¹ and the forest grows as s².
+    pub subdivisions: usize,
 }
 
 impl Default for BinMapParams {
@@ -81,6 +101,7 @@ impl Default for BinMapParams {
             leaf_size: DEFAULT_LEAF_SIZE,
             lookup: DEFAULT_LOOKUP,
             sigma_min: DEFAULT_MASKING_SIGMA_MIN,
+            subdivisions: DEFAULT_SUBDIVISIONS,
         }
     }
 }
@@ -88,9 +109,9 @@ impl Default for BinMapParams {
 /// Bytes held by a [`BinMap`], per part.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BinMapMemory {
-    /// The bin map 𝓑: one `u32` per texel.
+    /// The bin map 𝓑: one `u16` (B ≤ 65 536 bins) or `u32` per sub-texel.
     pub bin_map: usize,
-    /// The inverse bin map 𝓑⁻¹: one `u32` per texel.
+    /// The inverse bin map 𝓑⁻¹: one `u32` per sub-texel.
     pub inverse: usize,
     /// The packed forest: two `u32` per internal node.
     pub forest: usize,
@@ -116,7 +137,8 @@ impl BinMapMemory {
 /// footprint A covered by texels whose normal t_k lies in the bin H ∋ h, per unit solid angle; the
 /// patches divide it by the bin's mean cosine so that ∫ D cos θ dω = 1 (docs/binmap.md).
 ///
-/// Stored: 𝓑 and 𝓑⁻¹ (4 + 4 bytes per texel), the forest (two `u32` per internal node), the lookup,
+/// Stored: 𝓑 and 𝓑⁻¹ (2 or 4 + 4 bytes per sub-texel, s² sub-texels per texel), the forest (two
+/// `u32` per internal node), the lookup,
 /// per-bin mean cosines and centre slopes, and the slope-moment mip chain from level
 /// [`MASKING_FIRST_LEVEL`] for the masking lobe (≈ 1.7 bytes per texel). The normal map itself is not
 /// kept. See [`BinMap::memory`].
@@ -129,7 +151,10 @@ pub struct BinMap {
     height: usize,
     bins: HemisphereBins,
     params: BinMapParams,
-    bin_map: Vec<u32>,
+    /// The sub-texel grid: (s·width) × (s·height) elements, element (I, J) at index J·grid_w + I.
+    grid_w: usize,
+    grid_h: usize,
+    bin_map: BinIndex,
     inverse: Vec<u32>,
     nodes: Vec<u32>,
     table: Table,
@@ -206,6 +231,54 @@ impl BinFacet {
     }
 }
 
+/// 𝓑, one bin index per sub-texel, in the narrowest integer type that holds every bin.
+#[derive(Clone, Debug)]
+pub(super) enum BinIndex {
+    U16(Vec<u16>),
+    U32(Vec<u32>),
+}
+
+impl BinIndex {
+    fn new(bins: usize, elements: usize) -> BinIndex {
+        if bins <= 1 << 16 {
+            BinIndex::U16(vec![0; elements])
+        } else {
+            BinIndex::U32(vec![0; elements])
+        }
+    }
+
+    #[inline]
+    pub(super) fn get(&self, k: usize) -> Option<usize> {
+        match self {
+            BinIndex::U16(v) => v.get(k).map(|&b| b as usize),
+            BinIndex::U32(v) => v.get(k).map(|&b| b as usize),
+        }
+    }
+
+    /// Fills row `j` (of width `w`) with `f(I)`, in parallel over rows.
+    fn fill(&mut self, w: usize, f: impl Fn(usize, usize) -> usize + Sync) {
+        match self {
+            BinIndex::U16(v) => v.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
+                for (i, b) in row.iter_mut().enumerate() {
+                    *b = f(i, j) as u16;
+                }
+            }),
+            BinIndex::U32(v) => v.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
+                for (i, b) in row.iter_mut().enumerate() {
+                    *b = f(i, j) as u32;
+                }
+            }),
+        }
+    }
+
+    fn bytes(&self) -> usize {
+        match self {
+            BinIndex::U16(v) => 2 * v.len(),
+            BinIndex::U32(v) => 4 * v.len(),
+        }
+    }
+}
+
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> Error {
     Error::InvalidParameter {
         name,
@@ -233,6 +306,13 @@ fn check_params(params: &BinMapParams) -> Result<HemisphereBins> {
     if params.leaf_size == 0 {
         return Err(invalid("leaf_size", 0.0, "must be at least 1"));
     }
+    if !(1..=MAX_SUBDIVISIONS).contains(&params.subdivisions) {
+        return Err(invalid(
+            "subdivisions",
+            params.subdivisions as f64,
+            "must be in 1..=16",
+        ));
+    }
     if !(params.sigma_min.is_finite() && params.sigma_min > 0.0) {
         return Err(invalid(
             "sigma_min",
@@ -246,47 +326,61 @@ fn check_params(params: &BinMapParams) -> Result<HemisphereBins> {
 impl BinMap {
     /// Builds the bin map, the inverse bin map, its forest and lookup from a normal map.
     ///
-    /// 𝓑(k) = the bin of texel k's normal normalize(−x̃, −ỹ, 1) (the texel-centre normal: the
-    /// talk's piecewise-constant map, each texel a flat facet); 𝓑⁻¹ by counting sort (texels in
-    /// row-major order within a bin before the trees reorder them); one kd-tree per list longer than
-    /// `leaf_size`. Cost O(texels · log) single-threaded, plus the moment chain.
+    /// The map is split into s × s sub-texels (s = `subdivisions`); sub-texel (I, J) of the
+    /// (s·width) × (s·height) grid covers [I/s, (I + 1)/s) × [J/s, (J + 1)/s) in texel units and is a
+    /// flat facet with the interpolated surface's normal at its centre,
+    /// [`NormalMap::normal_at_texel`]((I + ½)/s, (J + ½)/s) (for s = 1 the texel-centre normal: the
+    /// talk's piecewise-constant map). 𝓑(k) = the bin of sub-texel k's normal; 𝓑⁻¹ by counting sort
+    /// (sub-texels in row-major order within a bin before the trees reorder them); one kd-tree per
+    /// list longer than `leaf_size`. Cost O(s² · texels · log), the normals in parallel.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `bins_per_axis` (even, 0 or > 4096), `leaf_size` (0) or
-    /// `sigma_min` (non-finite or ≤ 0); [`Error::InvalidSize`] for maps of 2³² texels or more (texel
-    /// indices are `u32`).
+    /// [`Error::InvalidParameter`] naming `bins_per_axis` (even, 0 or > 4096), `leaf_size` (0),
+    /// `subdivisions` (0 or > [`MAX_SUBDIVISIONS`]) or `sigma_min` (non-finite or ≤ 0);
+    /// [`Error::InvalidSize`] for maps of 2³² sub-texels or more (indices are `u32`).
     pub fn build(map: &NormalMap, params: BinMapParams) -> Result<BinMap> {
         let bins = check_params(&params)?;
         let (width, height) = (map.width(), map.height());
-        let texels = width * height;
-        if texels >= u32::MAX as usize {
-            return Err(Error::InvalidSize {
+        let s = params.subdivisions;
+        let (grid_w, grid_h) = (width * s, height * s);
+        let texels = grid_w
+            .checked_mul(grid_h)
+            .filter(|&t| t < u32::MAX as usize)
+            .ok_or(Error::InvalidSize {
                 width,
                 height,
-                reason: "the bin map needs fewer than 2^32 texels",
-            });
-        }
+                reason: "the bin map needs fewer than 2^32 sub-texels (width · height · s²)",
+            })?;
         let nb = bins.len();
-        // 𝓑: every stored slope is finite with z > 0, so `bin_of` succeeds; the pole bin guards it.
+        // 𝓑: every interpolated normal is finite with z > 0, so `bin_of` succeeds; the pole bin
+        // guards it.
         let pole = bins.bin_of(glam::Vec3::Z).unwrap_or(0);
-        let bin_map: Vec<u32> = map
-            .slopes()
-            .iter()
-            .map(|&s| bins.bin_of(slope_to_normal(s)).unwrap_or(pole) as u32)
-            .collect();
+        let mut bin_map = BinIndex::new(nb, texels);
+        let sf = s as f32;
+        bin_map.fill(grid_w, |i, j| {
+            let p = Vec2::new((i as f32 + 0.5) / sf, (j as f32 + 0.5) / sf);
+            let n = if s == 1 {
+                // Exactly the stored texel normal (no interpolation round-off).
+                slope_to_normal(map.slopes()[j * width + i])
+            } else {
+                map.normal_at_texel(p)
+            };
+            bins.bin_of(n).unwrap_or(pole)
+        });
         // 𝓑⁻¹ by counting sort.
         let mut offsets = vec![0u32; nb + 1];
-        for &b in &bin_map {
-            offsets[b as usize + 1] += 1;
+        for k in 0..texels {
+            offsets[bin_map.get(k).unwrap_or(pole) + 1] += 1;
         }
         for b in 0..nb {
             offsets[b + 1] += offsets[b];
         }
         let mut cursor: Vec<u32> = offsets[..nb].to_vec();
         let mut inverse = vec![0u32; texels];
-        for (k, &b) in bin_map.iter().enumerate() {
-            inverse[cursor[b as usize] as usize] = k as u32;
-            cursor[b as usize] += 1;
+        for k in 0..texels {
+            let b = bin_map.get(k).unwrap_or(pole);
+            inverse[cursor[b] as usize] = k as u32;
+            cursor[b] += 1;
         }
         // The forest.
         let mut nodes = Vec::new();
@@ -297,8 +391,8 @@ impl BinMap {
                 roots[b] = forest::build_tree(
                     &mut inverse[s..e],
                     s,
-                    width,
-                    height,
+                    grid_w,
+                    grid_h,
                     params.leaf_size,
                     &mut nodes,
                 );
@@ -326,6 +420,8 @@ impl BinMap {
             height,
             bins,
             params,
+            grid_w,
+            grid_h,
             bin_map,
             inverse,
             nodes,
@@ -356,12 +452,23 @@ impl BinMap {
         &self.params
     }
 
-    /// 𝓑(k): the bin of texel k = j · width + i (row major); `None` out of range.
-    pub fn bin_of_texel(&self, k: usize) -> Option<usize> {
-        self.bin_map.get(k).map(|&b| b as usize)
+    /// The sub-texel resolution s ([`BinMapParams::subdivisions`]).
+    pub fn subdivisions(&self) -> usize {
+        self.params.subdivisions
     }
 
-    /// 𝓑⁻¹(j): the texel indices of bin j, in the forest's order (empty for an empty or
+    /// The sub-texel grid (s·width, s·height): the elements that 𝓑, 𝓑⁻¹ and the forest index.
+    pub fn grid_size(&self) -> (usize, usize) {
+        (self.grid_w, self.grid_h)
+    }
+
+    /// 𝓑(k): the bin of sub-texel k = J · (s·width) + I (row major on the sub-texel grid; the texel
+    /// index when s = 1); `None` out of range.
+    pub fn bin_of_texel(&self, k: usize) -> Option<usize> {
+        self.bin_map.get(k)
+    }
+
+    /// 𝓑⁻¹(j): the sub-texel indices of bin j, in the forest's order (empty for an empty or
     /// out-of-range bin).
     pub fn texels_of_bin(&self, bin: usize) -> &[u32] {
         self.table
@@ -401,7 +508,7 @@ impl BinMap {
     /// Bytes held, per part.
     pub fn memory(&self) -> BinMapMemory {
         BinMapMemory {
-            bin_map: 4 * self.bin_map.len(),
+            bin_map: self.bin_map.bytes(),
             inverse: 4 * self.inverse.len(),
             forest: 4 * self.nodes.len(),
             lookup: self.table.bytes(),
@@ -411,9 +518,21 @@ impl BinMap {
         }
     }
 
-    /// The patch of a footprint, with the bin-resolution P-NDF ([`BinMapPatch`]).
+    /// The patch of a footprint, with the bin-resolution P-NDF ([`BinMapPatch`]). Allocates its
+    /// buffers; [`BinMap::patch_in`] reuses a caller's.
     pub fn patch(&self, footprint: &Footprint) -> BinMapPatch<'_> {
-        BinMapPatch::new(self, footprint, None)
+        BinMapPatch::new(self, footprint, None, None)
+    }
+
+    /// [`BinMap::patch`] with the patch's buffers borrowed from `scratch`: after one warm-up call of
+    /// a size at least as large, neither this call nor any [`Ndf`](crate::ndf::Ndf) method of the
+    /// patch allocates (tests/alloc.rs). The patch is the same as [`BinMap::patch`]'s.
+    pub fn patch_in<'a>(
+        &'a self,
+        footprint: &Footprint,
+        scratch: &'a mut GlintScratch,
+    ) -> BinMapPatch<'a> {
+        BinMapPatch::new(self, footprint, None, Some(&mut scratch.bin_map))
     }
 
     /// The patch of a footprint whose every bin's mass is spread by a Beckmann lobe of roughness
@@ -426,15 +545,27 @@ impl BinMap {
     /// \[Atanasov2020\] itself has one-bin angular resolution.
     pub fn patch_smoothed(&self, footprint: &Footprint, alpha: f32) -> BinMapPatch<'_> {
         let alpha = (alpha.is_finite() && alpha > 0.0).then(|| alpha.max(crate::ndf::MIN_ALPHA));
-        BinMapPatch::new(self, footprint, alpha)
+        BinMapPatch::new(self, footprint, alpha, None)
+    }
+
+    /// [`BinMap::patch_smoothed`] with the buffers borrowed from `scratch` (see
+    /// [`BinMap::patch_in`]).
+    pub fn patch_smoothed_in<'a>(
+        &'a self,
+        footprint: &Footprint,
+        alpha: f32,
+        scratch: &'a mut GlintScratch,
+    ) -> BinMapPatch<'a> {
+        let alpha = (alpha.is_finite() && alpha > 0.0).then(|| alpha.max(crate::ndf::MIN_ALPHA));
+        BinMapPatch::new(self, footprint, alpha, Some(&mut scratch.bin_map))
     }
 
     fn tree_view(&self) -> TreeView<'_> {
         TreeView {
             inverse: &self.inverse,
             nodes: &self.nodes,
-            width: self.width as u32,
-            height: self.height as u32,
+            width: self.grid_w as u32,
+            height: self.grid_h as u32,
             leaf: self.params.leaf_size,
         }
     }
@@ -446,6 +577,11 @@ impl GlintNdf for BinMap {
     /// [`BinMap::patch`].
     fn patch(&self, footprint: &Footprint) -> BinMapPatch<'_> {
         BinMap::patch(self, footprint)
+    }
+
+    /// [`BinMap::patch_in`].
+    fn patch_in<'a>(&'a self, footprint: &Footprint, scratch: &'a mut GlintScratch) -> BinMapPatch<'a> {
+        BinMap::patch_in(self, footprint, scratch)
     }
 }
 

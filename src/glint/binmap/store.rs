@@ -1,7 +1,8 @@
 //! Saving and loading a built [`BinMap`] (format: docs/format.md, kind 4).
 //!
-//! Stored: the map size, the build parameters, the bin map 𝓑 (u32 per texel), the inverse bin map 𝓑⁻¹
-//! in the forest's order (u32 per texel), the prefix-sum offsets of the bins' lists (B + 1) and their
+//! Stored: the map size, the build parameters (sub-texel resolution s included), the bin map 𝓑 (u32
+//! per sub-texel of the (s·width) × (s·height) grid), the inverse bin map 𝓑⁻¹ in the forest's order
+//! (u32 per sub-texel), the prefix-sum offsets of the bins' lists (B + 1) and their
 //! tree roots (B), the packed forest, and the coarse slope-moment chain of the masking lobe. Rebuilt
 //! on load (cheap, by the build's own routines): the per-bin tables (centre slopes, masking facets) and
 //! the lookup (dense or hash) from the offsets and roots.
@@ -16,7 +17,9 @@
 
 use super::forest::NO_TREE;
 use super::lookup::Table;
-use super::{BinFacet, BinLookup, BinMap, BinMapParams, MASKING_FIRST_LEVEL, check_params};
+use super::{
+    BinFacet, BinIndex, BinLookup, BinMap, BinMapParams, MASKING_FIRST_LEVEL, check_params,
+};
 use crate::Result;
 use crate::frame::normal_to_slope;
 use crate::glint::MAX_SLOPE;
@@ -55,12 +58,16 @@ impl BinMap {
             e.len(self.height)?;
             e.len(p.bins_per_axis)?;
             e.len(p.leaf_size)?;
+            e.len(p.subdivisions)?;
             e.put(match p.lookup {
                 BinLookup::Dense => 0u32,
                 BinLookup::Hash => 1u32,
             })?;
             e.put(p.sigma_min)?;
-            e.array(self.bin_map.iter().map(|&b| [b]))?;
+            match &self.bin_map {
+                BinIndex::U16(v) => e.array(v.iter().map(|&b| [b as u32]))?,
+                BinIndex::U32(v) => e.array(v.iter().map(|&b| [b]))?,
+            }
             e.array(self.inverse.iter().map(|&k| [k]))?;
             e.array(offsets.iter().map(|&o| [o]))?;
             e.array(entries.iter().map(|&(_, root)| [root]))?;
@@ -93,6 +100,7 @@ impl BinMap {
         let params = BinMapParams {
             bins_per_axis: d.len("bins_per_axis", usize::MAX)?,
             leaf_size: d.len("leaf_size", usize::MAX)?,
+            subdivisions: d.len("subdivisions", usize::MAX)?,
             lookup: match d.get::<u32>("lookup")? {
                 0 => BinLookup::Dense,
                 1 => BinLookup::Hash,
@@ -102,12 +110,14 @@ impl BinMap {
         };
         let refused = |e: crate::Error| invalid(format!("stored bin map refused: {e}"));
         let bins = check_params(&params).map_err(refused)?;
-        let texels =
-            crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))
-                .map_err(refused)?;
+        crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))
+            .map_err(refused)?;
+        let s = params.subdivisions;
+        let (grid_w, grid_h) = (width * s, height * s);
+        let texels = grid_w.saturating_mul(grid_h);
         if texels >= u32::MAX as usize {
             return Err(invalid(format!(
-                "{texels} texels: the bin map needs fewer than 2^32"
+                "{texels} sub-texels: the bin map needs fewer than 2^32"
             )));
         }
         let nb = bins.len();
@@ -162,7 +172,7 @@ impl BinMap {
             &offsets,
             &roots,
             &nodes,
-            [width, height],
+            [grid_w, grid_h],
             params.leaf_size,
         )?;
         let facets = (0..nb)
@@ -178,11 +188,19 @@ impl BinMap {
         let center_slope = (0..nb)
             .map(|b| normal_to_slope(bins.center(b)).unwrap_or(Vec2::ZERO))
             .collect();
+        // The builder's storage choice (u16 when every bin fits).
+        let bin_map = if nb <= 1 << 16 {
+            BinIndex::U16(bin_map.iter().map(|&b| b as u16).collect())
+        } else {
+            BinIndex::U32(bin_map)
+        };
         Ok(BinMap {
             width,
             height,
             bins,
             params,
+            grid_w,
+            grid_h,
             bin_map,
             inverse,
             nodes,
