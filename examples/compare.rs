@@ -33,10 +33,7 @@ mod tests {
             assert!(r.patch_s > 0.0 && r.d_s > 0.0 && r.eval_s > 0.0, "{r:?}");
         }
         for r in &results.view {
-            assert!(
-                r.v_rel_error.is_finite() && r.furnace.is_finite(),
-                "{r:?}"
-            );
+            assert!(r.v_rel_error.is_finite() && r.furnace.is_finite(), "{r:?}");
             // Every model except the published position-normal BRDF (the compare's
             // "position-normal" rows) conserves energy in the renderer's measure (Monte Carlo with
             // 64 samples: a generous 10 % for the noise).

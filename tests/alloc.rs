@@ -117,7 +117,12 @@ fn shading_allocates_nothing_after_warm_up() {
         }
         let n = allocations() - before;
         assert!(sink.is_finite());
-        assert_eq!(n, 0, "{}: {n} allocations in 40 shading points", model.name());
+        assert_eq!(
+            n,
+            0,
+            "{}: {n} allocations in 40 shading points",
+            model.name()
+        );
     }
 }
 

@@ -402,9 +402,7 @@ fn albedo<N: Ndf>(brdf: &MicrofacetBrdf<N, NoFresnel>, wo: Vec3, n: usize) -> (f
     let (mut sum, mut sum2) = (0.0, 0.0);
     for k in 0..n {
         let u = Vec2::new((k as f32 + rng.random::<f32>()) / n as f32, rng.random());
-        let v = brdf
-            .sample(wo, 0.5, u)
-            .map_or(0.0, |s| s.weight().x as f64);
+        let v = brdf.sample(wo, 0.5, u).map_or(0.0, |s| s.weight().x as f64);
         sum += v;
         sum2 += v * v;
     }

@@ -853,7 +853,10 @@ fn reciprocal_models() {
         // A tilted lobe is reciprocal in its own measure: f(wo, wi) cos θi / A(wi) is symmetric.
         let sg = MicrofacetBrdf::new(slope_gaussian(), NoFresnel).with_masking(masking);
         let a = |w: Vec3| slope_gaussian().projected_area(w);
-        let patch_measure = PatchMeasure { brdf: &sg, area: &a };
+        let patch_measure = PatchMeasure {
+            brdf: &sg,
+            area: &a,
+        };
         assert_reciprocal(&format!("slope gaussian {masking:?}"), &patch_measure);
         for (name, b) in crate_microfacets(0.3, masking, Sampling::VisibleNormals) {
             assert_reciprocal(&format!("{name} {masking:?}"), b.as_ref());

@@ -65,7 +65,10 @@ fn white_base_furnace_is_at_most_one_and_close_to_it() {
         for theta in [0.0, 30.0, 60.0, 75.0, 85.0, 89.0] {
             let wo = support::dir(theta, 20.0);
             let (e, se) = furnace(&layered, wo, 20_000);
-            assert!(e <= 1.0 + 4.0 * se + 2e-3, "α={alpha} θo={theta}: {e} ± {se}");
+            assert!(
+                e <= 1.0 + 4.0 * se + 2e-3,
+                "α={alpha} θo={theta}: {e} ± {se}"
+            );
             let r = layered.first_bounce_reflectance(wo).x as f64;
             let es = coat_albedo(layered.specular(), wo);
             // E = E_s + (1 − R̂): lower than 1 exactly by R̂ − E_s (the coat's masking loss).
@@ -120,8 +123,8 @@ fn glint_over_base_conserves_energy_and_agrees_with_itself() {
     for area in [1.0f32, 64.0] {
         let fp = Footprint::isotropic_texels(Vec2::new(0.4, 0.6), area, 32, 32);
         let patch = model.patch(&fp);
-        let b = LayeredBrdf::new(MicrofacetBrdf::new(&patch, gold), Vec3::new(0.9, 0.5, 0.2))
-            .unwrap();
+        let b =
+            LayeredBrdf::new(MicrofacetBrdf::new(&patch, gold), Vec3::new(0.9, 0.5, 0.2)).unwrap();
         for theta in [0.0, 50.0, 85.0, 89.9] {
             let wo = support::dir(theta, 10.0);
             let (e, se) = furnace(&b, wo, 8_000);
@@ -166,11 +169,26 @@ fn chi_square_of_the_layered_sampler() {
     let glint = LayeredBrdf::new(MicrofacetBrdf::new(&patch, schlick), Vec3::splat(0.5)).unwrap();
     let mut cases: Vec<(String, &dyn Bxdf, Vec3, usize)> = vec![];
     for theta in [0.0, 45.0, 75.0] {
-        cases.push((format!("layered ggx θo={theta}"), &ggx, support::dir(theta, 30.0), 1_000_000));
+        cases.push((
+            format!("layered ggx θo={theta}"),
+            &ggx,
+            support::dir(theta, 30.0),
+            1_000_000,
+        ));
     }
-    cases.push(("layered iso ggx θo=89".into(), &ggx_iso, support::dir(89.0, 30.0), 1_000_000));
+    cases.push((
+        "layered iso ggx θo=89".into(),
+        &ggx_iso,
+        support::dir(89.0, 30.0),
+        1_000_000,
+    ));
     for theta in [20.0, 70.0] {
-        cases.push((format!("layered glint θo={theta}"), &glint, support::dir(theta, 30.0), 200_000));
+        cases.push((
+            format!("layered glint θo={theta}"),
+            &glint,
+            support::dir(theta, 30.0),
+            200_000,
+        ));
     }
     let family = cases.len();
     let failures: Vec<String> = cases
@@ -180,7 +198,10 @@ fn chi_square_of_the_layered_sampler() {
                 samples: *n,
                 ..Chi2::new(name, family)
             }
-            .run(|uc, u| b.sample(*wo, uc, u).map(|s| s.wi), |w| b.pdf(*wo, w) as f64)
+            .run(
+                |uc, u| b.sample(*wo, uc, u).map(|s| s.wi),
+                |w| b.pdf(*wo, w) as f64,
+            )
             .err()
         })
         .collect();
@@ -190,7 +211,11 @@ fn chi_square_of_the_layered_sampler() {
 #[test]
 fn rejects_a_bad_base() {
     let coat = MicrofacetBrdf::new(Ggx::isotropic(0.2).unwrap(), NoFresnel);
-    for bad in [Vec3::new(1.2, 0.5, 0.5), Vec3::new(0.5, f32::NAN, 0.5), Vec3::splat(-0.1)] {
+    for bad in [
+        Vec3::new(1.2, 0.5, 0.5),
+        Vec3::new(0.5, f32::NAN, 0.5),
+        Vec3::splat(-0.1),
+    ] {
         let e = LayeredBrdf::new(coat, bad).unwrap_err();
         assert!(e.to_string().contains("base"), "{e}");
     }

@@ -117,7 +117,10 @@ impl Models {
         f("mixture exact", &self.mixture_exact.patch(fp));
         f("mixture approximate", &self.mixture_approx.patch(fp));
         f("bin map", &self.bin_map.patch(fp));
-        f("bin map smoothed", &self.bin_map.patch_smoothed(fp, SMOOTHING));
+        f(
+            "bin map smoothed",
+            &self.bin_map.patch_smoothed(fp, SMOOTHING),
+        );
         f("position-normal", &self.position_normal.patch(fp));
     }
 }
@@ -128,9 +131,18 @@ fn furnaces(patch: &dyn Ndf, wo: Vec3, n: usize) -> Vec<(String, (f64, f64))> {
     let hc = MicrofacetBrdf::new(patch, NoFresnel);
     let sep = hc.with_masking(Masking::Separable);
     vec![
-        ("height-correlated weight".into(), furnace_by_weight(&hc, wo, n, 11)),
-        ("height-correlated eval".into(), furnace_by_eval(&hc, wo, n, 12)),
-        ("separable weight".into(), furnace_by_weight(&sep, wo, n, 13)),
+        (
+            "height-correlated weight".into(),
+            furnace_by_weight(&hc, wo, n, 11),
+        ),
+        (
+            "height-correlated eval".into(),
+            furnace_by_eval(&hc, wo, n, 12),
+        ),
+        (
+            "separable weight".into(),
+            furnace_by_weight(&sep, wo, n, 13),
+        ),
     ]
 }
 
@@ -230,7 +242,12 @@ fn geometric_furnace_full_grid() {
 /// From one set of `n` stratified samples: the renderer's furnace (mean, se) of `sample().weight()`
 /// and the furnace the previous patch-measure `eval` gave with the geometric cosine,
 /// mean of weight · cos θi / A(wi).
-fn furnace_now_and_before(brdf: &dyn Bxdf, patch: &dyn Ndf, wo: Vec3, n: usize) -> ((f64, f64), f64) {
+fn furnace_now_and_before(
+    brdf: &dyn Bxdf,
+    patch: &dyn Ndf,
+    wo: Vec3,
+    n: usize,
+) -> ((f64, f64), f64) {
     let mut rng = support::rng(31);
     let (mut s, mut s2, mut before) = (0.0f64, 0.0f64, 0.0f64);
     for k in 0..n {
@@ -255,12 +272,19 @@ fn furnace_now_and_before(brdf: &dyn Bxdf, patch: &dyn Ndf, wo: Vec3, n: usize) 
 /// The unit sphere's (u, v) = (φ / 2π, θ / π) parametrisation, in f64.
 fn sphere_point(u: f64, v: f64) -> [f64; 3] {
     let (phi, theta) = (std::f64::consts::TAU * u, std::f64::consts::PI * v);
-    [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]
+    [
+        theta.sin() * phi.cos(),
+        theta.sin() * phi.sin(),
+        theta.cos(),
+    ]
 }
 
 fn sphere_uv(p: [f64; 3]) -> [f64; 2] {
     let phi = p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU);
-    [phi / std::f64::consts::TAU, p[2].clamp(-1.0, 1.0).acos() / std::f64::consts::PI]
+    [
+        phi / std::f64::consts::TAU,
+        p[2].clamp(-1.0, 1.0).acos() / std::f64::consts::PI,
+    ]
 }
 
 /// The hit point on the unit sphere of the pinhole camera's ray through pixel (x, y): camera at
@@ -339,7 +363,11 @@ fn footprint_from_surface_differentials_matches_finite_differences_on_a_sphere()
 /// footprint, never NaN.
 #[test]
 fn footprint_from_degenerate_surface_differentials_is_minimal() {
-    let (uv, dx, dy) = (Vec2::new(0.3, 0.4), Vec3::new(0.01, 0.0, 0.0), Vec3::new(0.0, 0.01, 0.0));
+    let (uv, dx, dy) = (
+        Vec2::new(0.3, 0.4),
+        Vec3::new(0.01, 0.0, 0.0),
+        Vec3::new(0.0, 0.01, 0.0),
+    );
     for (dpdu, dpdv) in [
         (Vec3::X, 2.0 * Vec3::X),
         (Vec3::X, Vec3::ZERO),
@@ -397,7 +425,10 @@ fn glint_model_patches_equal_their_models_patches() {
                     assert_eq!(p.d(m).to_bits(), own.d(m).to_bits(), "{name} d");
                     assert_eq!(p.lambda(wo).to_bits(), own.lambda(wo).to_bits(), "{name} Λ");
                     assert_eq!(p.sample_visible(wo, u), own.sample_visible(wo, u), "{name}");
-                    assert_eq!(p.pdf_visible(wo, m).to_bits(), own.pdf_visible(wo, m).to_bits());
+                    assert_eq!(
+                        p.pdf_visible(wo, m).to_bits(),
+                        own.pdf_visible(wo, m).to_bits()
+                    );
                 }
             }
         }

@@ -569,8 +569,7 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
         )?;
     }
     std::fs::write(out.join("compare_accuracy.csv"), csv)?;
-    let mut csv =
-        String::from("map,method,theta_deg,v_rel_error,furnace\n");
+    let mut csv = String::from("map,method,theta_deg,v_rel_error,furnace\n");
     for r in &results.view {
         writeln!(
             csv,

@@ -146,7 +146,11 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
             }
         }
         let r = sum / TRANSMISSION_SAMPLES as f32;
-        Vec3::select(r.is_finite_mask(), r.clamp(Vec3::ZERO, Vec3::ONE), Vec3::ONE)
+        Vec3::select(
+            r.is_finite_mask(),
+            r.clamp(Vec3::ZERO, Vec3::ONE),
+            Vec3::ONE,
+        )
     }
 
     /// The base term (1 − R̂(wo)) ρ/π.

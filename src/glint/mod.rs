@@ -67,9 +67,9 @@ mod slope_tree;
 mod store;
 
 pub use binmap::{
-    BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch,
-    DEFAULT_BINS_PER_AXIS, DEFAULT_LEAF_SIZE, DEFAULT_LOOKUP, DEFAULT_MASKING_SIGMA_MIN,
-    DEFAULT_SUBDIVISIONS, EXACT_MASKING_TEXELS, MASKING_FIRST_LEVEL, MAX_SUBDIVISIONS, QueryStats,
+    BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, DEFAULT_BINS_PER_AXIS,
+    DEFAULT_LEAF_SIZE, DEFAULT_LOOKUP, DEFAULT_MASKING_SIGMA_MIN, DEFAULT_SUBDIVISIONS,
+    EXACT_MASKING_TEXELS, MASKING_FIRST_LEVEL, MAX_SUBDIVISIONS, QueryStats,
 };
 pub use bins::HemisphereBins;
 pub use flakes::{
@@ -95,8 +95,8 @@ pub use normal_map::{
 pub use procedural::{
     BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
 };
-pub use scratch::GlintScratch;
 pub use reference::{BinnedPndf, Kernel, REFERENCE_BATCHES, binned_pndf, naive_brdf, tv_distance};
+pub use scratch::GlintScratch;
 
 use crate::ndf::Ndf;
 
@@ -156,7 +156,11 @@ pub trait GlintNdf {
     /// thread) and given back when the patch drops: once the scratch has grown to the largest
     /// footprint, building and querying a patch performs no heap allocation. Bit-identical results
     /// to [`GlintNdf::patch`]. The default ignores the scratch (for models that need none).
-    fn patch_in<'a>(&'a self, footprint: &Footprint, scratch: &'a mut GlintScratch) -> Self::Patch<'a> {
+    fn patch_in<'a>(
+        &'a self,
+        footprint: &Footprint,
+        scratch: &'a mut GlintScratch,
+    ) -> Self::Patch<'a> {
         let _ = scratch;
         self.patch(footprint)
     }

@@ -99,7 +99,11 @@ impl GlintNdf for GlintModel {
         }
     }
 
-    fn patch_in<'a>(&'a self, footprint: &Footprint, scratch: &'a mut GlintScratch) -> GlintPatch<'a> {
+    fn patch_in<'a>(
+        &'a self,
+        footprint: &Footprint,
+        scratch: &'a mut GlintScratch,
+    ) -> GlintPatch<'a> {
         match self {
             GlintModel::Mixture(m) => GlintPatch::Mixture(m.patch_in(footprint, scratch)),
             GlintModel::BinMap(m) => GlintPatch::BinMap(m.patch_in(footprint, scratch)),

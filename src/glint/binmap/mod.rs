@@ -580,7 +580,11 @@ impl GlintNdf for BinMap {
     }
 
     /// [`BinMap::patch_in`].
-    fn patch_in<'a>(&'a self, footprint: &Footprint, scratch: &'a mut GlintScratch) -> BinMapPatch<'a> {
+    fn patch_in<'a>(
+        &'a self,
+        footprint: &Footprint,
+        scratch: &'a mut GlintScratch,
+    ) -> BinMapPatch<'a> {
         BinMap::patch_in(self, footprint, scratch)
     }
 }

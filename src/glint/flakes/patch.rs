@@ -11,13 +11,13 @@ use super::build::slope_box;
 use super::{PositionNormalMap, SIGMA_H_PER_SPACING};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
+use crate::glint::GlintScratch;
 use crate::glint::cdf::invert_cdf;
+use crate::glint::scratch::Loan;
 use crate::glint::slope_tree::contains;
 use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
-use crate::glint::GlintScratch;
-use crate::glint::scratch::Loan;
 
 const TWO_PI: f64 = std::f64::consts::TAU;
 

@@ -12,13 +12,13 @@ use super::hierarchy::lobe_box;
 use super::{BeckmannMixture, MaskingMode, PatchOptions, build::kernel_sigma};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
+use crate::glint::GlintScratch;
 use crate::glint::cdf::invert_cdf;
+use crate::glint::scratch::{Lent, Loan};
 use crate::glint::slope_tree::contains;
 use crate::math::{finite_f32, finite_or_zero};
 use crate::ndf::{DEFAULT_SIGMA_MIN, Ndf, SIGMA_MIN_FLOOR, SlopeGaussian};
 use glam::{Vec2, Vec3};
-use crate::glint::GlintScratch;
-use crate::glint::scratch::{Lent, Loan};
 
 /// The slots of one axis of the weight rectangle.
 #[derive(Clone, Copy, Debug)]
@@ -392,23 +392,23 @@ impl<'a> MixturePatch<'a> {
         let mut m2 = [0.0f64; 3];
         let s2 = sigma_floor_squared(mix.params.sigma_min);
         weights.extend(w.iter_mut().enumerate().map(|(s, wi)| {
-                let wn = *wi * inv;
-                acc += wn;
-                *wi = acc;
-                let k = axes[1].lobe_of_slot(s / lx) * mix.grid[0] + axes[0].lobe_of_slot(s % lx);
-                let (mu, cov) = lobe_mean_cov(&mix.lobes[k], s2).unwrap_or_else(|| {
-                    let lobe = mix.lobe_at(k);
-                    let (mu, c) = (lobe.mean(), lobe.covariance());
-                    let c = [c.x_axis.x, c.x_axis.y, c.y_axis.y].map(f64::from);
-                    ([mu.x as f64, mu.y as f64], c)
-                });
-                m1[0] += wn * mu[0];
-                m1[1] += wn * mu[1];
-                m2[0] += wn * (cov[0] + mu[0] * mu[0]);
-                m2[1] += wn * (cov[1] + mu[0] * mu[1]);
-                m2[2] += wn * (cov[2] + mu[1] * mu[1]);
-                wn as f32
-            }));
+            let wn = *wi * inv;
+            acc += wn;
+            *wi = acc;
+            let k = axes[1].lobe_of_slot(s / lx) * mix.grid[0] + axes[0].lobe_of_slot(s % lx);
+            let (mu, cov) = lobe_mean_cov(&mix.lobes[k], s2).unwrap_or_else(|| {
+                let lobe = mix.lobe_at(k);
+                let (mu, c) = (lobe.mean(), lobe.covariance());
+                let c = [c.x_axis.x, c.x_axis.y, c.y_axis.y].map(f64::from);
+                ([mu.x as f64, mu.y as f64], c)
+            });
+            m1[0] += wn * mu[0];
+            m1[1] += wn * mu[1];
+            m2[0] += wn * (cov[0] + mu[0] * mu[0]);
+            m2[1] += wn * (cov[1] + mu[0] * mu[1]);
+            m2[2] += wn * (cov[2] + mu[1] * mu[1]);
+            wn as f32
+        }));
         // Σ W = 1 up to rounding; the covariance is floored at 0 against cancellation.
         let slope_cov = [
             (m2[0] - m1[0] * m1[0]).max(0.0),
@@ -538,7 +538,8 @@ impl<'a> MixturePatch<'a> {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
         }
-        g.bufs.weights
+        g.bufs
+            .weights
             .iter()
             .zip(self.slot_lobes(g))
             .map(|(&wi, lobe)| wi as f64 * lobe.visible_area(w) as f64)
@@ -720,7 +721,8 @@ impl Ndf for MixturePatch<'_> {
 impl MixturePatch<'_> {
     /// Σ W_i D_i(m) over every gathered lobe, in `f64`.
     fn untruncated_d(&self, g: &Gathered, m: Vec3) -> f64 {
-        g.bufs.weights
+        g.bufs
+            .weights
             .iter()
             .zip(self.slot_lobes(g))
             .map(|(&w, lobe)| w as f64 * lobe.d(m) as f64)
