@@ -296,6 +296,7 @@ fn camera_hit(x: f64, y: f64) -> [f64; 3] {
     let d = d.map(|c| c / n);
     let b = o[0] * d[0] + o[1] * d[1] + o[2] * d[2];
     let c = o[0] * o[0] + o[1] * o[1] + o[2] * o[2] - 1.0;
+    assert!(b * b - c > 0.0, "pixel ({x}, {y}) misses the sphere");
     let t = -b - (b * b - c).sqrt();
     [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]]
 }
@@ -307,7 +308,13 @@ fn camera_hit(x: f64, y: f64) -> [f64; 3] {
 fn footprint_from_surface_differentials_matches_finite_differences_on_a_sphere() {
     let h = 1e-4;
     let v3 = |p: [f64; 3]| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
-    for (x, y) in [(0.0, 0.0), (-20.0, 5.0), (15.0, -18.0), (8.0, 22.0)] {
+    for (x, y) in [
+        (0.0, 0.0),
+        (-20.0, 5.0),
+        (5.0, -10.0),
+        (-5.0, 12.0),
+        (12.0, 14.0),
+    ] {
         let p = camera_hit(x, y);
         let [u, v] = sphere_uv(p);
         let (phi, theta) = (std::f64::consts::TAU * u, std::f64::consts::PI * v);
@@ -325,7 +332,12 @@ fn footprint_from_surface_differentials_matches_finite_differences_on_a_sphere()
         let q = sphere_point(u + h, v);
         let r = sphere_point(u - h, v);
         for k in 0..3 {
-            assert!(((q[k] - r[k]) / (2.0 * h) - dpdu[k]).abs() < 1e-6);
+            let fd = (q[k] - r[k]) / (2.0 * h);
+            assert!(
+                (fd - dpdu[k]).abs() < 1e-6,
+                "{x} {y} u={u} v={v} k={k}: {fd} vs {}",
+                dpdu[k]
+            );
         }
         let diff = |f: &dyn Fn(f64) -> [f64; 3]| -> [f64; 3] {
             let (a, b) = (f(h), f(-h));

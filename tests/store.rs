@@ -229,8 +229,9 @@ fn bin_map_round_trip_is_exact() {
     }
 }
 
-/// Offsets in a bin-map file: width 24, height 32, bins 40, leaf 48, lookup 56, σ 60, 𝓑 count 64,
-/// 𝓑 72.., then 𝓑⁻¹ (count, data), offsets, roots, forest, moments.
+/// Offsets in a bin-map file: width 24, height 32, bins 40, leaf 48, sub-texels 56, lookup 64, σ 68,
+/// 𝓑 count 72, 𝓑 80.. (one u32 per sub-texel), then 𝓑⁻¹ (count, data), offsets, roots, forest,
+/// moments.
 #[test]
 fn inconsistent_bin_maps_are_errors() {
     let n = 16;
@@ -241,8 +242,13 @@ fn inconsistent_bin_maps_are_errors() {
     };
     let built = BinMap::build(&map(n), params).unwrap();
     let file = saved(|w| built.save(w));
-    let texels = n * n;
-    let bin_map_at = 72;
+    let sub = built.subdivisions();
+    assert_eq!(
+        sub, 2,
+        "the default sub-texel resolution the layout assumes"
+    );
+    let texels = (n * sub) * (n * sub);
+    let bin_map_at = 80;
     let inverse_at = bin_map_at + 4 * texels + 8;
     let offsets_at = inverse_at + 4 * texels + 8;
     let roots_at = offsets_at + 4 * 26 + 8;
