@@ -454,7 +454,7 @@ pub struct Options {
 impl Options {
     /// The gallery's settings (≤ ~40 s for the four images on 2 cores).
     pub fn quick() -> Options {
-        Options { width: 320, height: 200, spp: 8, map_size: 256, texels_per_pixel: 3.0, progress: false }
+        Options { width: 320, height: 200, spp: 12, map_size: 256, texels_per_pixel: 3.0, progress: false }
     }
     /// `cargo run --release --example render` without `--quick`.
     pub fn full() -> Options {
@@ -514,14 +514,14 @@ pub fn showcase(sphere: impl FnOnce(Vec2) -> Res<Material>, opts: &Options) -> R
             b: Lambert::new(Vec3::splat(0.25))?,
             square: 0.5,
         }),
-        light: Some(PointLight { position: Vec3::new(-3.0, 5.0, 3.0), intensity: Vec3::splat(60.0) }),
-        sky: Sky::Gradient { scale: 0.5 },
+        light: Some(PointLight { position: Vec3::new(-3.0, 5.0, 3.0), intensity: Vec3::splat(70.0) }),
+        sky: Sky::Gradient { scale: 0.3 },
         camera,
     })
 }
 
 /// Exposure of the showcase images (fixed, so that the four are comparable).
-const EXPOSURE: f32 = 1.0;
+const EXPOSURE: f32 = 1.3;
 
 /// Writes the hammered normal map PNG, then renders the four materials; returns the files.
 pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
