@@ -66,7 +66,7 @@ fn main() -> Res<()> {
              shading one sphere with analytic gold, two glint conductors (a procedural scratched map \
              and a PNG normal map the example writes first) and a glint clear coat over red paint, \
              through the public API only (the render example, quick setting).",
-            common::render::run,
+            common::render::showcase::run,
         ),
     ];
     let mut sections = Vec::new();

@@ -12,11 +12,15 @@
 mod common;
 
 use common::Res;
-use common::render::{Options, run_with};
+use common::render::showcase::{Options, run_with};
 
 fn main() -> Res<()> {
     let out = common::out_dir()?;
-    let mut opts = if common::has_flag("--quick") { Options::quick() } else { Options::full() };
+    let mut opts = if common::has_flag("--quick") {
+        Options::quick()
+    } else {
+        Options::full()
+    };
     if let Some(spp) = common::arg_value("--spp") {
         opts.spp = spp.parse()?;
     }
@@ -34,9 +38,8 @@ fn main() -> Res<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::common::render::{
-        Camera, Material, Scene, Sky, glint_model, progress_bar, render, showcase, Options,
-    };
+    use super::common::render::showcase::{Options, glint_model, progress_bar, showcase};
+    use super::common::render::{Camera, Material, Scene, Sky, render};
     use brdf::fresnel::NoFresnel;
     use brdf::glint::{ScratchedParams, bumpy, scratched};
     use brdf::{Vec2, Vec3};
@@ -45,16 +48,34 @@ mod tests {
     /// and not black (the sphere and the lit ground return light).
     #[test]
     fn tiny_render_is_finite_and_non_negative() {
-        let opts = Options { width: 16, height: 16, spp: 2, map_size: 32, texels_per_pixel: 3.0, progress: false };
-        let model = glint_model(&scratched(32, 32, ScratchedParams::default(), 1).unwrap()).unwrap();
+        let opts = Options {
+            width: 16,
+            height: 16,
+            spp: 2,
+            map_size: 32,
+            texels_per_pixel: 3.0,
+            progress: false,
+        };
+        let model =
+            glint_model(&scratched(32, 32, ScratchedParams::default(), 1).unwrap()).unwrap();
         let scene = showcase(
-            |tiles| Ok(Material::Glint { model, fresnel: Box::new(brdf::fresnel::ConductorFresnel::GOLD), tiles }),
+            |tiles| {
+                Ok(Material::Glint {
+                    model,
+                    fresnel: Box::new(brdf::fresnel::ConductorFresnel::GOLD),
+                    tiles,
+                })
+            },
             &opts,
         )
         .unwrap();
         let img = render(&scene, opts.spp, 1, &progress_bar(false, 16, ""));
         assert_eq!(img.pixels.len(), 256);
-        assert!(img.pixels.iter().all(|p| p.is_finite() && p.min_element() >= 0.0));
+        assert!(
+            img.pixels
+                .iter()
+                .all(|p| p.is_finite() && p.min_element() >= 0.0)
+        );
         assert!(img.pixels.iter().map(|p| p.element_sum()).sum::<f32>() > 0.0);
     }
 
@@ -71,7 +92,11 @@ mod tests {
         let scene = Scene {
             center: Vec3::ZERO,
             radius: 1.0,
-            sphere: Material::Glint { model, fresnel: Box::new(NoFresnel), tiles: Vec2::new(2.0, 1.0) },
+            sphere: Material::Glint {
+                model,
+                fresnel: Box::new(NoFresnel),
+                tiles: Vec2::new(2.0, 1.0),
+            },
             ground: None,
             light: None,
             sky: Sky::Constant(Vec3::ONE),
@@ -81,7 +106,10 @@ mod tests {
         // Pixels whose 3 × 3 grid of sub-pixel points all hit the sphere (no background mixed in).
         let inside = |x: u32, y: u32| {
             (0..9).all(|k| {
-                let px = Vec2::new(x as f32 + 0.1 + 0.4 * (k % 3) as f32, y as f32 + 0.1 + 0.4 * (k / 3) as f32);
+                let px = Vec2::new(
+                    x as f32 + 0.1 + 0.4 * (k % 3) as f32,
+                    y as f32 + 0.1 + 0.4 * (k / 3) as f32,
+                );
                 let d = scene.camera.direction_to(px);
                 scene.intersect(scene.camera.eye, d).is_some()
             })
@@ -96,7 +124,10 @@ mod tests {
         let mean = values.iter().sum::<f64>() / n;
         let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
         let se = (var / n).sqrt();
-        eprintln!("furnace: mean {mean:.4}, standard error {se:.4}, {} pixels", values.len());
+        eprintln!(
+            "furnace: mean {mean:.4}, standard error {se:.4}, {} pixels",
+            values.len()
+        );
         assert!(mean <= 1.0 + 4.0 * se, "furnace mean {mean} > 1 + 4 × {se}");
         assert!(mean > 0.5, "furnace mean {mean}");
     }

@@ -7,24 +7,20 @@
 //! scratch), fresnel)` and need nothing else. World space: y up, lengths in scene units; BRDFs see
 //! directions in the local frame of the hit (z = normal, x = ∂p/∂u). See docs/render.md.
 
-use super::{Artifact, Res, save_rgb};
 use brdf::bxdf::{Bxdf, LayeredBrdf, MicrofacetBrdf};
 use brdf::frame::Frame;
-use brdf::fresnel::{ConductorFresnel, DielectricFresnel, Fresnel};
-use brdf::glint::{
-    BeckmannMixture, FlakesParams, Footprint, GlintModel, GlintNdf, GlintScratch, MixtureParams,
-    NormalMap, NormalRepair, PatchOptions, ScratchedParams, TangentConvention, flakes, scratched,
-};
+use brdf::fresnel::{ConductorFresnel, Fresnel};
+use brdf::glint::{Footprint, GlintModel, GlintNdf, GlintScratch};
 use brdf::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
 use brdf::{Ggx, Lambert, Vec2, Vec3};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 use rayon::prelude::*;
 use std::f32::consts::PI;
-use std::path::Path;
 use std::sync::Arc;
-use std::time::Instant;
+
+pub mod showcase;
 
 /// Offset of secondary ray origins along the normal (scene units; the scene is ~1 unit across).
 const RAY_EPSILON: f32 = 1e-4;
@@ -105,7 +101,8 @@ impl Material {
                 tiles,
                 base,
             } => {
-                let coat = MicrofacetBrdf::new(model.patch_in(&footprint(*tiles), scratch), fresnel);
+                let coat =
+                    MicrofacetBrdf::new(model.patch_in(&footprint(*tiles), scratch), fresnel);
                 match LayeredBrdf::new(coat, *base) {
                     Ok(layered) => f(&layered),
                     Err(_) => f(&Black),
@@ -167,7 +164,15 @@ impl Camera {
         let right = forward.cross(Vec3::Y).normalize();
         let up = right.cross(forward);
         let tan_half = (0.5 * fov_deg.to_radians()).tan();
-        Camera { eye, forward, right, up, tan_half, width, height }
+        Camera {
+            eye,
+            forward,
+            right,
+            up,
+            tan_half,
+            width,
+            height,
+        }
     }
 
     /// One pixel's step in the image plane at unit distance along `forward`.
@@ -243,7 +248,14 @@ impl Scene {
             (Some(ts), tg) if tg.is_none_or(|tg| ts < tg) => Some(self.sphere_hit(o + d * ts)),
             (_, Some(tg)) => {
                 let p = o + d * tg;
-                Some(Hit { p, n: Vec3::Y, uv: Vec2::new(p.x, p.z), dpdu: Vec3::X, dpdv: Vec3::Z, sphere: false })
+                Some(Hit {
+                    p,
+                    n: Vec3::Y,
+                    uv: Vec2::new(p.x, p.z),
+                    dpdu: Vec3::X,
+                    dpdv: Vec3::Z,
+                    sphere: false,
+                })
             }
             _ => None,
         }
@@ -269,9 +281,22 @@ impl Scene {
         let theta = l.y.clamp(-1.0, 1.0).acos();
         let r = self.radius;
         let dpdu = 2.0 * PI * r * Vec3::new(-l.z, 0.0, l.x);
-        let dpdv = PI * r * Vec3::new(theta.cos() * phi.cos(), -theta.sin(), theta.cos() * phi.sin());
+        let dpdv = PI
+            * r
+            * Vec3::new(
+                theta.cos() * phi.cos(),
+                -theta.sin(),
+                theta.cos() * phi.sin(),
+            );
         let uv = Vec2::new(phi / (2.0 * PI), theta / PI);
-        Hit { p, n: l, uv, dpdu, dpdv, sphere: true }
+        Hit {
+            p,
+            n: l,
+            uv,
+            dpdu,
+            dpdv,
+            sphere: true,
+        }
     }
 
     /// Whether nothing blocks o + t d for t in (ε, t_max).
@@ -318,13 +343,24 @@ impl Scene {
                 break;
             }
             let (dpdx, dpdy) = self.camera.dp_dxy(hit.p, hit.n);
-            let material = if hit.sphere { &self.sphere } else { self.ground.as_ref().unwrap_or(&self.sphere) };
-            let u = [rng.random::<f32>(), rng.random(), rng.random(), rng.random(), rng.random()];
-            let (direct, next) = material.with_bxdf(&hit, (dpdx * spread, dpdy * spread), scratch, |bxdf| {
-                let direct = self.direct(&hit, &frame, wo, bxdf, Vec2::new(u[0], u[1]));
-                let s = bxdf.sample(wo, u[2], Vec2::new(u[3], u[4]));
-                (direct, s.map(|s| (frame.to_world(s.wi), s.weight(), s.pdf)))
-            });
+            let material = if hit.sphere {
+                &self.sphere
+            } else {
+                self.ground.as_ref().unwrap_or(&self.sphere)
+            };
+            let u = [
+                rng.random::<f32>(),
+                rng.random(),
+                rng.random(),
+                rng.random(),
+                rng.random(),
+            ];
+            let (direct, next) =
+                material.with_bxdf(&hit, (dpdx * spread, dpdy * spread), scratch, |bxdf| {
+                    let direct = self.direct(&hit, &frame, wo, bxdf, Vec2::new(u[0], u[1]));
+                    let s = bxdf.sample(wo, u[2], Vec2::new(u[3], u[4]));
+                    (direct, s.map(|s| (frame.to_world(s.wi), s.weight(), s.pdf)))
+                });
             total += throughput * direct;
             let Some((wi, weight, pdf)) = next else { break };
             throughput *= weight;
@@ -333,7 +369,11 @@ impl Scene {
             previous = Some((hit.n, pdf));
             spread *= SECONDARY_FOOTPRINT_GROWTH;
         }
-        if total.is_finite() { total.max(Vec3::ZERO) } else { Vec3::ZERO }
+        if total.is_finite() {
+            total.max(Vec3::ZERO)
+        } else {
+            Vec3::ZERO
+        }
     }
 
     /// Next-event estimation at a hit: the point light (a delta light: light sampling only) plus one
@@ -366,7 +406,13 @@ impl Scene {
 /// Veach's power heuristic (β = 2) for one sample of strategy a against strategy b ([Veach1997] eq. 9.13).
 pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
     let (a, b) = (pdf_a * pdf_a, pdf_b * pdf_b);
-    if a + b > 0.0 && (a + b).is_finite() { a / (a + b) } else if pdf_a > 0.0 { 1.0 } else { 0.0 }
+    if a + b > 0.0 && (a + b).is_finite() {
+        a / (a + b)
+    } else if pdf_a > 0.0 {
+        1.0
+    } else {
+        0.0
+    }
 }
 
 /// A linear HDR image, row major.
@@ -387,10 +433,14 @@ pub fn render(scene: &Scene, spp: u32, seed: u64, bar: &ProgressBar) -> Image {
             let row = (0..cam.width)
                 .map(|x| {
                     let pixel = (y as u64) * cam.width as u64 + x as u64;
-                    let mut rng = Pcg32::seed_from_u64(seed ^ pixel.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+                    let mut rng =
+                        Pcg32::seed_from_u64(seed ^ pixel.wrapping_mul(0x9E37_79B9_7F4A_7C15));
                     let mut sum = Vec3::ZERO;
                     for _ in 0..spp {
-                        let px = Vec2::new(x as f32 + rng.random::<f32>(), y as f32 + rng.random::<f32>());
+                        let px = Vec2::new(
+                            x as f32 + rng.random::<f32>(),
+                            y as f32 + rng.random::<f32>(),
+                        );
                         let d = cam.direction(px).normalize();
                         sum += scene.radiance(cam.eye, d, &mut rng, scratch, footprint_scale);
                     }
@@ -401,175 +451,9 @@ pub fn render(scene: &Scene, spp: u32, seed: u64, bar: &ProgressBar) -> Image {
             row
         })
         .collect();
-    Image { width: cam.width, height: cam.height, pixels: rows.concat() }
-}
-
-/// A progress bar over `len` rows (hidden when `show` is false, e.g. in tests).
-pub fn progress_bar(show: bool, len: u64, msg: &str) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
+    Image {
+        width: cam.width,
+        height: cam.height,
+        pixels: rows.concat(),
     }
-    let bar = ProgressBar::new(len);
-    if let Ok(style) = ProgressStyle::with_template("{msg:>24} [{bar:30}] {pos}/{len} rows {elapsed}") {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_message(msg.to_string());
-    bar
-}
-
-/// 8-bit sRGB of `img` scaled by `exposure`, through Narkowicz's fit of the ACES filmic curve
-/// (x (2.51 x + 0.03)) / (x (2.43 x + 0.59) + 0.14) per channel, then the sRGB transfer function.
-pub fn tone_map(img: &Image, exposure: f32) -> Vec<u8> {
-    let aces = |x: f32| (x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
-    let srgb = |c: f32| {
-        let s = if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
-        (s * 255.0).round() as u8
-    };
-    img.pixels
-        .iter()
-        .flat_map(|p| {
-            let c = *p * exposure;
-            [srgb(aces(c.x)), srgb(aces(c.y)), srgb(aces(c.z))]
-        })
-        .collect()
-}
-
-// ---------------------------------------------------------------------------------------------
-// The showcase: four materials on the same sphere
-// ---------------------------------------------------------------------------------------------
-
-/// Render settings.
-#[derive(Clone, Debug)]
-pub struct Options {
-    pub width: u32,
-    pub height: u32,
-    pub spp: u32,
-    /// Side of the normal maps, in texels.
-    pub map_size: usize,
-    /// Map texels per pixel across the sphere's equator (the tiling follows from it).
-    pub texels_per_pixel: f32,
-    pub progress: bool,
-}
-
-impl Options {
-    /// The gallery's settings (≤ ~40 s for the four images on 2 cores).
-    pub fn quick() -> Options {
-        Options { width: 320, height: 200, spp: 12, map_size: 256, texels_per_pixel: 3.0, progress: false }
-    }
-    /// `cargo run --release --example render` without `--quick`.
-    pub fn full() -> Options {
-        Options { width: 800, height: 500, spp: 32, map_size: 512, texels_per_pixel: 3.0, progress: true }
-    }
-}
-
-/// A glint model of `map`: the Beckmann mixture of \[Chermain2019\] with 64 quadrature nodes per
-/// lobe (the orb example's setting, 4× faster to build than the default) and its level of detail at
-/// 256 lobes, so that the wide footprints of secondary hits cost one filtered lobe (the default
-/// threshold, 16384, lets a bounce off the ground query thousands of lobes: minutes per image).
-pub fn glint_model(map: &NormalMap) -> Res<Arc<GlintModel>> {
-    let params = MixtureParams {
-        samples: 64,
-        patch: PatchOptions { lod_lobes: 256.0, ..PatchOptions::default() },
-        ..MixtureParams::default()
-    };
-    Ok(Arc::new(BeckmannMixture::build(map, params)?.into()))
-}
-
-/// A hammered-metal height field (overlapping parabolic dents, the deepest wins), `n` × `n`, tiled,
-/// heights in texels; slopes up to ~0.3.
-pub fn hammered_heights(n: usize, seed: u64) -> Vec<f32> {
-    let mut rng = Pcg32::seed_from_u64(seed);
-    let dents: Vec<(Vec2, f32)> = (0..n * n / 40)
-        .map(|_| {
-            let c = Vec2::new(rng.random::<f32>(), rng.random::<f32>()) * n as f32;
-            (c, 4.0 + 6.0 * rng.random::<f32>())
-        })
-        .collect();
-    let wrap = |d: f32| d - n as f32 * (d / n as f32).round();
-    (0..n * n)
-        .map(|k| {
-            let p = Vec2::new((k % n) as f32 + 0.5, (k / n) as f32 + 0.5);
-            dents.iter().fold(0.0f32, |h, &(c, r)| {
-                let d2 = Vec2::new(wrap(p.x - c.x), wrap(p.y - c.y)).length_squared() / (r * r);
-                h.min(-0.15 * r * (1.0 - d2).max(0.0))
-            })
-        })
-        .collect()
-}
-
-/// The showcase scene around `sphere`: a unit sphere on a checkered ground, a strong point light
-/// above left, a sky gradient. The map tiling puts `texels_per_pixel` texels per pixel on the
-/// equator (∂p/∂u spans 2π r, ∂p/∂v π r, hence half as many tiles along v).
-pub fn showcase(sphere: impl FnOnce(Vec2) -> Res<Material>, opts: &Options) -> Res<Scene> {
-    let camera = Camera::look_at(Vec3::new(0.0, 1.5, 4.2), Vec3::new(0.0, 0.85, 0.0), 32.0, opts.width, opts.height);
-    let radius_px = 1.0 / (4.2 * camera.pixel_step());
-    let tiles_u = (opts.texels_per_pixel * 2.0 * PI * radius_px / opts.map_size as f32).round().max(1.0);
-    let tiles = Vec2::new(tiles_u, (0.5 * tiles_u).round().max(1.0));
-    Ok(Scene {
-        center: Vec3::new(0.0, 1.0, 0.0),
-        radius: 1.0,
-        sphere: sphere(tiles)?,
-        ground: Some(Material::Checker {
-            a: Lambert::new(Vec3::splat(0.6))?,
-            b: Lambert::new(Vec3::splat(0.25))?,
-            square: 0.5,
-        }),
-        light: Some(PointLight { position: Vec3::new(-3.0, 5.0, 3.0), intensity: Vec3::splat(70.0) }),
-        sky: Sky::Gradient { scale: 0.3 },
-        camera,
-    })
-}
-
-/// Exposure of the showcase images (fixed, so that the four are comparable).
-const EXPOSURE: f32 = 1.3;
-
-/// Writes the hammered normal map PNG, then renders the four materials; returns the files.
-pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
-    let n = opts.map_size;
-    let mut artifacts = Vec::new();
-    // (c)'s asset: a normal map PNG written from a height field, then read back like any file.
-    let png = out.join("render_hammered_normals.png");
-    let heights = hammered_heights(n, 11);
-    let normals = NormalMap::from_heights(n, n, &heights, 1.0)?;
-    save_rgb(&png, n as u32, n as u32, normals.to_rgb8(TangentConvention::OpenGl))?;
-    artifacts.push(Artifact::new(&png, "the hammered normal map (OpenGL convention) that the render example writes, then loads"));
-    let hammered = glint_model(&NormalMap::load(&png, TangentConvention::OpenGl, NormalRepair::Reject)?)?;
-    let scratched = glint_model(&scratched(n, n, ScratchedParams::default(), 7)?)?;
-    let flakes = glint_model(&flakes(n, n, FlakesParams { cell_texels: 6.0, tilt_sigma: 0.15 }, 3)?)?;
-    type Make = Box<dyn FnOnce(Vec2) -> Res<Material>>;
-    let shots: [(&str, &str, Make); 4] = [
-        ("render_gold.png", "analytic gold: GGX α = 0.15, conductor Fresnel", Box::new(|_| {
-            Ok(Material::Conductor(MicrofacetBrdf::new(Ggx::isotropic(0.15)?, ConductorFresnel::GOLD)))
-        })),
-        ("render_scratched.png", "glints: silver with a procedural scratched map (Beckmann mixture)", Box::new(move |tiles| {
-            Ok(Material::Glint { model: scratched, fresnel: Box::new(ConductorFresnel::SILVER), tiles })
-        })),
-        ("render_hammered.png", "glints: copper with the hammered PNG normal map (Beckmann mixture)", Box::new(move |tiles| {
-            Ok(Material::Glint { model: hammered, fresnel: Box::new(ConductorFresnel::COPPER), tiles })
-        })),
-        ("render_flake_paint.png", "layered: a glint clear coat (flakes map, η = 1.5) over red Lambert paint", Box::new(move |tiles| {
-            let fresnel = Box::new(DielectricFresnel::new(1.5)?);
-            Ok(Material::GlintCoat { model: flakes, fresnel, tiles, base: Vec3::new(0.5, 0.03, 0.02) })
-        })),
-    ];
-    for (k, (file, caption, make)) in shots.into_iter().enumerate() {
-        let scene = showcase(make, opts)?;
-        let bar = progress_bar(opts.progress, opts.height as u64, file);
-        let t = Instant::now();
-        let img = render(&scene, opts.spp, 0x5EED + k as u64, &bar);
-        bar.finish();
-        let path = out.join(file);
-        save_rgb(&path, img.width, img.height, tone_map(&img, EXPOSURE))?;
-        let caption = format!(
-            "{caption}; {}×{}, {} spp, {:.1} s (cargo run --release --example render)",
-            img.width, img.height, opts.spp, t.elapsed().as_secs_f64()
-        );
-        artifacts.push(Artifact::new(path, caption));
-    }
-    Ok(artifacts)
-}
-
-/// The gallery's entry point.
-pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
-    run_with(out, &if quick { Options::quick() } else { Options::full() })
 }
