@@ -12,6 +12,7 @@ pub mod lobes;
 pub mod mixture_images;
 pub mod orb;
 pub mod pndf_images;
+pub mod render;
 
 use plotters::prelude::*;
 use std::error::Error;
