@@ -279,6 +279,26 @@ impl BinIndex {
     }
 }
 
+/// The per-bin tables derived from the bins and the lists' offsets (built, and rebuilt on load): the
+/// masking facets, sampled only for the bins some sub-texel falls in (the only ones a footprint's
+/// masking sums; the others keep their exact mean cosine), and the bins' centre slopes.
+pub(super) fn bin_tables(bins: &HemisphereBins, offsets: &[u32]) -> (Vec<BinFacet>, Vec<Vec2>) {
+    let facets = (0..bins.len())
+        .into_par_iter()
+        .map(|b| {
+            if offsets[b + 1] > offsets[b] {
+                BinFacet::new(bins, b)
+            } else {
+                BinFacet::empty(bins, b)
+            }
+        })
+        .collect();
+    let center_slope = (0..bins.len())
+        .map(|b| normal_to_slope(bins.center(b)).unwrap_or(Vec2::ZERO))
+        .collect();
+    (facets, center_slope)
+}
+
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> Error {
     Error::InvalidParameter {
         name,
@@ -398,22 +418,8 @@ impl BinMap {
                 );
             }
         }
-        // The masking facets are sampled only for the bins some texel falls in (the only ones a
-        // footprint's masking sums); the others keep their exact mean cosine.
-        let facets = (0..nb)
-            .into_par_iter()
-            .map(|b| {
-                if offsets[b + 1] > offsets[b] {
-                    BinFacet::new(&bins, b)
-                } else {
-                    BinFacet::empty(&bins, b)
-                }
-            })
-            .collect();
+        let (facets, center_slope) = bin_tables(&bins, &offsets);
         let table = Table::new(params.lookup, offsets, roots);
-        let center_slope = (0..nb)
-            .map(|b| normal_to_slope(bins.center(b)).unwrap_or(Vec2::ZERO))
-            .collect();
         let moments = map.pyramid().coarse_from(MASKING_FIRST_LEVEL);
         Ok(BinMap {
             width,

@@ -17,16 +17,11 @@
 
 use super::forest::NO_TREE;
 use super::lookup::Table;
-use super::{
-    BinFacet, BinIndex, BinLookup, BinMap, BinMapParams, MASKING_FIRST_LEVEL, check_params,
-};
+use super::{BinIndex, BinLookup, BinMap, BinMapParams, MASKING_FIRST_LEVEL, check_params};
 use crate::Result;
-use crate::frame::normal_to_slope;
 use crate::glint::MAX_SLOPE;
 use crate::glint::moments::{MomentLevel, MomentPyramid};
 use crate::glint::store::{self, Decoder, Kind, invalid};
-use glam::Vec2;
-use rayon::prelude::*;
 use std::io::{Read, Write};
 
 impl BinMap {
@@ -175,19 +170,7 @@ impl BinMap {
             [grid_w, grid_h],
             params.leaf_size,
         )?;
-        let facets = (0..nb)
-            .into_par_iter()
-            .map(|b| {
-                if offsets[b + 1] > offsets[b] {
-                    BinFacet::new(&bins, b)
-                } else {
-                    BinFacet::empty(&bins, b)
-                }
-            })
-            .collect();
-        let center_slope = (0..nb)
-            .map(|b| normal_to_slope(bins.center(b)).unwrap_or(Vec2::ZERO))
-            .collect();
+        let (facets, center_slope) = super::bin_tables(&bins, &offsets);
         // The builder's storage choice (u16 when every bin fits).
         let bin_map = if nb <= 1 << 16 {
             BinIndex::U16(bin_map.iter().map(|&b| b as u16).collect())
