@@ -153,9 +153,18 @@ fn lobe_mean_cov(m: &[f32; 5], s2: f64) -> Option<([f64; 2], [f64; 3])> {
     let [ex, ey, exx, eyy, exy] = m.map(f64::from);
     let vx = (exx - ex * ex).max(s2);
     let vy = (eyy - ey * ey).max(s2);
+    Some((
+        [ex, ey],
+        [vx, clamped_covariance(vx, vy, exy - ex * ey, s2), vy],
+    ))
+}
+
+/// The covariance c clamped to ±√((σx² − σ²)(σy² − σ²)), so that the floored matrix stays positive
+/// semi-definite (as [`SlopeGaussian::from_moments`]).
+#[inline]
+fn clamped_covariance(vx: f64, vy: f64, c: f64, s2: f64) -> f64 {
     let c_max = ((vx - s2) * (vy - s2)).sqrt();
-    let c = (exy - ex * ey).clamp(-c_max, c_max);
-    Some(([ex, ey], [vx, c, vy]))
+    c.clamp(-c_max, c_max)
 }
 
 /// The P-NDF of one footprint of a [`BeckmannMixture`]: an [`Ndf`] with D_P(h) = Σ W_i D_i(h).
@@ -297,13 +306,18 @@ impl LeafEval {
     /// \[Chermain2019\] eq. 4-6 (the lobe), §5 (the box).
     #[inline]
     fn p22_in_box(&self, m: &[f32; 5], s: Vec2) -> Leaf {
-        let Some(([ex, ey], [vx, c, vy])) = lobe_mean_cov(m, self.s2) else {
+        if !m.iter().all(|v| v.is_finite()) {
             return Leaf::Degenerate;
-        };
+        }
+        let [ex, ey, exx, eyy, exy] = m.map(f64::from);
+        let vx = (exx - ex * ex).max(self.s2);
+        let vy = (eyy - ey * ey).max(self.s2);
         let (dx, dy) = (s.x as f64 - ex, s.y as f64 - ey);
+        // The box test first: most visited leaves end here, before the correlation's square root.
         if dx * dx > self.k2 * vx || dy * dy > self.k2 * vy {
             return Leaf::Outside;
         }
+        let c = clamped_covariance(vx, vy, exy - ex * ey, self.s2);
         let det = vx * vy - c * c;
         let q = (vy * dx * dx - 2.0 * c * dx * dy + vx * dy * dy) / det;
         let p = (-0.5 * q as f32).exp() as f64 / (std::f64::consts::TAU * det.sqrt());
