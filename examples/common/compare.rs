@@ -188,7 +188,10 @@ struct PositionNormalMethod {
 
 impl Method for PositionNormalMethod {
     fn label(&self) -> String {
-        format!("position-normal (rate {})", self.map.params().sampling_rate)
+        format!(
+            "position-normal (rate {}, published BRDF)",
+            self.map.params().sampling_rate
+        )
     }
     fn bytes_per_texel(&self) -> f64 {
         let m = self.map.memory();
