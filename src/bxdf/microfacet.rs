@@ -157,13 +157,19 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
     /// wo·h = wi·h > 0 (the χ⁺ factors are checked by the caller): 1/(V_o V_i) (separable) or
     /// 1/(V_o A_i + V_i A_o − A_o A_i) (height-correlated); 0 when the denominator is not positive.
     pub fn masking_factor(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.masking_factor_with(wo, wi, self.ndf.projected_area(wi))
+    }
+
+    /// [`MicrofacetBrdf::masking_factor`] with A(wi) = `ai` already evaluated (`eval` needs it for
+    /// the renderer's-measure factor too, and a glint patch's A is not free).
+    #[inline]
+    fn masking_factor_with(&self, wo: Vec3, wi: Vec3, ai: f32) -> f32 {
         let vo = self.ndf.visible_area(wo);
         let vi = self.ndf.visible_area(wi);
         let denom = match self.masking {
             Masking::Separable => vo * vi,
             Masking::HeightCorrelated => {
                 let ao = self.ndf.projected_area(wo);
-                let ai = self.ndf.projected_area(wi);
                 vo * ai + vi * ao - ao * ai
             }
         };
@@ -195,14 +201,13 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
         (c > 0.0).then_some((h, c))
     }
 
-    /// The renderer's-measure factor A(wi)/cos θi that turns the patch BRDF f_P (normalised in the
+    /// The renderer's-measure factor A(wi)/cos θi (with `ai` = A(wi)) that turns the patch BRDF f_P (normalised in the
     /// measure A(wi) dωi) into the BRDF a renderer integrates against the geometric cos θi dωi:
     /// exactly 1 for centred NDFs (A = cos θ, and x/x = 1 in IEEE arithmetic), the patch's projected
     /// area over the geometric cosine for leaning glint patches, 0 when the patch's mean plane faces
     /// away from wi (A ≤ 0: it intercepts no light from there).
     #[inline]
-    fn measure_factor(&self, wi: Vec3) -> f32 {
-        let ai = self.ndf.projected_area(wi);
+    fn measure_factor(wi: Vec3, ai: f32) -> f32 {
         if ai > 0.0 && wi.z > 0.0 {
             ai / wi.z
         } else {
@@ -217,7 +222,8 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
         if d.is_nan() || d <= 0.0 {
             return Vec3::ZERO;
         }
-        let scale = 0.25 * d * self.masking_factor(wo, wi) * self.measure_factor(wi);
+        let ai = self.ndf.projected_area(wi);
+        let scale = 0.25 * d * self.masking_factor_with(wo, wi, ai) * Self::measure_factor(wi, ai);
         let v = self.fresnel.eval(c) * scale;
         if v.is_finite() { v } else { Vec3::ZERO }
     }
