@@ -52,7 +52,7 @@
 mod binmap;
 mod bins;
 mod cdf;
-mod flakes;
+mod position_normal;
 mod footprint;
 #[cfg(feature = "image")]
 mod image_io;
@@ -72,7 +72,7 @@ pub use binmap::{
     EXACT_MASKING_TEXELS, MASKING_FIRST_LEVEL, MAX_SUBDIVISIONS, QueryStats,
 };
 pub use bins::HemisphereBins;
-pub use flakes::{
+pub use position_normal::{
     DEFAULT_MASKING_ALPHA, EXACT_MASKING_ELEMENTS, PositionNormalBrdf, PositionNormalMap,
     PositionNormalMemory, PositionNormalParams, PositionNormalPatch,
 };

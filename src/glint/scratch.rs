@@ -35,7 +35,7 @@ use std::sync::{Mutex, OnceLock};
 pub struct GlintScratch {
     pub(crate) mixture: crate::glint::mixture::MixtureScratch,
     pub(crate) bin_map: crate::glint::binmap::BinMapScratch,
-    pub(crate) position_normal: crate::glint::flakes::PositionNormalScratch,
+    pub(crate) position_normal: crate::glint::position_normal::PositionNormalScratch,
 }
 
 /// Buffers `T` lent to one patch: taken from the caller's scratch (or fresh) at construction,
