@@ -1,8 +1,9 @@
 //! Build against load: how long each glint model takes to build from a normal map, and to load back
 //! from its saved file (docs/format.md), with the memory it holds per texel and its file size.
 //!
-//! `cargo run --release --example store_timing -- [--size N] [--loads K]` (default 2048² bumpy map,
-//! 5 loads per build). Builds and loads alternate (build, loads, build, loads) so that a change of
+//! `cargo run --release --example store_timing -- [--size N] [--loads K] [--models LIST]` (default
+//! 2048² bumpy map, 5 loads per build, every model; LIST is a comma-separated subset of `normal`,
+//! `mixture`, `pn`, `binmap`). Builds and loads alternate (build, loads, build, loads) so that a change of
 //! machine load hits both; files are saved to and loaded from memory (a `Vec<u8>`), so disk speed is
 //! left out. Prints a Markdown table (docs/results.md, "Saving and loading built maps").
 
@@ -16,6 +17,17 @@ fn arg(name: &str) -> Option<usize> {
         .position(|a| a == name)
         .and_then(|i| args.get(i + 1))
         .and_then(|v| v.parse().ok())
+}
+
+/// Whether model `key` was asked for (`--models a,b`; all when absent).
+fn wanted(key: &str) -> bool {
+    let args: Vec<String> = std::env::args().collect();
+    match args.iter().position(|a| a == "--models") {
+        Some(i) => args
+            .get(i + 1)
+            .is_some_and(|list| list.split(',').any(|m| m == key)),
+        None => true,
+    }
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -83,49 +95,58 @@ fn main() {
     let map = bumpy(n, n, 0.25, 4.0, 1).unwrap();
     let texels = (n * n) as f64;
     let rows = vec![
-        measure(
-            "NormalMap (from slopes)",
-            2,
-            loads,
-            || NormalMap::from_slopes(n, n, map.slopes().to_vec()).unwrap(),
-            |m, f| m.save(f).unwrap(),
-            |f| NormalMap::load_binary(&mut &f[..]).unwrap(),
-            |m| m.slopes().len() * 8,
-        ),
-        measure(
-            "BeckmannMixture",
-            2,
-            loads,
-            || BeckmannMixture::build(&map, MixtureParams::default()).unwrap(),
-            |m, f| m.save(f).unwrap(),
-            |f| BeckmannMixture::load(&mut &f[..]).unwrap(),
-            |m| {
-                let b = m.memory();
-                b.lobe_bytes + b.hierarchy_bytes + b.mip_bytes
-            },
-        ),
-        measure(
-            "PositionNormalMap",
-            2,
-            loads,
-            || PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap(),
-            |m, f| m.save(f).unwrap(),
-            |f| PositionNormalMap::load(&mut &f[..]).unwrap(),
-            |m| {
-                let b = m.memory();
-                b.element_bytes + b.hierarchy_bytes
-            },
-        ),
-        measure(
-            "BinMap",
-            2,
-            loads,
-            || BinMap::build(&map, BinMapParams::default()).unwrap(),
-            |m, f| m.save(f).unwrap(),
-            |f| BinMap::load(&mut &f[..]).unwrap(),
-            |m| m.memory().total(),
-        ),
+        wanted("normal").then(|| {
+            measure(
+                "NormalMap (from slopes)",
+                2,
+                loads,
+                || NormalMap::from_slopes(n, n, map.slopes().to_vec()).unwrap(),
+                |m, f| m.save(f).unwrap(),
+                |f| NormalMap::load_binary(&mut &f[..]).unwrap(),
+                |m| m.slopes().len() * 8,
+            )
+        }),
+        wanted("mixture").then(|| {
+            measure(
+                "BeckmannMixture",
+                2,
+                loads,
+                || BeckmannMixture::build(&map, MixtureParams::default()).unwrap(),
+                |m, f| m.save(f).unwrap(),
+                |f| BeckmannMixture::load(&mut &f[..]).unwrap(),
+                |m| {
+                    let b = m.memory();
+                    b.lobe_bytes + b.hierarchy_bytes + b.mip_bytes
+                },
+            )
+        }),
+        wanted("pn").then(|| {
+            measure(
+                "PositionNormalMap",
+                2,
+                loads,
+                || PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap(),
+                |m, f| m.save(f).unwrap(),
+                |f| PositionNormalMap::load(&mut &f[..]).unwrap(),
+                |m| {
+                    let b = m.memory();
+                    b.element_bytes + b.hierarchy_bytes
+                },
+            )
+        }),
+        wanted("binmap").then(|| {
+            measure(
+                "BinMap",
+                2,
+                loads,
+                || BinMap::build(&map, BinMapParams::default()).unwrap(),
+                |m, f| m.save(f).unwrap(),
+                |f| BinMap::load(&mut &f[..]).unwrap(),
+                |m| m.memory().total(),
+            )
+        }),
     ];
+    let rows: Vec<Row> = rows.into_iter().flatten().collect();
     println!(
         "map: bumpy {n}², {} builds and {} loads per model",
         2,

@@ -13,15 +13,22 @@ use brdf::glint::{
 use brdf::ndf::Ndf;
 use brdf::{Error, Vec2, Vec3};
 
-/// The documented checksum (docs/format.md).
+/// The documented checksum (docs/format.md, format version 2): four lanes, word k into lane k mod 4.
 fn doc_checksum(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xCBF2_9CE4_8422_2325;
-    for chunk in bytes.chunks(8) {
+    const MUL: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mix = |h: u64, w: u64| (h ^ w).wrapping_mul(MUL).rotate_left(29);
+    let mut lanes = [0u64; 4];
+    for (j, lane) in lanes.iter_mut().enumerate() {
+        *lane = 0xCBF2_9CE4_8422_2325u64 + j as u64;
+    }
+    for (k, chunk) in bytes.chunks(8).enumerate() {
         let mut w = [0u8; 8];
         w[..chunk.len()].copy_from_slice(chunk);
-        h = (h ^ u64::from_le_bytes(w))
-            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-            .rotate_left(29);
+        lanes[k % 4] = mix(lanes[k % 4], u64::from_le_bytes(w));
+    }
+    let mut h = lanes[0];
+    for lane in &lanes[1..] {
+        h = mix(h, *lane);
     }
     h ^= bytes.len() as u64;
     h ^= h >> 30;
@@ -216,6 +223,15 @@ fn bin_map_round_trip_is_exact() {
         assert_eq!(loaded.memory(), built.memory());
         assert_eq!(loaded.inverse_bin_map(), built.inverse_bin_map());
         assert_eq!(loaded.forest(), built.forest());
+        // 𝓑 is derived on load, not stored: the same bin for every sub-texel.
+        let (gw, gh) = built.grid_size();
+        for k in 0..gw * gh {
+            assert_eq!(
+                loaded.bin_of_texel(k),
+                built.bin_of_texel(k),
+                "sub-texel {k}"
+            );
+        }
         for (k, f) in footprints(n).iter().enumerate() {
             let what = format!("{lookup:?} fp {k}");
             assert_same_patch(&built.patch(f), &loaded.patch(f), &what);
@@ -230,8 +246,8 @@ fn bin_map_round_trip_is_exact() {
 }
 
 /// Offsets in a bin-map file: width 24, height 32, bins 40, leaf 48, sub-texels 56, lookup 64, σ 68,
-/// 𝓑 count 72, 𝓑 80.. (one u32 per sub-texel), then 𝓑⁻¹ (count, data), offsets, roots, forest,
-/// moments.
+/// 𝓑⁻¹ count 72, 𝓑⁻¹ 80.. (one u32 per sub-texel), then offsets (count, data), roots, forest,
+/// moments. (𝓑 is not stored: the loader derives it from 𝓑⁻¹ and the offsets.)
 #[test]
 fn inconsistent_bin_maps_are_errors() {
     let n = 16;
@@ -248,8 +264,7 @@ fn inconsistent_bin_maps_are_errors() {
         "the default sub-texel resolution the layout assumes"
     );
     let texels = (n * sub) * (n * sub);
-    let bin_map_at = 80;
-    let inverse_at = bin_map_at + 4 * texels + 8;
+    let inverse_at = 80;
     let offsets_at = inverse_at + 4 * texels + 8;
     let roots_at = offsets_at + 4 * 26 + 8;
     let forest_at = roots_at + 4 * 25 + 8;
@@ -279,11 +294,20 @@ fn inconsistent_bin_maps_are_errors() {
     let mid = built.forest()[0] as usize;
     assert!(s < mid && mid < e);
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![
-        ("bin beyond B", with(bin_map_at, 25), "bin_map[0]"),
         (
-            "offsets not the counts",
-            with(offsets_at + 4, u32_at(&file, offsets_at + 4) + 1),
-            "offsets",
+            "sub-texel beyond the grid",
+            with(inverse_at, texels as u32),
+            "out of range",
+        ),
+        (
+            "offsets decreasing",
+            with(offsets_at + 4, texels as u32 + 5),
+            "must not decrease",
+        ),
+        (
+            "offsets not ending at the sub-texel count",
+            with(offsets_at + 4 * 25, texels as u32 - 1),
+            "offsets run from",
         ),
         (
             "inverse not a permutation",
@@ -408,14 +432,14 @@ fn header_errors_name_what_is_wrong() {
     let e = load_mixture(&f).unwrap_err();
     assert!(e.to_string().contains("BRDFGLNT"), "{e}");
     let mut f = file.clone();
-    f[8..12].copy_from_slice(&2u32.to_le_bytes());
+    f[8..12].copy_from_slice(&3u32.to_le_bytes());
     let e = load_mixture(&reseal(f)).unwrap_err();
     assert!(
         matches!(
             e,
             Error::UnsupportedVersion {
-                found: 2,
-                supported: 1
+                found: 3,
+                supported: 2
             }
         ),
         "{e}"

@@ -89,13 +89,19 @@ pub fn check_bxdf(bxdf: &dyn Bxdf, probe: &Probe) {
 /// The file checksum of docs/format.md, written from the documentation (not the crate's code), so
 /// that the store targets can re-seal a mutated file and reach the loaders' content checks.
 pub fn format_checksum(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xCBF2_9CE4_8422_2325;
-    for chunk in bytes.chunks(8) {
+    let mix = |h: u64, w: u64| (h ^ w).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(29);
+    let mut lanes = [0u64; 4];
+    for (j, lane) in lanes.iter_mut().enumerate() {
+        *lane = 0xCBF2_9CE4_8422_2325u64 + j as u64;
+    }
+    for (k, chunk) in bytes.chunks(8).enumerate() {
         let mut w = [0u8; 8];
         w[..chunk.len()].copy_from_slice(chunk);
-        h = (h ^ u64::from_le_bytes(w))
-            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-            .rotate_left(29);
+        lanes[k % 4] = mix(lanes[k % 4], u64::from_le_bytes(w));
+    }
+    let mut h = lanes[0];
+    for lane in &lanes[1..] {
+        h = mix(h, *lane);
     }
     h ^= bytes.len() as u64;
     h ^= h >> 30;

@@ -8,6 +8,7 @@
 //! each model recomputes it from its elements at query time.
 
 use glam::Vec2;
+use rayon::prelude::*;
 
 /// Whether a slope lies in a box (NaN slopes never do).
 #[inline]
@@ -52,23 +53,28 @@ impl SlopeTree {
             let [pw, ph] = sizes[l - 1];
             let [w, h] = sizes[l];
             let prev: &[[f32; 4]] = if l == 1 { leaf } else { &boxes[l - 2] };
-            let mut level = Vec::with_capacity(w * h);
-            for y in 0..h {
-                for x in 0..w {
+            let mut level = vec![[0.0f32; 4]; w * h];
+            // Each parent is the union of its (up to) 2 × 2 children, taken in the order (row 2y:
+            // 2x, 2x + 1), (row 2y + 1: 2x, 2x + 1); rows in parallel.
+            level.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
+                let row = |cy: usize| (cy < ph).then(|| &prev[cy * pw..(cy + 1) * pw]);
+                let (r0, r1) = (row(2 * y), row(2 * y + 1));
+                for (x, o) in out.iter_mut().enumerate() {
                     let mut b = [
                         f32::INFINITY,
                         f32::INFINITY,
                         f32::NEG_INFINITY,
                         f32::NEG_INFINITY,
                     ];
-                    for cy in (2 * y)..(2 * y + 2).min(ph) {
-                        for cx in (2 * x)..(2 * x + 2).min(pw) {
-                            b = union(b, prev[cy * pw + cx]);
+                    for r in [r0, r1].into_iter().flatten() {
+                        b = union(b, r[2 * x]);
+                        if let Some(&c) = r.get(2 * x + 1) {
+                            b = union(b, c);
                         }
                     }
-                    level.push(b);
+                    *o = b;
                 }
-            }
+            });
             boxes.push(level);
         }
         SlopeTree { sizes, boxes }

@@ -23,7 +23,7 @@ use std::io::{Read, Write};
 pub(crate) const MAGIC: [u8; 8] = *b"BRDFGLNT";
 
 /// The format version written, and the only one read.
-pub(crate) const VERSION: u32 = 1;
+pub(crate) const VERSION: u32 = 2;
 
 /// Bytes of the header (magic, version, kind, payload length).
 const HEADER_BYTES: usize = 24;
@@ -57,17 +57,21 @@ impl Kind {
     }
 }
 
-/// The file checksum: a 64-bit multiply-rotate hash over little-endian 64-bit words.
+/// The file checksum: four interleaved 64-bit multiply-rotate lanes over little-endian 64-bit words.
 ///
-/// h₀ = 0xCBF2_9CE4_8422_2325; for each 8-byte word w (the last one zero-padded):
-/// h ← rotl₂₉((h ⊕ w) · 0x9E37_79B9_7F4A_7C15); then h ← h ⊕ (byte count) and the SplitMix64
-/// finaliser (h ⊕= h ≫ 30; h ·= 0xBF58_476D_1CE4_E5B9; h ⊕= h ≫ 27; h ·= 0x94D0_49BB_1331_11EB;
-/// h ⊕= h ≫ 31). Every step is a bijection of h for a fixed word, so any change of one word changes
-/// the result; it detects corruption, it is not a cryptographic signature. ~1 cycle per byte.
+/// Word k of the input (8 bytes, the last one zero-padded) goes to lane k mod 4; lane j starts at
+/// 0xCBF2_9CE4_8422_2325 + j and takes a word w as h ← rotl₂₉((h ⊕ w) · 0x9E37_79B9_7F4A_7C15).
+/// At the end h = lane 0, then for j = 1, 2, 3: h ← rotl₂₉((h ⊕ lane j) · 0x9E37_79B9_7F4A_7C15);
+/// then h ← h ⊕ (byte count) and the SplitMix64 finaliser (h ⊕= h ≫ 30; h ·= 0xBF58_476D_1CE4_E5B9;
+/// h ⊕= h ≫ 27; h ·= 0x94D0_49BB_1331_11EB; h ⊕= h ≫ 31). Every step is a bijection of its lane (or
+/// of h) for fixed other inputs, so any change of one word changes the result; it detects
+/// corruption, it is not a cryptographic signature. The four lanes are independent dependency
+/// chains, so the hash runs at the multiplier's throughput (~0.2 cycle per byte) rather than its
+/// latency (~0.7 for the single chain of format version 1).
 #[derive(Clone, Debug)]
 pub(crate) struct Checksum {
-    state: u64,
-    pending: [u8; 8],
+    lanes: [u64; 4],
+    pending: [u8; 32],
     pending_len: usize,
     total: u64,
 }
@@ -78,47 +82,63 @@ impl Checksum {
 
     pub(crate) fn new() -> Checksum {
         Checksum {
-            state: Self::SEED,
-            pending: [0; 8],
+            lanes: std::array::from_fn(|j| Self::SEED.wrapping_add(j as u64)),
+            pending: [0; 32],
             pending_len: 0,
             total: 0,
         }
     }
 
     #[inline]
-    fn word(&mut self, w: u64) {
-        self.state = (self.state ^ w).wrapping_mul(Self::MUL).rotate_left(29);
+    fn mix(h: u64, w: u64) -> u64 {
+        (h ^ w).wrapping_mul(Self::MUL).rotate_left(29)
+    }
+
+    /// One 32-byte block: words 0-3 into lanes 0-3.
+    #[inline]
+    fn block(&mut self, b: &[u8]) {
+        for (j, lane) in self.lanes.iter_mut().enumerate() {
+            let w = u64::from_le_bytes(b[8 * j..8 * j + 8].try_into().unwrap_or([0; 8]));
+            *lane = Self::mix(*lane, w);
+        }
     }
 
     pub(crate) fn update(&mut self, mut bytes: &[u8]) {
         self.total += bytes.len() as u64;
         if self.pending_len > 0 {
-            let take = (8 - self.pending_len).min(bytes.len());
+            let take = (32 - self.pending_len).min(bytes.len());
             self.pending[self.pending_len..self.pending_len + take].copy_from_slice(&bytes[..take]);
             self.pending_len += take;
             bytes = &bytes[take..];
-            if self.pending_len < 8 {
+            if self.pending_len < 32 {
                 return;
             }
-            self.word(u64::from_le_bytes(self.pending));
+            let block = self.pending;
+            self.block(&block);
             self.pending_len = 0;
         }
-        let mut words = bytes.chunks_exact(8);
-        for w in &mut words {
-            self.word(u64::from_le_bytes(w.try_into().unwrap_or([0; 8])));
+        let mut blocks = bytes.chunks_exact(32);
+        for b in &mut blocks {
+            self.block(b);
         }
-        let rest = words.remainder();
+        let rest = blocks.remainder();
         self.pending[..rest.len()].copy_from_slice(rest);
         self.pending_len = rest.len();
     }
 
     pub(crate) fn finish(mut self) -> u64 {
-        if self.pending_len > 0 {
-            let mut last = [0u8; 8];
-            last[..self.pending_len].copy_from_slice(&self.pending[..self.pending_len]);
-            self.word(u64::from_le_bytes(last));
+        // The last (< 32) bytes: whole and zero-padded words into lanes 0, 1, ... in order.
+        let mut tail = [0u8; 32];
+        tail[..self.pending_len].copy_from_slice(&self.pending[..self.pending_len]);
+        for j in 0..self.pending_len.div_ceil(8) {
+            let w = u64::from_le_bytes(tail[8 * j..8 * j + 8].try_into().unwrap_or([0; 8]));
+            self.lanes[j] = Self::mix(self.lanes[j], w);
         }
-        let mut h = self.state ^ self.total;
+        let mut h = self.lanes[0];
+        for &lane in &self.lanes[1..] {
+            h = Self::mix(h, lane);
+        }
+        h ^= self.total;
         h ^= h >> 30;
         h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
         h ^= h >> 27;
@@ -140,10 +160,16 @@ fn stream(source: std::io::Error) -> Error {
 }
 
 /// A value that can be written to and read from a file as fixed-size little-endian bytes.
-pub(crate) trait Scalar: Copy {
+///
+/// `Pod` lets arrays be read straight into their final storage (one copy from the reader, no
+/// per-scalar decoding); [`Scalar::le_to_native`] then reorders the bytes on a big-endian target and is
+/// the identity (compiled away) on a little-endian one.
+pub(crate) trait Scalar: Copy + bytemuck::Pod {
     const BYTES: usize;
     fn put(self, out: &mut Vec<u8>);
     fn get(b: &[u8]) -> Self;
+    /// The value whose little-endian bytes are this value's in-memory bytes.
+    fn le_to_native(self) -> Self;
 }
 
 macro_rules! scalar {
@@ -159,6 +185,10 @@ macro_rules! scalar {
                 let mut a = [0u8; $n];
                 a.copy_from_slice(&b[..$n]);
                 <$t>::from_le_bytes(a)
+            }
+            #[inline]
+            fn le_to_native(self) -> Self {
+                <$t>::from_le_bytes(self.to_ne_bytes())
             }
         }
     };
@@ -343,7 +373,7 @@ impl<'a> Decoder<'a> {
     /// An array written by [`Encoder::array`] whose element count must equal `expected` (derived
     /// from the parameters already read). The count is checked against `expected` and against the
     /// declared payload before anything is allocated; records are read in chunks.
-    pub(crate) fn array<T: Scalar + Default, const N: usize>(
+    pub(crate) fn array<T: Scalar, const N: usize>(
         &mut self,
         what: &'static str,
         expected: usize,
@@ -361,7 +391,7 @@ impl<'a> Decoder<'a> {
 
     /// An array written by [`Encoder::array`] whose element count is free up to `max` (checked, as
     /// everything else, before allocating).
-    pub(crate) fn array_up_to<T: Scalar + Default, const N: usize>(
+    pub(crate) fn array_up_to<T: Scalar, const N: usize>(
         &mut self,
         what: &'static str,
         max: usize,
@@ -370,7 +400,11 @@ impl<'a> Decoder<'a> {
         self.records(what, n)
     }
 
-    fn records<T: Scalar + Default, const N: usize>(
+    /// Reads `expected` records: bytes go from the reader into a chunk of records (no per-scalar
+    /// decoding), are hashed there and appended to the vector, which grows as data arrive (so a
+    /// file that declares more than it holds allocates at most about twice what it did hold). The
+    /// bytes are reordered in place only on a big-endian target.
+    fn records<T: Scalar, const N: usize>(
         &mut self,
         what: &'static str,
         expected: usize,
@@ -384,17 +418,21 @@ impl<'a> Decoder<'a> {
         self.take(bytes, what)?;
         let per_chunk = (CHUNK_BYTES / record).max(1);
         let mut out: Vec<[T; N]> = Vec::with_capacity(expected.min(per_chunk));
-        let mut buf = vec![0u8; per_chunk * record];
+        let mut buf = vec![[T::zeroed(); N]; expected.min(per_chunk)];
         let mut left = expected;
         while left > 0 {
             let k = left.min(per_chunk);
-            let chunk = &mut buf[..k * record];
-            read_exact(self.r, chunk, what)?;
-            self.sum.update(chunk);
-            out.extend(chunk.chunks_exact(record).map(|rec| {
-                std::array::from_fn(|i| T::get(&rec[i * T::BYTES..(i + 1) * T::BYTES]))
-            }));
+            let chunk = &mut buf[..k];
+            let raw: &mut [u8] = bytemuck::cast_slice_mut(chunk.as_flattened_mut());
+            read_exact(self.r, raw, what)?;
+            self.sum.update(raw);
+            out.extend_from_slice(chunk);
             left -= k;
+        }
+        if cfg!(target_endian = "big") {
+            for v in out.iter_mut().flatten() {
+                *v = v.le_to_native();
+            }
         }
         Ok(out)
     }
@@ -440,14 +478,25 @@ pub(crate) fn invalid(reason: String) -> Error {
 }
 
 /// Checks that every value is finite and within [lo, hi]; `what` names the array in the error.
+///
+/// The bounds are taken once per component and the items are scanned without an early exit (a
+/// loop the compiler vectorises); only a failing array is scanned again to name its first bad value.
 pub(crate) fn check_range<const N: usize>(
     items: &[[f32; N]],
     what: &str,
     bound: impl Fn(usize) -> (f32, f32),
 ) -> Result<()> {
+    let bounds: [(f32, f32); N] = std::array::from_fn(&bound);
+    let inside = |item: &[f32; N]| {
+        item.iter()
+            .zip(&bounds)
+            .fold(true, |ok, (&v, &(lo, hi))| ok & (v >= lo) & (v <= hi))
+    };
+    if items.iter().fold(true, |ok, item| ok & inside(item)) {
+        return Ok(());
+    }
     for (k, item) in items.iter().enumerate() {
-        for (c, &v) in item.iter().enumerate() {
-            let (lo, hi) = bound(c);
+        for (c, (&v, &(lo, hi))) in item.iter().zip(&bounds).enumerate() {
             if !(v >= lo && v <= hi) {
                 return Err(invalid(format!(
                     "{what}[{k}][{c}] = {v} is outside [{lo}, {hi}] (or not finite)"
@@ -466,7 +515,7 @@ mod tests {
     fn checksum_is_independent_of_chunking() {
         let data: Vec<u8> = (0..1000u32).map(|k| (k * 7 + 3) as u8).collect();
         let whole = checksum(&data);
-        for split in [1, 3, 7, 8, 9, 500, 999] {
+        for split in [1, 3, 7, 8, 9, 31, 32, 33, 500, 999] {
             let mut c = Checksum::new();
             for part in data.chunks(split) {
                 c.update(part);
@@ -484,13 +533,23 @@ mod tests {
         assert_ne!(checksum(&d), whole);
     }
 
-    /// The reference value of the documented algorithm, computed by hand-written steps here.
+    /// The reference value of the documented algorithm, computed by hand-written steps here: 9 bytes,
+    /// i.e. word 0 ("BRDFGLNT") into lane 0 and word 1 (0x01, zero-padded) into lane 1.
     #[test]
     fn checksum_matches_the_documented_steps() {
         let bytes = b"BRDFGLNT\x01";
-        let mut h: u64 = 0xCBF2_9CE4_8422_2325;
-        for w in [u64::from_le_bytes(*b"BRDFGLNT"), 1u64] {
-            h = (h ^ w).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(29);
+        let seed: u64 = 0xCBF2_9CE4_8422_2325;
+        let mul: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mix = |h: u64, w: u64| (h ^ w).wrapping_mul(mul).rotate_left(29);
+        let lanes = [
+            mix(seed, u64::from_le_bytes(*b"BRDFGLNT")),
+            mix(seed + 1, 1),
+            seed + 2,
+            seed + 3,
+        ];
+        let mut h = lanes[0];
+        for lane in &lanes[1..] {
+            h = mix(h, *lane);
         }
         h ^= 9;
         h ^= h >> 30;

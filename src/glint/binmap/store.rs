@@ -1,18 +1,19 @@
 //! Saving and loading a built [`BinMap`] (format: docs/format.md, kind 4).
 //!
-//! Stored: the map size, the build parameters (sub-texel resolution s included), the bin map 𝓑 (u32
-//! per sub-texel of the (s·width) × (s·height) grid), the inverse bin map 𝓑⁻¹ in the forest's order
-//! (u32 per sub-texel), the prefix-sum offsets of the bins' lists (B + 1) and their
-//! tree roots (B), the packed forest, and the coarse slope-moment chain of the masking lobe. Rebuilt
-//! on load (cheap, by the build's own routines): the per-bin tables (centre slopes, masking facets) and
-//! the lookup (dense or hash) from the offsets and roots.
+//! Stored: the map size, the build parameters (sub-texel resolution s included), the inverse bin map
+//! 𝓑⁻¹ in the forest's order (u32 per sub-texel of the (s·width) × (s·height) grid), the prefix-sum
+//! offsets of the bins' lists (B + 1) and their tree roots (B), the packed forest, and the coarse
+//! slope-moment chain of the masking lobe. Rebuilt on load (cheap, by the build's own routines): the
+//! bin map 𝓑 itself (sub-texel k is in bin b exactly when k is in b's list of 𝓑⁻¹), the per-bin
+//! tables (centre slopes, masking facets) and the lookup (dense or hash) from the offsets and roots.
 //!
 //! The inverse map and the forest are stored rather than rebuilt because sorting the texels into the
 //! trees is most of the build. The loader therefore validates them completely before use: 𝓑⁻¹ is a
-//! permutation whose lists agree with 𝓑 and the offsets; the forest is exactly the pre-order layout
+//! permutation of the sub-texels (so 𝓑 derived from it is total and consistent with the offsets); the forest is exactly the pre-order layout
 //! the builder writes (each internal node where the previous one ends, right-child links consistent,
-//! a list gets a tree exactly when it is longer than the leaf size), and every node's texels lie in
-//! its region with the split the builder uses. A file that passes is a bin map the builder could
+//! a list gets a tree exactly when it is longer than the leaf size), and every leaf's texels lie in
+//! the leaf's region (regions nest, so every internal node's two ranges then hold exactly the
+//! texels on each side of its split, the builder's partition). A file that passes is a bin map the builder could
 //! have produced.
 
 use super::forest::NO_TREE;
@@ -22,12 +23,13 @@ use crate::Result;
 use crate::glint::MAX_SLOPE;
 use crate::glint::moments::{MomentLevel, MomentPyramid};
 use crate::glint::store::{self, Decoder, Kind, invalid};
+use rayon::prelude::*;
 use std::io::{Read, Write};
 
 impl BinMap {
-    /// Writes the bin map in the crate's binary format (docs/format.md): size, parameters, 𝓑, 𝓑⁻¹,
-    /// bin offsets and roots, forest and coarse moments, exactly (about 8 bytes per texel plus 8 per
-    /// bin). Writes in 64 KiB blocks.
+    /// Writes the bin map in the crate's binary format (docs/format.md): size, parameters, 𝓑⁻¹,
+    /// bin offsets and roots, forest and coarse moments, exactly (about 4 bytes per sub-texel plus 8
+    /// per bin). Writes in 64 KiB blocks.
     ///
     /// # Errors
     /// [`crate::Error::Stream`] if the writer fails.
@@ -59,10 +61,6 @@ impl BinMap {
                 BinLookup::Hash => 1u32,
             })?;
             e.put(p.sigma_min)?;
-            match &self.bin_map {
-                BinIndex::U16(v) => e.array(v.iter().map(|&b| [b as u32]))?,
-                BinIndex::U32(v) => e.array(v.iter().map(|&b| [b]))?,
-            }
             e.array(self.inverse.iter().map(|&k| [k]))?;
             e.array(offsets.iter().map(|&o| [o]))?;
             e.array(entries.iter().map(|&(_, root)| [root]))?;
@@ -116,7 +114,6 @@ impl BinMap {
             )));
         }
         let nb = bins.len();
-        let bin_map = flat(d.array::<u32, 1>("bin_map", texels)?);
         let inverse = flat(d.array::<u32, 1>("inverse", texels)?);
         let offsets = flat(d.array::<u32, 1>("offsets", nb + 1)?);
         let roots = flat(d.array::<u32, 1>("roots", nb)?);
@@ -161,22 +158,24 @@ impl BinMap {
                 _ => (-m * m, m * m),
             })?;
         }
-        check_lists(&bin_map, &inverse, &offsets, nb)?;
-        check_forest(
-            &inverse,
-            &offsets,
-            &roots,
-            &nodes,
-            [grid_w, grid_h],
-            params.leaf_size,
-        )?;
+        check_offsets(&offsets, inverse.len())?;
+        // Deriving 𝓑 (random writes) and walking the forest (reads) are independent.
+        let (bin_map, forest) = rayon::join(
+            || bins_of(&inverse, &offsets, nb),
+            || {
+                check_forest(
+                    &inverse,
+                    &offsets,
+                    &roots,
+                    &nodes,
+                    [grid_w, grid_h],
+                    params.leaf_size,
+                )
+            },
+        );
+        let bin_map = bin_map?;
+        forest?;
         let (facets, center_slope) = super::bin_tables(&bins, &offsets);
-        // The builder's storage choice (u16 when every bin fits).
-        let bin_map = if nb <= 1 << 16 {
-            BinIndex::U16(bin_map.iter().map(|&b| b as u16).collect())
-        } else {
-            BinIndex::U32(bin_map)
-        };
         Ok(BinMap {
             width,
             height,
@@ -196,42 +195,78 @@ impl BinMap {
 }
 
 fn flat(v: Vec<[u32; 1]>) -> Vec<u32> {
-    v.into_iter().map(|[x]| x).collect()
+    // Same size and alignment: the vector is reinterpreted in place, no copy.
+    bytemuck::cast_vec(v)
 }
 
-/// 𝓑 holds bins < B; the offsets are prefix sums from 0 to the texel count whose differences are the
-/// bins' texel counts in 𝓑; 𝓑⁻¹ is a permutation of the texels, each in the list of its bin.
-fn check_lists(bin_map: &[u32], inverse: &[u32], offsets: &[u32], nb: usize) -> Result<()> {
-    let mut counts = vec![0u32; nb];
-    for (k, &b) in bin_map.iter().enumerate() {
-        let c = counts
-            .get_mut(b as usize)
-            .ok_or_else(|| invalid(format!("bin_map[{k}] = {b}, beyond the {nb} bins")))?;
-        *c += 1;
+/// The offsets are prefix sums: from 0 to the sub-texel count `n`, never decreasing.
+fn check_offsets(offsets: &[u32], n: usize) -> Result<()> {
+    let nb = offsets.len() - 1;
+    if offsets[0] != 0 || offsets[nb] as usize != n {
+        return Err(invalid(format!(
+            "offsets run from {} to {} where the lists of {n} sub-texels need 0 to {n}",
+            offsets[0], offsets[nb]
+        )));
     }
-    if offsets[0] != 0 {
-        return Err(invalid(format!("offsets[0] = {} (0 expected)", offsets[0])));
+    if let Some(b) = (0..nb).find(|&b| offsets[b + 1] < offsets[b]) {
+        return Err(invalid(format!(
+            "offsets[{}] = {} < offsets[{b}] = {}: the offsets must not decrease",
+            b + 1,
+            offsets[b + 1],
+            offsets[b]
+        )));
     }
-    for b in 0..nb {
-        if offsets[b + 1].checked_sub(offsets[b]) != Some(counts[b]) {
-            return Err(invalid(format!(
-                "offsets[{}] − offsets[{b}] is not bin {b}'s texel count {}",
-                b + 1,
-                counts[b]
-            )));
-        }
-    }
-    let mut seen = vec![false; inverse.len()];
-    for b in 0..nb {
+    Ok(())
+}
+
+/// 𝓑 from 𝓑⁻¹ and offsets already checked by [`check_offsets`]: 𝓑⁻¹ must be a permutation of the
+/// sub-texels (each index in range and listed once), so every sub-texel gets exactly one bin (the one
+/// whose list holds it).
+fn bins_of(inverse: &[u32], offsets: &[u32], nb: usize) -> Result<BinIndex> {
+    // The builder's storage choice (u16 when every bin fits).
+    Ok(if nb <= 1 << 16 {
+        let mut v = vec![0u16; inverse.len()];
+        scatter_bins(inverse, offsets, &mut v, |b| b as u16)?;
+        BinIndex::U16(v)
+    } else {
+        let mut v = vec![0u32; inverse.len()];
+        scatter_bins(inverse, offsets, &mut v, |b| b as u32)?;
+        BinIndex::U32(v)
+    })
+}
+
+/// Writes bin b into `bin_map[k]` for every k of b's list, checking with a bit set (n / 8 bytes, which
+/// stays in cache where 𝓑 does not) that every k is in range and listed once.
+///
+/// The lists visit sub-texels all over the map, so these writes miss the cache (~37 ns per sub-texel
+/// at 1024², s = 2, on a loaded machine: most of the load). Two cache-friendlier orders were tried
+/// and were slower: partitioning the pairs by blocks of 𝓑 into a temporary array first, and scanning
+/// all lists once per block of 𝓑 (branchy or branch-free).
+fn scatter_bins<T>(
+    inverse: &[u32],
+    offsets: &[u32],
+    bin_map: &mut [T],
+    bin: impl Fn(usize) -> T,
+) -> Result<()> {
+    let n = inverse.len();
+    let mut seen = vec![0u64; n.div_ceil(64)];
+    for b in 0..offsets.len() - 1 {
         let (start, end) = (offsets[b] as usize, offsets[b + 1] as usize);
         for (i, &k) in (start..).zip(&inverse[start..end]) {
             let k = k as usize;
-            if k >= seen.len() || seen[k] || bin_map[k] as usize != b {
-                return Err(invalid(format!(
-                    "inverse[{i}] = {k} is out of range, repeated, or not a texel of bin {b}"
-                )));
+            let bit = 1u64 << (k % 64);
+            match seen.get_mut(k / 64) {
+                Some(word) if k < n && *word & bit == 0 => {
+                    *word |= bit;
+                    bin_map[k] = bin(b);
+                }
+                _ => {
+                    return Err(invalid(format!(
+                        "inverse[{i}] = {k} is out of range or repeated (not a permutation of the \
+                         {n} sub-texels)"
+                    )));
+                }
             }
-            seen[k] = true;
         }
     }
     Ok(())
@@ -240,8 +275,10 @@ fn check_lists(bin_map: &[u32], inverse: &[u32], offsets: &[u32], nb: usize) -> 
 /// The forest is exactly the builder's layout (see forest.rs): bins in order, each list longer than
 /// `leaf` has a tree at the current end of the array, nodes in pre-order (a left child that is internal
 /// follows its parent, the stored right-child index is where the left subtree ends), mids within the
-/// node's range, and every texel on the side of the split the builder puts it. (With 𝓑⁻¹ a permutation,
-/// this puts every node's texels inside its region.) Cost O(texels × depth), no allocation.
+/// node's range, and every leaf's texels inside the leaf's region. Regions nest and the two children of
+/// a node split its region at the builder's split, so this puts every internal node's left range on
+/// one side of its split and its right range on the other: the builder's partition. Cost O(texels +
+/// nodes) (one division per texel), no allocation.
 fn check_forest(
     inverse: &[u32],
     offsets: &[u32],
@@ -256,27 +293,54 @@ fn check_forest(
         width: size[0] as u32,
         leaf,
     };
+    // Each tree is walked from its stored root, bins in parallel; the layout (trees back to back in
+    // bin order, from 0 to the end of the array) is then checked in order on the walks' ends.
+    let ends: Vec<Result<Option<usize>>> = (0..roots.len())
+        .into_par_iter()
+        .map(|b| {
+            let (start, end) = (offsets[b] as usize, offsets[b + 1] as usize);
+            if end - start <= leaf {
+                return if roots[b] == NO_TREE {
+                    f.node(
+                        b,
+                        start,
+                        end,
+                        [0, 0, size[0] as u32, size[1] as u32],
+                        &mut 0,
+                    )
+                    .map(|()| None)
+                } else {
+                    Err(invalid(format!(
+                        "roots[{b}] = {} where the forest layout needs {NO_TREE} (no tree)",
+                        roots[b]
+                    )))
+                };
+            }
+            let mut cursor = roots[b] as usize;
+            f.node(
+                b,
+                start,
+                end,
+                [0, 0, size[0] as u32, size[1] as u32],
+                &mut cursor,
+            )
+            .map(|()| Some(cursor))
+        })
+        .collect();
     let mut cursor = 0usize;
-    for b in 0..roots.len() {
-        let (start, end) = (offsets[b] as usize, offsets[b + 1] as usize);
-        let expected_root = if end - start > leaf {
-            cursor as u32
-        } else {
-            NO_TREE
-        };
-        if roots[b] != expected_root {
+    for (b, walked) in ends.into_iter().enumerate() {
+        // The same first error as walking the trees one after the other: a misplaced root before
+        // anything found inside its tree.
+        let has_tree = offsets[b + 1] - offsets[b] > leaf as u32;
+        if has_tree && roots[b] as usize != cursor {
             return Err(invalid(format!(
-                "roots[{b}] = {} where the forest layout needs {expected_root}",
+                "roots[{b}] = {} where the forest layout needs {cursor}",
                 roots[b]
             )));
         }
-        f.node(
-            b,
-            start,
-            end,
-            [0, 0, size[0] as u32, size[1] as u32],
-            &mut cursor,
-        )?;
+        if let Some(end) = walked? {
+            cursor = end;
+        }
     }
     if cursor != nodes.len() {
         return Err(invalid(format!(
@@ -305,10 +369,22 @@ impl Forest<'_> {
         region: [u32; 4],
         cursor: &mut usize,
     ) -> Result<()> {
+        let [x0, y0, x1, y1] = region;
         if e - s <= self.leaf {
+            let w = self.width;
+            let outside = |k: u32| {
+                let (x, y) = (k % w, k / w);
+                x < x0 || x >= x1 || y < y0 || y >= y1
+            };
+            if let Some(i) = (s..e).find(|&i| outside(self.inverse[i])) {
+                return Err(invalid(format!(
+                    "forest of bin {b}: texel {} at inverse[{i}] lies outside its leaf's region \
+                     {region:?} (on the wrong side of a split)",
+                    self.inverse[i]
+                )));
+            }
             return Ok(());
         }
-        let [x0, y0, x1, y1] = region;
         let at = *cursor;
         if at + 2 > self.nodes.len() || (x1 - x0) as u64 * (y1 - y0) as u64 <= 1 {
             return Err(invalid(format!(
@@ -327,14 +403,6 @@ impl Forest<'_> {
         } else {
             y0 + (y1 - y0) / 2
         };
-        let w = self.width;
-        let coord = |k: u32| if along_x { k % w } else { k / w };
-        if let Some(i) = (s..e).find(|&i| (coord(self.inverse[i]) < split) != (i < mid)) {
-            return Err(invalid(format!(
-                "forest of bin {b}: texel {} at inverse[{i}] is on the wrong side of its node's split",
-                self.inverse[i]
-            )));
-        }
         let (left, right) = if along_x {
             ([x0, y0, split, y1], [split, y0, x1, y1])
         } else {

@@ -29,6 +29,7 @@ use crate::error::{Error, Result, positive};
 use crate::glint::slope_tree::SlopeTree;
 use crate::glint::{Footprint, GlintNdf, GlintScratch, MAX_TRUNCATION_SIGMAS, NormalMap};
 use glam::{Mat2, Vec2};
+use rayon::prelude::*;
 
 /// σ_h / h = 1/√(8 ln 2) (see [`PositionNormalMap::SIGMA_H_PER_SPACING`]).
 pub(crate) const SIGMA_H_PER_SPACING: f64 = 0.424_660_900_144_009_5;
@@ -234,7 +235,7 @@ impl PositionNormalMap {
         let spacing = 1.0 / params.sampling_rate as f64;
         let sigma_h = SIGMA_H_PER_SPACING * spacing;
         let leaf: Vec<[f32; 4]> = elements
-            .iter()
+            .par_iter()
             .map(|e| build::slope_box(e, sigma_h, &params))
             .collect();
         let tree = SlopeTree::build(grid[0], grid[1], &leaf);
