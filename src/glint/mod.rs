@@ -63,6 +63,8 @@ mod position_normal;
 mod procedural;
 mod reference;
 mod scratch;
+#[cfg(feature = "serde")]
+mod serde_impl;
 mod slope_tree;
 mod store;
 

@@ -1,0 +1,94 @@
+//! `serde` support (feature `serde`): every built model and the normal map round-trip through a binary
+//! serde format (postcard) bit-identically, and a damaged byte string is an error, not a panic.
+//!
+//! `cargo test --features serde --test serde` (CI runs it).
+
+mod support;
+
+use brdf::glint::{
+    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintNdf, MixtureParams, NormalMap,
+    PositionNormalMap, PositionNormalParams,
+};
+use brdf::ndf::Ndf;
+use brdf::{Vec2, Vec3};
+
+fn map() -> NormalMap {
+    brdf::glint::bumpy(24, 24, 0.3, 3.0, 5).unwrap()
+}
+
+/// d, lambda and pdf_visible of two patches agree bit for bit over a few directions.
+fn same(a: &impl Ndf, b: &impl Ndf) {
+    for th in [0.0f64, 40.0, 80.0] {
+        for ph in [0.0f64, 130.0] {
+            let w = support::dir(th, ph);
+            let m = (w + Vec3::Z).normalize();
+            assert_eq!(a.d(m).to_bits(), b.d(m).to_bits(), "d at {th} {ph}");
+            assert_eq!(a.lambda(w).to_bits(), b.lambda(w).to_bits(), "lambda");
+            assert_eq!(
+                a.pdf_visible(w, m).to_bits(),
+                b.pdf_visible(w, m).to_bits(),
+                "pdf_visible"
+            );
+        }
+    }
+}
+
+fn footprint() -> Footprint {
+    Footprint::from_differentials(
+        Vec2::new(0.4, 0.55),
+        Vec2::new(3.0 / 24.0, 0.0),
+        Vec2::new(0.0, 3.0 / 24.0),
+    )
+}
+
+fn round_trip<T: serde::Serialize + serde::de::DeserializeOwned>(t: &T) -> T {
+    let bytes = postcard::to_allocvec(t).unwrap();
+    postcard::from_bytes(&bytes).unwrap()
+}
+
+#[test]
+fn every_model_round_trips_through_postcard() {
+    let m = map();
+    let back = round_trip(&m);
+    assert_eq!(back.slopes(), m.slopes());
+
+    let mix = BeckmannMixture::build(
+        &m,
+        MixtureParams {
+            samples: 16,
+            ..MixtureParams::default()
+        },
+    )
+    .unwrap();
+    same(
+        &mix.patch(&footprint()),
+        &round_trip(&mix).patch(&footprint()),
+    );
+
+    let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
+    same(
+        &pn.patch(&footprint()),
+        &round_trip(&pn).patch(&footprint()),
+    );
+
+    let bm = BinMap::build(&m, BinMapParams::default()).unwrap();
+    same(
+        &bm.patch(&footprint()),
+        &round_trip(&bm).patch(&footprint()),
+    );
+}
+
+#[test]
+fn damaged_bytes_are_errors() {
+    let bytes = postcard::to_allocvec(&map()).unwrap();
+    // Flip a byte inside the slopes: the checksum catches it.
+    let mut bad = bytes.clone();
+    let k = bad.len() / 2;
+    bad[k] ^= 0x40;
+    let e = postcard::from_bytes::<NormalMap>(&bad);
+    assert!(e.is_err());
+    // Cut short: the byte string itself is incomplete.
+    assert!(postcard::from_bytes::<NormalMap>(&bytes[..bytes.len() - 9]).is_err());
+    // A normal map's bytes are not a bin map.
+    assert!(postcard::from_bytes::<BinMap>(&bytes).is_err());
+}
