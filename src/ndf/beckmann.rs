@@ -9,7 +9,10 @@ use super::Ndf;
 use crate::Result;
 use crate::error::positive;
 use crate::frame::slope_to_normal;
-use crate::math::{INV_SQRT_PI, atan2_pos, erf, erfcx_small, erfinv, exp_neg_sq};
+use crate::math::{
+    INV_SQRT_PI, atan2_pos, erf_with_exp_neg_sq, erfcx_small, erfinv, exp_neg_sq,
+    is_positive_finite,
+};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -251,16 +254,23 @@ const G1_END_SQ: f32 = G1_END * G1_END;
 fn visible_area_ratio(z: f32, s: f32) -> (f32, f32) {
     let b = (z * z) / s;
     let n = s.sqrt();
-    let b2 = b * b;
-    let [p0, p1, p2, p3, p4] = G1_P;
-    let [q0, q1, q2, q3, q4] = G1_Q;
-    let p = (p0 + p1 * b) + b2 * ((p2 + p3 * b) + p4 * b2);
-    let q = (q0 + q1 * b) + b2 * ((q2 + q3 * b) + q4 * b2);
+    let (p, q) = e_fit(b);
     if b < G1_END_SQ {
         (0.5 * (z * q) + n * p, q)
     } else {
         (z, 1.0)
     }
+}
+
+/// (P(b), Q(b)) of [`visible_area_ratio`], both by Estrin's scheme (no cancellation for b ≥ 0).
+#[inline(always)]
+fn e_fit(b: f32) -> (f32, f32) {
+    let b2 = b * b;
+    let [p0, p1, p2, p3, p4] = G1_P;
+    let [q0, q1, q2, q3, q4] = G1_Q;
+    let p = (p0 + p1 * b) + b2 * ((p2 + p3 * b) + p4 * b2);
+    let q = (q0 + q1 * b) + b2 * ((q2 + q3 * b) + q4 * b2);
+    (p, q)
 }
 
 /// Numerator P(b) of E(b) ≈ P/Q in [`visible_area_ratio`], ascending powers of b = a²
@@ -292,9 +302,17 @@ const G1_Q: [f32; 5] = [
 /// \[Walter2007\] §5.1 (Beckmann G1), \[Heitz2014\] eq. 72 (Λ).
 #[inline(always)]
 fn g1_zs(z: f32, s: f32) -> f32 {
-    let (num, den) = visible_area_ratio(z, s);
-    // The fit may exceed the truth by its error just below the cut-off, where G1 < 1 by less.
-    (z * den / num).min(1.0)
+    let b = (z * z) / s;
+    if b < G1_END_SQ {
+        let (p, q) = e_fit(b);
+        let zq = z * q;
+        // z Q/(z Q/2 + n P) with both sides doubled (exact): the same bits, one multiplication fewer.
+        // The fit may exceed the truth by its error just below the cut-off, where G1 < 1 by less.
+        ((zq + zq) / (zq + 2.0 * (s.sqrt() * p))).min(1.0)
+    } else {
+        // Also at normal incidence (b = +∞) and for b = NaN (z = s = 0, rejected by the callers).
+        1.0
+    }
 }
 
 /// V = num/den of [`visible_area_ratio`] (one division).
@@ -334,9 +352,10 @@ fn visible_slope_x<const HALLEY: bool>(
     theta: f32,
     ux: f32,
 ) -> (f32, u32) {
-    let c = erf(cot_theta);
+    let e_cot = exp_neg_sq(cot_theta);
+    let c = erf_with_exp_neg_sq(cot_theta, e_cot);
     let k = tan_theta * INV_SQRT_PI;
-    let total = 1.0 + c + k * exp_neg_sq(cot_theta);
+    let total = 1.0 + c + k * e_cot;
     let ux = ux.clamp(0.0, 1.0);
     let target = ux * total;
     let tol = if HALLEY { 3e-6 } else { 1e-5 } * total;
@@ -469,7 +488,7 @@ impl Ndf for Beckmann {
     fn g1(&self, w: Vec3, m: Vec3) -> f32 {
         let c = w.dot(m);
         let g = g1_zs(w.z, self.stretched_sin_sq(w));
-        if w.z > 0.0 && c > 0.0 && c <= f32::MAX {
+        if w.z > 0.0 && is_positive_finite(c) {
             g
         } else {
             0.0
