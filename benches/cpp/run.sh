@@ -3,6 +3,9 @@
 # (C++, crate, C++, crate), printing ns per call (minimum and median over batches of 1024 calls).
 # Run from the crate root: `sh benches/cpp/run.sh [ROUNDS [BATCHES]]` (default 5 1000).
 # Not part of CI: needs g++; the crate side builds with `cargo bench --no-run`.
+# Before/after comparisons: set BEFORE_NDF and BEFORE_FRESNEL to bench binaries built from an older
+# `src/` (copied out of target/release/deps/ before rebuilding); each pass then runs C++, before,
+# crate, with the before rows labelled `before`.
 set -e
 ROUNDS=${1:-5}
 BATCHES=${2:-1000}
@@ -17,6 +20,11 @@ echo "# g++ $(g++ -dumpfullversion) -O3 -fno-math-errno; crate: cargo bench (rel
 for pass in 1 2; do
   echo "## pass $pass: C++"
   "$OUT/analytic" "$ROUNDS" "$BATCHES"
+  if [ -n "$BEFORE_NDF" ]; then
+    echo "## pass $pass: before"
+    BRDF_TABLE=1 BRDF_TABLE_ROUNDS=$ROUNDS BRDF_TABLE_BATCHES=$BATCHES "$BEFORE_NDF" | sed 's/ crate    / before   /'
+    BRDF_TABLE=1 BRDF_TABLE_ROUNDS=$ROUNDS BRDF_TABLE_BATCHES=$BATCHES "$BEFORE_FRESNEL" | sed 's/ crate    / before   /'
+  fi
   echo "## pass $pass: crate"
   BRDF_TABLE=1 BRDF_TABLE_ROUNDS=$ROUNDS BRDF_TABLE_BATCHES=$BATCHES "$NDF"
   BRDF_TABLE=1 BRDF_TABLE_ROUNDS=$ROUNDS BRDF_TABLE_BATCHES=$BATCHES "$FRESNEL"
