@@ -38,9 +38,13 @@ use glam::{Vec2, Vec3};
 use lookup::Table;
 use rayon::prelude::*;
 
-/// Default bins per axis n (B = n² = 16129 bins of 3.9·10⁻⁴ sr, about 1.1° across), the talk's
-/// car-paint setting (127²).
-pub const DEFAULT_BINS_PER_AXIS: usize = 127;
+/// Default bins per axis n: 255 (B = n² = 65 025 bins of 9.7·10⁻⁵ sr, about 0.56° across; 𝓑 still
+/// fits `u16`). Chosen with [`DEFAULT_SUBDIVISIONS`] from accuracy against memory on the procedural
+/// maps (docs/results.md, "The bin map, finished"): against the talk's car-paint setting 127² it
+/// lowers the TV distance to the ground truth at ≥ 256 texels on brushed, scratched and flakes
+/// (1.3-2.3×) and raises it 1.2× on the smooth bumpy map, for 0.5 B/texel more at 2048² (the
+/// per-bin tables: 3.4 MB per map whatever its size). 127 remains the talk's setting.
+pub const DEFAULT_BINS_PER_AXIS: usize = 255;
 
 /// Default maximum leaf size L of the kd-trees: lists of at most L texels are scanned linearly, and
 /// only longer lists get a tree (16, as in the talk).
