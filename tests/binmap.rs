@@ -1259,7 +1259,11 @@ fn exact_measure_table() {
                 .iter()
                 .map(|bm| {
                     let p = bm.patch(&fp);
-                    format!("{:.3} / {:.3}", tv_distance(&p, &para, 64), tv_exact(&p, &para))
+                    format!(
+                        "{:.3} / {:.3}",
+                        tv_distance(&p, &para, 64),
+                        tv_exact(&p, &para)
+                    )
                 })
                 .collect();
             println!(
@@ -1361,19 +1365,4 @@ fn grazing_furnace_budget() {
     for ((b, s, t), (e, r)) in mean {
         println!("| mean of the four | {b}², {s} | {t} | {e:.4} | | {r:.5} |");
     }
-}
-
-#[test]
-#[ignore]
-fn tmp_patch_profile() {
-    let map = bumpy(1024, 1024, 0.25, 4.0, 1).unwrap();
-    let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
-    let t = std::time::Instant::now();
-    let mut acc = 0.0;
-    for k in 0..400 {
-        let c = Vec2::new(0.3 + 0.001 * k as f32, 0.6);
-        let fp = Footprint::isotropic_texels(c, 4096.0, 1024, 1024);
-        acc += bm.patch(&fp).area_texels();
-    }
-    println!("{acc} {:.3} ms per patch", t.elapsed().as_secs_f64() / 400.0 * 1e3);
 }

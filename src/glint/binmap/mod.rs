@@ -54,9 +54,10 @@ pub const DEFAULT_LEAF_SIZE: usize = 16;
 pub const DEFAULT_MASKING_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
 
 /// Default sub-texel resolution s: each texel is binned as s × s sub-texels of the interpolated
-/// surface. 2 was chosen from accuracy against memory on the procedural maps (docs/results.md,
-/// "Sub-texel binning"): at ≥ 256 texels it lowers the TV distance to the ground truth 1.5-3× for
-/// 2.6× the memory; s = 4 gains less again for 9× the memory.
+/// surface. 2 was chosen with [`DEFAULT_BINS_PER_AXIS`] from accuracy against memory on the
+/// procedural maps (docs/results.md, "The bin map, finished"): with 255² bins, at ≥ 256 texels, the
+/// TV distance to the ground truth is 1.6-3.8× below the talk's map (s = 1, 127²) for 2.8× its
+/// memory (29.2 B/texel at 2048²); s = 3 would reach 2.3-4.4× but costs 62.9 B/texel.
 pub const DEFAULT_SUBDIVISIONS: usize = 2;
 
 /// Largest accepted sub-texel resolution s (s² sub-texels per texel).

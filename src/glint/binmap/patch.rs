@@ -506,6 +506,47 @@ impl<'a> BinMapPatch<'a> {
     }
 }
 
+/// Sorts the (bin, overlap) pairs of a footprint by bin and returns the sorted slice: an LSD radix
+/// sort on the bytes of the bin index (1-3 passes of a 256-bucket counting sort for B = `bins`,
+/// O(N) against O(N log N) for a comparison sort; the 4096-texel patch spent ~25 % of its time
+/// sorting 16 384 pairs), using the second half of `acc` as the ping-pong buffer. Short lists use
+/// the comparison sort (the counting passes cost 256 buckets each).
+fn sort_by_bin(acc: &mut Vec<(u32, f64)>, bins: usize) -> &[(u32, f64)] {
+    let len = acc.len();
+    if len < 256 {
+        acc.sort_unstable_by_key(|e| e.0);
+        return acc;
+    }
+    let passes = match bins.saturating_sub(1) {
+        0..=0xFF => 1,
+        0x100..=0xFFFF => 2,
+        0x1_0000..=0xFF_FFFF => 3,
+        _ => 4,
+    };
+    acc.resize(2 * len, (0, 0.0));
+    let (mut src, mut dst) = acc.split_at_mut(len);
+    for pass in 0..passes {
+        let shift = 8 * pass;
+        let mut start = [0usize; 256];
+        for e in src.iter() {
+            start[((e.0 >> shift) & 0xFF) as usize] += 1;
+        }
+        let mut sum = 0;
+        for c in start.iter_mut() {
+            let n = *c;
+            *c = sum;
+            sum += n;
+        }
+        for e in src.iter() {
+            let d = ((e.0 >> shift) & 0xFF) as usize;
+            dst[start[d]] = *e;
+            start[d] += 1;
+        }
+        std::mem::swap(&mut src, &mut dst);
+    }
+    src
+}
+
 /// ∫ cos θ dω over the equal-area image of the square-cell rectangle [x0, x1] × [y0, y1] ⊂ [0, 1]²,
 /// divided by 2π: its area × (1 − mean of max(a², b²)), (a, b) = 2u − 1 (z = 1 − max(a², b²) under
 /// the equal-area map; exact up to rounding, see [`HemisphereBins::mean_cos`]).
@@ -583,7 +624,7 @@ impl<'a> ExactMasking<'a> {
                 }
             }
         }
-        acc.sort_unstable_by_key(|e| e.0);
+        let acc = sort_by_bin(acc, map.bins.len());
         let inv_area = 1.0 / para.area();
         let (bins_out, lobes_out) = (bins.vec(), lobes.vec());
         bins_out.clear();
@@ -617,16 +658,21 @@ impl<'a> ExactMasking<'a> {
                 *ai += m as f64 * scale;
             }
             let corner = |x: f32, y: f32| map.bins.sample_in_bin(bin, Vec2::new(x, y));
+            // The left corners of bin j are the right corners of bin j − 1 of the same row (the
+            // same points of the square, so the same f32 directions): reuse them when the previous
+            // bin of the sorted list is that one (half the equal-area map evaluations on dense
+            // footprints).
+            let [c00, c01] = match bins_out.last() {
+                Some(p) if p.bin as usize + 1 == bin && bin % map.bins.n() != 0 => {
+                    [p.corners[1], p.corners[3]]
+                }
+                _ => [corner(0.0, 0.0), corner(0.0, 1.0)],
+            };
             bins_out.push(PatchBin {
                 bin: bin as u32,
                 scale: scale as f32,
                 facet: f,
-                corners: [
-                    corner(0.0, 0.0),
-                    corner(1.0, 0.0),
-                    corner(0.0, 1.0),
-                    corner(1.0, 1.0),
-                ],
+                corners: [c00, corner(1.0, 0.0), c01, corner(1.0, 1.0)],
             });
         }
         let total: f32 = bins.as_slice().iter().map(|b| b.scale).sum();
@@ -707,8 +753,8 @@ fn visible_part(bins: &HemisphereBins, b: &PatchBin, w: Vec3, refine: bool) -> f
     let inv = 1.0 / (n * k) as f32;
     let r = SUB_BIN_REFINE;
     let (inv_r, inv_r2) = (1.0 / r as f32, 1.0 / (r * r) as f32);
-    let rho_fine = EQUAL_AREA_LIPSCHITZ * std::f32::consts::FRAC_1_SQRT_2 / (n * k * r) as f32
-        + DOT_ROUNDING;
+    let rho_fine =
+        EQUAL_AREA_LIPSCHITZ * std::f32::consts::FRAC_1_SQRT_2 / (n * k * r) as f32 + DOT_ROUNDING;
     for sb in 0..k {
         for sa in 0..k {
             let corner = Vec2::new((i * k + sa) as f32, (j * k + sb) as f32);
@@ -1061,7 +1107,8 @@ mod tests {
         for n in [15usize, 63, 127] {
             let bins = HemisphereBins::new(n).unwrap();
             let rho_q = EQUAL_AREA_LIPSCHITZ * std::f32::consts::FRAC_1_SQRT_2 / (n * q) as f32;
-            let (mut ex_fine, mut ex_coarse, mut ex_refined, mut cut) = (0.0f64, 0.0f64, 0.0f64, 0usize);
+            let (mut ex_fine, mut ex_coarse, mut ex_refined, mut cut) =
+                (0.0f64, 0.0f64, 0.0f64, 0usize);
             while cut < 150 {
                 let theta = rng.random_range(1.2f32..std::f32::consts::FRAC_PI_2);
                 let phi = rng.random_range(0.0f32..std::f32::consts::TAU);
@@ -1132,7 +1179,10 @@ mod tests {
             // Refining the cut sub-cells 4 × 4: measured 4.4e-3 / 1.1e-3 / 4.9e-4 (2.4-2.5× below
             // the k × k bound; the rest of the excess is the ρ of the uncut sub-cells on the
             // minority side of the horizon). 1.5× is a regression bound.
-            assert!(ex_refined < ex_fine / 1.5, "n={n}: {ex_refined} vs {ex_fine}");
+            assert!(
+                ex_refined < ex_fine / 1.5,
+                "n={n}: {ex_refined} vs {ex_fine}"
+            );
         }
     }
 }
