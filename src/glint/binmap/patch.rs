@@ -663,7 +663,7 @@ impl<'a> ExactMasking<'a> {
             // bin of the sorted list is that one (half the equal-area map evaluations on dense
             // footprints).
             let [c00, c01] = match bins_out.last() {
-                Some(p) if p.bin as usize + 1 == bin && bin % map.bins.n() != 0 => {
+                Some(p) if p.bin as usize + 1 == bin && !bin.is_multiple_of(map.bins.n()) => {
                     [p.corners[1], p.corners[3]]
                 }
                 _ => [corner(0.0, 0.0), corner(0.0, 1.0)],
