@@ -155,8 +155,9 @@ impl Method for BinMapMethod {
     }
 }
 
-/// The bin map at B = 63², 127² (the default) and 255² with the default sub-texel resolution
-/// (s = 2), the talk's one normal per texel (127², s = 1), and the default smoothed by α = 0.02.
+/// The bin map at B = 63², 127² and 255² (the default) with the default sub-texel resolution
+/// (s = 2), the talk's one normal per texel (127², s = 1), and 127², s = 2 smoothed by α = 0.02
+/// (the smoothed cost grows with (n α)², so it is shown at 127², the default before issue 17).
 fn binmap_methods(map: &NormalMap, _: &Settings) -> Res<Vec<Box<dyn Method>>> {
     let mut methods: Vec<Box<dyn Method>> = Vec::new();
     for (n, s) in [(63, 2), (127, 1), (127, 2), (255, 2)] {

@@ -126,7 +126,7 @@ impl HemisphereBins {
 }
 
 /// Mean of max(a², b²) over the rectangle [a0, a1] × [b0, b1] (exact up to rounding).
-fn mean_max_square(a0: f64, a1: f64, b0: f64, b1: f64) -> f64 {
+pub(crate) fn mean_max_square(a0: f64, a1: f64, b0: f64, b1: f64) -> f64 {
     // g(a) = ∫_{b0}^{b1} max(a², b²) db in closed form: b² outside |b| < |a|, a² inside.
     let g = |a: f64| {
         let abs = a.abs();

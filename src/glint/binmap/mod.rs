@@ -38,9 +38,13 @@ use glam::{Vec2, Vec3};
 use lookup::Table;
 use rayon::prelude::*;
 
-/// Default bins per axis n (B = n² = 16129 bins of 3.9·10⁻⁴ sr, about 1.1° across), the talk's
-/// car-paint setting (127²).
-pub const DEFAULT_BINS_PER_AXIS: usize = 127;
+/// Default bins per axis n: 255 (B = n² = 65 025 bins of 9.7·10⁻⁵ sr, about 0.56° across; 𝓑 still
+/// fits `u16`). Chosen with [`DEFAULT_SUBDIVISIONS`] from accuracy against memory on the procedural
+/// maps (docs/results.md, "The bin map, finished"): against the talk's car-paint setting 127² it
+/// lowers the TV distance to the ground truth at ≥ 256 texels on brushed, scratched and flakes
+/// (1.3-2.3×) and raises it 1.2× on the smooth bumpy map, for 0.5 B/texel more at 2048² (the
+/// per-bin tables: 3.4 MB per map whatever its size). 127 remains the talk's setting.
+pub const DEFAULT_BINS_PER_AXIS: usize = 255;
 
 /// Default maximum leaf size L of the kd-trees: lists of at most L texels are scanned linearly, and
 /// only longer lists get a tree (16, as in the talk).
@@ -50,9 +54,10 @@ pub const DEFAULT_LEAF_SIZE: usize = 16;
 pub const DEFAULT_MASKING_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
 
 /// Default sub-texel resolution s: each texel is binned as s × s sub-texels of the interpolated
-/// surface. 2 was chosen from accuracy against memory on the procedural maps (docs/results.md,
-/// "Sub-texel binning"): at ≥ 256 texels it lowers the TV distance to the ground truth 1.5-3× for
-/// 2.6× the memory; s = 4 gains less again for 9× the memory.
+/// surface. 2 was chosen with [`DEFAULT_BINS_PER_AXIS`] from accuracy against memory on the
+/// procedural maps (docs/results.md, "The bin map, finished"): with 255² bins, at ≥ 256 texels, the
+/// TV distance to the ground truth is 1.6-3.8× below the talk's map (s = 1, 127²) for 2.8× its
+/// memory (29.2 B/texel at 2048²); s = 3 would reach 2.3-4.4× but costs 62.9 B/texel.
 pub const DEFAULT_SUBDIVISIONS: usize = 2;
 
 /// Largest accepted sub-texel resolution s (s² sub-texels per texel).
