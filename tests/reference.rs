@@ -90,10 +90,8 @@ fn single_facet_orientation_both_references_equal_the_closed_form() {
                 let h = unit([wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]]);
                 let sh = [-h[0] / h[2], -h[1] / h[2]];
                 let dev2 = (sh[0] - s[0]).powi(2) + (sh[1] - s[1]).powi(2);
-                let d = (-dev2 / (2.0 * SIGMA * SIGMA)).exp() / (2.0 * std::f64::consts::PI
-                    * SIGMA
-                    * SIGMA
-                    * h[2].powi(4));
+                let d = (-dev2 / (2.0 * SIGMA * SIGMA)).exp()
+                    / (2.0 * std::f64::consts::PI * SIGMA * SIGMA * h[2].powi(4));
                 let want = d / (4.0 * area(s, wo) * wi[2]);
                 for (area_texels, kernel) in [
                     (1.0, Kernel::Gaussian),
@@ -102,7 +100,8 @@ fn single_facet_orientation_both_references_equal_the_closed_form() {
                 ] {
                     let fp = Footprint::isotropic_texels(Vec2::new(0.3, 0.6), area_texels, 32, 32);
                     let r = footprint_brdf(&map, &fp, kernel, v3(wo), v3(wi), SIGMA as f32, 64, 5);
-                    for (name, got) in [("pbrdf", r.pbrdf()), ("normal-mapped", r.normal_mapped())] {
+                    for (name, got) in [("pbrdf", r.pbrdf()), ("normal-mapped", r.normal_mapped())]
+                    {
                         assert!(
                             close(got, want, 1e-5),
                             "{name}: slope {s:?}, θo {theta}, offset {offset}, {area_texels} texels: \
@@ -135,9 +134,17 @@ fn two_facets_facing_both_directions_give_the_hand_derived_eq7_value() {
     // And exactly from the formula in f64 (the hand numbers carry 5 digits).
     let (a1, a2) = (area([0.0, 0.0], wo), area([0.5, 0.0], wo));
     let exact_a = 0.5 * peak([0.0, 0.0]) / (4.0 * 0.5 * (a1 + a2) * wi[2]);
-    assert!(close(acc.pbrdf(), exact_a, 1e-5), "{} vs {exact_a}", acc.pbrdf());
+    assert!(
+        close(acc.pbrdf(), exact_a, 1e-5),
+        "{} vs {exact_a}",
+        acc.pbrdf()
+    );
     let exact_b = 0.5 * peak([0.0, 0.0]) / (4.0 * a1 * wi[2]);
-    assert!(close(acc.normal_mapped(), exact_b, 1e-5), "{} vs {exact_b}", acc.normal_mapped());
+    assert!(
+        close(acc.normal_mapped(), exact_b, 1e-5),
+        "{} vs {exact_b}",
+        acc.normal_mapped()
+    );
     assert!(close(acc.normal_mapped() / acc.pbrdf(), 0.79023, 1e-4));
 }
 
@@ -151,13 +158,20 @@ fn two_facets_facing_both_directions_give_the_hand_derived_eq7_value() {
 fn two_facets_one_hidden_from_the_viewer_double_the_eq7_value() {
     let wo = dir(40.0, false);
     let wi = dir(40.0, true);
-    assert!(area([1.5, 0.0], wo) < -30.0 * SIGMA * wo[0], "facet 2 is well behind wo");
+    assert!(
+        area([1.5, 0.0], wo) < -30.0 * SIGMA * wo[0],
+        "facet 2 is well behind wo"
+    );
     let mut acc = FootprintBrdf::new(v3(wo), v3(wi), SIGMA as f32);
     acc.add_weighted(Vec2::ZERO, 0.5);
     acc.add_weighted(Vec2::new(1.5, 0.0), 0.5);
     let a1 = area([0.0, 0.0], wo);
     let want_a = peak([0.0, 0.0]) / (4.0 * a1 * wi[2]);
-    assert!(close(acc.pbrdf(), want_a, 1e-5), "{} vs {want_a}", acc.pbrdf());
+    assert!(
+        close(acc.pbrdf(), want_a, 1e-5),
+        "{} vs {want_a}",
+        acc.pbrdf()
+    );
     assert!(close(acc.pbrdf() / acc.normal_mapped(), 2.0, 1e-5));
 }
 
@@ -173,20 +187,46 @@ fn two_facets_one_hidden_from_the_viewer_double_the_eq7_value() {
 fn two_facet_map_through_the_footprint_sampler_matches_the_closed_form() {
     let (w, h) = (4096usize, 128usize);
     let slopes: Vec<Vec2> = (0..w * h)
-        .map(|k| if k % w < w / 2 { Vec2::ZERO } else { Vec2::new(0.5, 0.0) })
+        .map(|k| {
+            if k % w < w / 2 {
+                Vec2::ZERO
+            } else {
+                Vec2::new(0.5, 0.0)
+            }
+        })
         .collect();
     let map = NormalMap::from_slopes(w, h, slopes).unwrap();
     let fp = Footprint::anisotropic_texels(Vec2::new(0.5, 0.5), (w * h) as f32, 32.0, 0.0, w, h);
     let (_, a, b) = fp.parallelogram_texels(w, h);
-    assert!((a.x - 4096.0).abs() < 1.0 && (b.y - 128.0).abs() < 0.1, "edges {a} {b}");
+    assert!(
+        (a.x - 4096.0).abs() < 1.0 && (b.y - 128.0).abs() < 0.1,
+        "edges {a} {b}"
+    );
     let wo = dir(40.0, false);
     let wi = dir(40.0, true);
-    let r = footprint_brdf(&map, &fp, Kernel::Parallelogram, v3(wo), v3(wi), 0.01, 1 << 20, 3);
+    let r = footprint_brdf(
+        &map,
+        &fp,
+        Kernel::Parallelogram,
+        v3(wo),
+        v3(wi),
+        0.01,
+        1 << 20,
+        3,
+    );
     let (a1, a2) = (area([0.0, 0.0], wo), area([0.5, 0.0], wo));
     let want_a = 0.5 * peak([0.0, 0.0]) / (4.0 * 0.5 * (a1 + a2) * wi[2]);
     let want_b = 0.5 * peak([0.0, 0.0]) / (4.0 * a1 * wi[2]);
-    assert!(close(r.pbrdf(), want_a, 0.01), "eq. 7: {} vs {want_a}", r.pbrdf());
-    assert!(close(r.normal_mapped(), want_b, 0.01), "{} vs {want_b}", r.normal_mapped());
+    assert!(
+        close(r.pbrdf(), want_a, 0.01),
+        "eq. 7: {} vs {want_a}",
+        r.pbrdf()
+    );
+    assert!(
+        close(r.normal_mapped(), want_b, 0.01),
+        "{} vs {want_b}",
+        r.normal_mapped()
+    );
 }
 
 /// Degenerate input gives 0, never NaN.

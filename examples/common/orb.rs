@@ -23,9 +23,9 @@ use brdf::frame::Frame;
 use brdf::fresnel::{ConductorFresnel, Fresnel};
 use brdf::glint::{
     BeckmannMixture, BinMap, BinMapParams, BrushedParams, FlakesParams, Footprint, GlintNdf,
-    MaskingMode, MixtureParams, MixturePatch, NormalMap, NormalRepair, PatchOptions,
+    Kernel, MaskingMode, MixtureParams, MixturePatch, NormalMap, NormalRepair, PatchOptions,
     PositionNormalMap, PositionNormalParams, ScratchedParams, TangentConvention, brushed, bumpy,
-    Kernel, flakes, footprint_brdf, scratched,
+    flakes, footprint_brdf, scratched,
 };
 use glam::{Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -920,7 +920,13 @@ pub fn run(opts: &OrbOptions, out: &Path) -> Res<Vec<Artifact>> {
     );
     println!(
         "{:<30} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}",
-        "method (errors vs (a))", "build s", "render s", "rel RMSE", "denoised", "4x4", "energy",
+        "method (errors vs (a))",
+        "build s",
+        "render s",
+        "rel RMSE",
+        "denoised",
+        "4x4",
+        "energy",
         "vs (b)"
     );
     println!(

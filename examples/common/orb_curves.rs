@@ -170,7 +170,11 @@ pub fn naive_time_at(curve: &[(f64, f64)], error: f64) -> (f64, &'static str) {
     }
     let (t0, e0) = (curve[i - 1].0.ln(), curve[i - 1].1.max(floor).ln());
     let (t1, e1) = (curve[i].0.ln(), curve[i].1.max(floor).ln());
-    let f = if e1 < e0 { (e.ln() - e0) / (e1 - e0) } else { 1.0 };
+    let f = if e1 < e0 {
+        (e.ln() - e0) / (e1 - e0)
+    } else {
+        1.0
+    };
     ((t0 + f * (t1 - t0)).exp(), "=")
 }
 
@@ -200,14 +204,8 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
             let mask = coverage(&scene);
             let tpp = texels_per_pixel(&scene, &mask, map.width(), map.height());
             let t = Instant::now();
-            let refs = render_references(
-                &scene,
-                &map,
-                SIGMA_EPS,
-                opts.reference_k,
-                orb.seed,
-                &hidden,
-            );
+            let refs =
+                render_references(&scene, &map, SIGMA_EPS, opts.reference_k, orb.seed, &hidden);
             let ref_s = t.elapsed().as_secs_f64();
             let (a0, a1) = (&refs.pbrdf.0, &refs.pbrdf.1);
             let (b0, b1) = (&refs.normal_mapped.0, &refs.normal_mapped.1);
@@ -440,30 +438,36 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res
                 .draw()?;
             let naive: Vec<&&Point> = here.iter().filter(|p| p.method == "naive").collect();
             c.draw_series(LineSeries::new(
-                naive.iter().map(|p| (p.render_s, y(p.vs_a.rel_rmse_denoised))),
+                naive
+                    .iter()
+                    .map(|p| (p.render_s, y(p.vs_a.rel_rmse_denoised))),
                 BLACK.stroke_width(2),
             ))?
             .label("naive")
             .legend(|(x, yy)| PathElement::new(vec![(x, yy), (x + 14, yy)], BLACK.stroke_width(2)));
-            c.draw_series(
+            c.draw_series(naive.iter().map(|p| {
+                Circle::new((p.render_s, y(p.vs_a.rel_rmse_denoised)), 2, BLACK.filled())
+            }))?;
+            c.draw_series(DashedLineSeries::new(
                 naive
                     .iter()
-                    .map(|p| Circle::new((p.render_s, y(p.vs_a.rel_rmse_denoised)), 2, BLACK.filled())),
-            )?;
-            c.draw_series(DashedLineSeries::new(
-                naive.iter().map(|p| (p.render_s, y(p.vs_b.rel_rmse_denoised))),
+                    .map(|p| (p.render_s, y(p.vs_b.rel_rmse_denoised))),
                 3,
                 3,
                 BLACK.mix(0.5).into(),
             ))?;
-            for (mi, m) in ["mixture (lod 256)", "bin map", "position-normal"].iter().enumerate() {
+            for (mi, m) in ["mixture (lod 256)", "bin map", "position-normal"]
+                .iter()
+                .enumerate()
+            {
                 let col = colours[mi];
                 let pts: Vec<&&Point> = here.iter().filter(|p| p.method == *m).collect();
                 if pts.is_empty() {
                     continue;
                 }
                 c.draw_series(LineSeries::new(
-                    pts.iter().map(|p| (p.render_s, y(p.vs_a.rel_rmse_denoised))),
+                    pts.iter()
+                        .map(|p| (p.render_s, y(p.vs_a.rel_rmse_denoised))),
                     col.stroke_width(2),
                 ))?
                 .label(*m)

@@ -480,7 +480,10 @@ impl FootprintBrdf {
         let Ok(lobe) = SlopeGaussian::new(slope, Mat2::from_diagonal(Vec2::splat(var))) else {
             return; // a slope outside f32 range: the facet contributes its area only
         };
-        let (vo, vi) = (lobe.visible_area(self.wo) as f64, lobe.visible_area(self.wi) as f64);
+        let (vo, vi) = (
+            lobe.visible_area(self.wo) as f64,
+            lobe.visible_area(self.wi) as f64,
+        );
         self.visible_o += weight * vo;
         self.visible_i += weight * vi;
         if !(self.wo.dot(wh) > 0.0 && self.wi.dot(wh) > 0.0) {
