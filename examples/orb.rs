@@ -1,5 +1,6 @@
 //! A metallic orb with a high-definition normal map under a point light, rendered with each glint
-//! model and the naive reference (\[Chermain2019\] Fig. 1 and 11); see docs/orb.md.
+//! model and the two references, the exact P-BRDF of the map and normal-mapped rendering
+//! (\[Chermain2019\] Fig. 1 and 11); see docs/orb.md.
 //!
 //! `cargo run --release --example orb -- [--map scratched|brushed|bumpy|flakes|PATH] [--spp N]
 //! [--size PIXELS] [--map-size TEXELS] [--tiles UxV] [--naive-spp N] [--sigma S]
