@@ -18,7 +18,7 @@ type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
 fn main() -> Res<()> {
     let out = common::out_dir()?;
     let quick = !common::has_flag("--full");
-    let parts: [(&str, &str, Part); 8] = [
+    let parts: [(&str, &str, Part); 9] = [
         (
             "Analytic core",
             "NDF slices, Smith masking and Fresnel curves.",
@@ -44,8 +44,18 @@ fn main() -> Res<()> {
         (
             "Orb renders",
             "A metallic sphere with a high-definition normal map under a point light (Chermain 2019 \
-             Fig. 1): each glint method beside the naive reference (the orb example, small strip).",
+             Fig. 1): each glint method beside the two references, (a) the exact P-BRDF of the \
+             interpolated map and (b) normal-mapped rendering, all with the same pixel kernel (the \
+             orb example, small strip).",
             common::orb::run_gallery,
+        ),
+        (
+            "Orb: error against time",
+            "Naive sampling at 1…1024 spp against each glint model at 1, 4 and 16 evaluations per \
+             pixel, on the four maps at two map scales, with equal-error speedups (the orb example's \
+             --curves --quick, also under --full: the full sweep takes ~30 min, run it as \
+             `orb -- --curves`).",
+            |out, _quick| common::orb_curves::run(out, true),
         ),
         (
             "Accuracy against speed",

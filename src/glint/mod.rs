@@ -47,7 +47,9 @@
 //!
 //! [`binned_pndf`] estimates the P-NDF of the interpolated map through a footprint on equal-area
 //! [`HemisphereBins`], with ∫ D cos θ dω = 1 (D_P(m) = ∫ δ(ω_n(u) − m) k_P(u) du / cos θ_m);
-//! [`tv_distance`] compares a model with it; [`naive_brdf`] is the per-position shading reference.
+//! [`tv_distance`] compares a model with it; [`naive_brdf`] is normal-mapped shading at one position;
+//! [`FootprintBrdf`] / [`footprint_brdf`] give the two references of a footprint's BRDF (the exact
+//! P-BRDF of eq. 7 with the true P-NDF, and normal-mapped shading averaged over the footprint).
 
 mod binmap;
 mod bins;
@@ -97,7 +99,10 @@ pub use position_normal::{
 pub use procedural::{
     BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
 };
-pub use reference::{BinnedPndf, Kernel, REFERENCE_BATCHES, binned_pndf, naive_brdf, tv_distance};
+pub use reference::{
+    BinnedPndf, FootprintBrdf, Kernel, REFERENCE_BATCHES, binned_pndf, footprint_brdf, naive_brdf,
+    tv_distance,
+};
 pub use scratch::GlintScratch;
 
 use crate::ndf::Ndf;

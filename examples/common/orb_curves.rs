@@ -1,0 +1,499 @@
+//! Error against time on the orb (`orb -- --curves`): naive sampling at 1 … 4096 spp against each
+//! glint model at 1, 4 and 16 evaluations per pixel, on the four procedural maps and a sweep of the
+//! map's scale, and the equal-error speedups read off those curves. See docs/orb.md.
+//!
+//! Everything is measured on the same scene, pixel kernel (the footprint's Gaussian k_P, pixel-centre
+//! frame, linear uv) and measure (the renderer's) as the orb's references ([`render_references`]).
+//! Errors are `rel_rmse_denoised` of [`errors`] against a reference's two independent halves:
+//! ‖m − r‖² minus the reference's own noise variance ‖a − b‖²/4 (E‖r − E r‖²), clamped at 0,
+//! over ‖r‖² — an unbiased estimate of the squared error against the reference's expectation.
+
+use super::orb::{
+    Errors, Image, MapSource, OrbOptions, Scene, coverage, errors, gap_errors, glint_pixel,
+    load_map, reference_noise, render_glint_evals, render_naive, render_references,
+};
+use super::{Artifact, Res, register_font, save_rgb};
+use brdf::glint::{
+    BeckmannMixture, BinMap, BinMapParams, GlintModel, MixtureParams, PatchOptions,
+    PositionNormalMap, PositionNormalParams,
+};
+use glam::Vec2;
+use indicatif::ProgressBar;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+/// The sweep's settings.
+#[derive(Clone, Debug)]
+pub struct CurveOptions {
+    /// Image size (pixels per side).
+    pub size: u32,
+    /// Procedural map size (texels per side).
+    pub map_size: usize,
+    /// Map scales: the map is tiled (2k, k) times over the sphere's (u, v).
+    pub scales: Vec<u32>,
+    /// Reference: 2 halves of k × k positions per pixel.
+    pub reference_k: u32,
+    /// Naive: 1, 4, 16, … up to this many spp.
+    pub naive_max_spp: u32,
+    /// Skip a glint render whose projected time exceeds this (s), said in the output.
+    pub budget_s: f64,
+}
+
+impl CurveOptions {
+    /// The full sweep (`--curves`).
+    pub fn full() -> CurveOptions {
+        CurveOptions {
+            size: 128,
+            map_size: 512,
+            scales: vec![2, 16, 128],
+            reference_k: 48,
+            naive_max_spp: 4096,
+            budget_s: 40.0,
+        }
+    }
+
+    /// The gallery's sweep (`--curves --quick`): a few minutes at most.
+    pub fn quick() -> CurveOptions {
+        CurveOptions {
+            size: 64,
+            map_size: 256,
+            scales: vec![2, 32],
+            reference_k: 32,
+            naive_max_spp: 1024,
+            budget_s: 10.0,
+        }
+    }
+}
+
+/// One measured point.
+#[derive(Clone, Debug)]
+struct Point {
+    map: String,
+    scale: u32,
+    texels_per_pixel: f64,
+    method: String,
+    evals: u32,
+    build_s: f64,
+    render_s: f64,
+    vs_a: Errors,
+    vs_b: Errors,
+    /// Relative noise of reference (a) (half the difference of its halves over its norm).
+    noise_a: f64,
+}
+
+const SIGMA_EPS: f32 = brdf::glint::DEFAULT_SIGMA_MIN;
+const MAPS: [&str; 4] = ["scratched", "brushed", "bumpy", "flakes"];
+const EVALS: [u32; 3] = [1, 4, 16];
+
+/// The glint models of one map with their build times: the mixture as a path tracer would use it
+/// (64 quadrature nodes per lobe and `lod_lobes` 256, examples/render.rs), the bin map and the
+/// position-normal map at their defaults.
+fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<(String, GlintModel, f64)>> {
+    let t = Instant::now();
+    let params = MixtureParams {
+        sigma_min: SIGMA_EPS,
+        samples: 64,
+        patch: PatchOptions {
+            lod_lobes: 256.0,
+            ..PatchOptions::default()
+        },
+        ..MixtureParams::default()
+    };
+    let mixture: GlintModel = BeckmannMixture::build(map, params)?.into();
+    let mixture_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let binmap: GlintModel = BinMap::build(map, BinMapParams::default())?.into();
+    let binmap_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let pn: GlintModel = PositionNormalMap::build(map, PositionNormalParams::default())?.into();
+    let pn_s = t.elapsed().as_secs_f64();
+    Ok(vec![
+        ("mixture (lod 256)".to_string(), mixture, mixture_s),
+        ("bin map".to_string(), binmap, binmap_s),
+        ("position-normal".to_string(), pn, pn_s),
+    ])
+}
+
+/// Median footprint area (texels², of the clamped pixel parallelogram) over the covered pixels.
+fn texels_per_pixel(scene: &Scene, mask: &[bool], map_w: usize, map_h: usize) -> f64 {
+    let mut a: Vec<f64> = (0..scene.size * scene.size)
+        .filter(|&k| mask[k as usize])
+        .filter_map(|k| {
+            let (x, y) = (k % scene.size, k / scene.size);
+            scene
+                .shading(Vec2::new(x as f32 + 0.5, y as f32 + 0.5))
+                .map(|sp| sp.footprint().area_texels(map_w, map_h) as f64)
+        })
+        .collect();
+    if a.is_empty() {
+        return 0.0;
+    }
+    a.sort_by(f64::total_cmp);
+    a[a.len() / 2]
+}
+
+/// Projected render time of `model` at `evals` evaluations per pixel, from 64 covered pixels spread
+/// over the image.
+fn pilot_seconds(scene: &Scene, mask: &[bool], model: &GlintModel, evals: u32) -> f64 {
+    let covered: Vec<u32> = (0..scene.size * scene.size)
+        .filter(|&k| mask[k as usize])
+        .collect();
+    if covered.is_empty() {
+        return 0.0;
+    }
+    let step = covered.len().div_ceil(64);
+    let q = (evals as f64).sqrt() as u32;
+    let t = Instant::now();
+    let mut n = 0;
+    for &k in covered.iter().step_by(step) {
+        std::hint::black_box(glint_pixel(scene, model, k % scene.size, k / scene.size, q));
+        n += 1;
+    }
+    // Two cores render in parallel.
+    t.elapsed().as_secs_f64() / n as f64 * covered.len() as f64 / 2.0
+}
+
+/// The time naive sampling needs to reach `error` on its measured curve `(seconds, error)` (spp
+/// increasing), interpolated linearly in log-log between the bracketing points, with a flag: "="
+/// interpolated, ">" never reached (the last time, a lower bound), "<" already reached at the first
+/// point (its time, an upper bound).
+pub fn naive_time_at(curve: &[(f64, f64)], error: f64) -> (f64, &'static str) {
+    let floor = 1e-9;
+    let e = error.max(floor);
+    let Some(i) = curve.iter().position(|&(_, ei)| ei <= e) else {
+        return (curve.last().map_or(f64::NAN, |p| p.0), ">");
+    };
+    if i == 0 {
+        return (curve[0].0, "<");
+    }
+    let (t0, e0) = (curve[i - 1].0.ln(), curve[i - 1].1.max(floor).ln());
+    let (t1, e1) = (curve[i].0.ln(), curve[i].1.max(floor).ln());
+    let f = if e1 < e0 {
+        (e.ln() - e0) / (e1 - e0)
+    } else {
+        1.0
+    };
+    ((t0 + f * (t1 - t0)).exp(), "=")
+}
+
+/// Runs the sweep and writes orb_curves.csv, orb_speedup.csv and orb_curves.png into `out`.
+pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
+    std::fs::create_dir_all(out)?;
+    let opts = if quick {
+        CurveOptions::quick()
+    } else {
+        CurveOptions::full()
+    };
+    let wall = Instant::now();
+    let hidden = ProgressBar::hidden();
+    let mut points: Vec<Point> = Vec::new();
+    let mut notes = String::new();
+    for map_name in MAPS {
+        let orb = OrbOptions {
+            map: MapSource::parse(map_name),
+            map_size: opts.map_size,
+            progress: false,
+            ..OrbOptions::default()
+        };
+        let map = load_map(&orb)?;
+        let models = build_models(&map)?;
+        for &k in &opts.scales {
+            let scene = Scene::new(opts.size, Vec2::new(2.0 * k as f32, k as f32));
+            let mask = coverage(&scene);
+            let tpp = texels_per_pixel(&scene, &mask, map.width(), map.height());
+            let t = Instant::now();
+            let refs =
+                render_references(&scene, &map, SIGMA_EPS, opts.reference_k, orb.seed, &hidden);
+            let ref_s = t.elapsed().as_secs_f64();
+            let (a0, a1) = (&refs.pbrdf.0, &refs.pbrdf.1);
+            let (b0, b1) = (&refs.normal_mapped.0, &refs.normal_mapped.1);
+            let noise_a = reference_noise(a0, a1, &mask);
+            let point = |method: &str, evals, build_s, render_s, img: &Image| Point {
+                map: map_name.to_string(),
+                scale: k,
+                texels_per_pixel: tpp,
+                method: method.to_string(),
+                evals,
+                build_s,
+                render_s,
+                vs_a: errors(img, a0, a1, &mask),
+                vs_b: errors(img, b0, b1, &mask),
+                noise_a,
+            };
+            // The gap: reference (b) against (a) (same positions: the correlated-noise form).
+            let gap = gap_errors(&refs, &mask);
+            points.push(Point {
+                map: map_name.to_string(),
+                scale: k,
+                texels_per_pixel: tpp,
+                method: "(b) normal-mapped reference".to_string(),
+                evals: 2 * opts.reference_k * opts.reference_k,
+                build_s: 0.0,
+                render_s: ref_s,
+                vs_a: gap,
+                vs_b: Errors {
+                    rel_rmse: reference_noise(b0, b1, &mask),
+                    ..Errors::default()
+                },
+                noise_a,
+            });
+            let mut spp = 1;
+            while spp <= opts.naive_max_spp {
+                let t = Instant::now();
+                let img = render_naive(&scene, &map, SIGMA_EPS, spp, 1000 + spp as u64, &hidden);
+                let s = t.elapsed().as_secs_f64();
+                points.push(point("naive", spp, 0.0, s, &img));
+                spp *= 4;
+            }
+            for (label, model, build_s) in &models {
+                for evals in EVALS {
+                    let projected = pilot_seconds(&scene, &mask, model, evals);
+                    if projected > opts.budget_s {
+                        let _ = writeln!(
+                            notes,
+                            "{map_name} ×{k} {label} {evals} evals: skipped (projected {projected:.0} s > budget {} s)",
+                            opts.budget_s
+                        );
+                        continue;
+                    }
+                    let t = Instant::now();
+                    let img = render_glint_evals(&scene, model, evals, &hidden);
+                    let s = t.elapsed().as_secs_f64();
+                    points.push(point(label, evals, *build_s, s, &img));
+                }
+            }
+            eprintln!(
+                "curves: {map_name} ×{k} ({tpp:.0} texels/pixel) done at {:.0} s",
+                wall.elapsed().as_secs_f64()
+            );
+        }
+    }
+    let wall_s = wall.elapsed().as_secs_f64();
+
+    // orb_curves.csv
+    let mut csv = String::from(
+        "map,scale,texels_per_pixel,method,evals_per_pixel,build_s,render_s,rel_rmse,\
+         rel_rmse_denoised,rel_rmse_vs_b,rel_rmse_denoised_vs_b,energy_error,reference_noise\n",
+    );
+    for p in &points {
+        let _ = writeln!(
+            csv,
+            "{},{},{:.0},{},{},{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
+            p.map,
+            p.scale,
+            p.texels_per_pixel,
+            p.method,
+            p.evals,
+            p.build_s,
+            p.render_s,
+            p.vs_a.rel_rmse,
+            p.vs_a.rel_rmse_denoised,
+            p.vs_b.rel_rmse,
+            p.vs_b.rel_rmse_denoised,
+            p.vs_a.energy,
+            p.noise_a
+        );
+    }
+    let curves_path = out.join("orb_curves.csv");
+    std::fs::write(&curves_path, csv)?;
+
+    // orb_speedup.csv: per map, scale, method and evals, against each truth.
+    let mut sp = String::from(
+        "map,scale,texels_per_pixel,method,evals_per_pixel,truth,method_error,naive_s_at_error,\
+         naive_bound,method_render_s,build_s,speedup,speedup_with_build\n",
+    );
+    for p in points
+        .iter()
+        .filter(|p| p.method != "naive" && !p.method.starts_with("(b)"))
+    {
+        for truth in ["a", "b"] {
+            let err = |e: &Point| {
+                if truth == "a" {
+                    e.vs_a.rel_rmse_denoised
+                } else {
+                    e.vs_b.rel_rmse_denoised
+                }
+            };
+            let curve: Vec<(f64, f64)> = points
+                .iter()
+                .filter(|q| q.method == "naive" && q.map == p.map && q.scale == p.scale)
+                .map(|q| (q.render_s, err(q)))
+                .collect();
+            let (tn, bound) = naive_time_at(&curve, err(p));
+            let _ = writeln!(
+                sp,
+                "{},{},{:.0},{},{},{truth},{:.4},{:.4},{bound},{:.4},{:.3},{:.2},{:.3}",
+                p.map,
+                p.scale,
+                p.texels_per_pixel,
+                p.method,
+                p.evals,
+                err(p),
+                tn,
+                p.render_s,
+                p.build_s,
+                tn / p.render_s,
+                tn / (p.render_s + p.build_s)
+            );
+        }
+    }
+    let speedup_path = out.join("orb_speedup.csv");
+    std::fs::write(&speedup_path, sp)?;
+
+    let chart_path = out.join("orb_curves.png");
+    chart(&chart_path, &points, &opts, quick)?;
+    println!(
+        "orb curves ({}): image {}², map {}², scales {:?}, reference 2 × {} spp, wall time {wall_s:.0} s",
+        if quick { "quick" } else { "full" },
+        opts.size,
+        opts.map_size,
+        opts.scales,
+        opts.reference_k * opts.reference_k
+    );
+    print!("{notes}");
+    for p in [&curves_path, &speedup_path, &chart_path] {
+        println!("wrote {}", p.display());
+    }
+    Ok(vec![
+        Artifact::new(
+            &chart_path,
+            format!(
+                "Orb error against time (denoised relative RMSE against reference (a), the exact \
+                 P-BRDF; Gaussian pixel kernel for every curve): naive sampling 1…{} spp (solid: \
+                 against (a); dotted: against (b), its own limit), each glint model at 1, 4, 16 \
+                 evaluations per pixel (filled: render time; hollow: + build). Rows: maps; columns: \
+                 map scale (median texels per pixel in the title). Points on the bottom edge \
+                 (1e-3) are within the reference's noise.",
+                opts.naive_max_spp
+            ),
+        ),
+        Artifact::new(&curves_path, "Every point of the curves (CSV)."),
+        Artifact::new(
+            &speedup_path,
+            "Equal-error speedups against naive sampling, with and without build (CSV).",
+        ),
+    ])
+}
+
+/// A grid of log-log panels, maps × scales.
+fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res<()> {
+    register_font();
+    let (cols, rows) = (opts.scales.len() as u32, MAPS.len() as u32);
+    let (pw, ph) = (360u32, 260u32);
+    let (w, h) = (cols * pw, rows * ph + 30);
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        let (title, body) = root.split_vertically(30);
+        title.draw(&Text::new(
+            format!(
+                "orb: denoised rel. RMSE vs (a) exact P-BRDF against time (s){}; naive dotted = vs (b)",
+                if quick { ", --quick" } else { "" }
+            ),
+            (6, 6),
+            ("sans-serif", 15).into_font(),
+        ))?;
+        let panels = body.split_evenly((rows as usize, cols as usize));
+        let colours = [BLUE, RED, RGBColor(0, 150, 0), MAGENTA];
+        for (pi, area) in panels.iter().enumerate() {
+            let (map, scale) = (MAPS[pi / cols as usize], opts.scales[pi % cols as usize]);
+            let here: Vec<&Point> = points
+                .iter()
+                .filter(|p| p.map == map && p.scale == scale)
+                .collect();
+            let floor = 1e-3;
+            let y = |e: f64| e.max(floor);
+            let ts: Vec<f64> = here
+                .iter()
+                .flat_map(|p| [p.render_s, p.render_s + p.build_s])
+                .filter(|t| *t > 0.0)
+                .collect();
+            let (tmin, tmax) = ts
+                .iter()
+                .fold((f64::MAX, 0.0f64), |(a, b), &t| (a.min(t), b.max(t)));
+            if ts.is_empty() {
+                continue;
+            }
+            let tpp = here.first().map_or(0.0, |p| p.texels_per_pixel);
+            let mut c = ChartBuilder::on(area)
+                .caption(
+                    format!("{map}, tiles {}x{scale}, ~{tpp:.0} texels/px", 2 * scale),
+                    ("sans-serif", 13),
+                )
+                .margin(4)
+                .x_label_area_size(22)
+                .y_label_area_size(40)
+                .build_cartesian_2d(
+                    (tmin * 0.7..tmax * 1.4).log_scale(),
+                    (floor..3.0f64).log_scale(),
+                )?;
+            c.configure_mesh()
+                .x_labels(4)
+                .y_labels(4)
+                .label_style(("sans-serif", 10))
+                .x_label_formatter(&|v| format!("{v:.0e}"))
+                .y_label_formatter(&|v| format!("{v:.0e}"))
+                .draw()?;
+            let naive: Vec<&&Point> = here.iter().filter(|p| p.method == "naive").collect();
+            c.draw_series(LineSeries::new(
+                naive
+                    .iter()
+                    .map(|p| (p.render_s, y(p.vs_a.rel_rmse_denoised))),
+                BLACK.stroke_width(2),
+            ))?
+            .label("naive")
+            .legend(|(x, yy)| PathElement::new(vec![(x, yy), (x + 14, yy)], BLACK.stroke_width(2)));
+            c.draw_series(naive.iter().map(|p| {
+                Circle::new((p.render_s, y(p.vs_a.rel_rmse_denoised)), 2, BLACK.filled())
+            }))?;
+            c.draw_series(DashedLineSeries::new(
+                naive
+                    .iter()
+                    .map(|p| (p.render_s, y(p.vs_b.rel_rmse_denoised))),
+                3,
+                3,
+                BLACK.mix(0.5).into(),
+            ))?;
+            for (mi, m) in ["mixture (lod 256)", "bin map", "position-normal"]
+                .iter()
+                .enumerate()
+            {
+                let col = colours[mi];
+                let pts: Vec<&&Point> = here.iter().filter(|p| p.method == *m).collect();
+                if pts.is_empty() {
+                    continue;
+                }
+                c.draw_series(LineSeries::new(
+                    pts.iter()
+                        .map(|p| (p.render_s, y(p.vs_a.rel_rmse_denoised))),
+                    col.stroke_width(2),
+                ))?
+                .label(*m)
+                .legend(move |(x, yy)| {
+                    PathElement::new(vec![(x, yy), (x + 14, yy)], col.stroke_width(3))
+                });
+                c.draw_series(pts.iter().map(|p| {
+                    Circle::new((p.render_s, y(p.vs_a.rel_rmse_denoised)), 3, col.filled())
+                }))?;
+                c.draw_series(pts.iter().map(|p| {
+                    Circle::new(
+                        (p.render_s + p.build_s, y(p.vs_a.rel_rmse_denoised)),
+                        3,
+                        col.stroke_width(1),
+                    )
+                }))?;
+            }
+            if pi == 0 {
+                c.configure_series_labels()
+                    .label_font(("sans-serif", 10))
+                    .background_style(WHITE.mix(0.8))
+                    .border_style(BLACK)
+                    .draw()?;
+            }
+        }
+        root.present()?;
+    }
+    save_rgb(path, w, h, buf)
+}
