@@ -285,7 +285,8 @@ pub fn adaptive_bin_masses<M: Ndf + Sync + ?Sized>(
         0.0
     };
     let change = |delta: &[f64]| 0.5 * delta.iter().sum::<f64>();
-    while !(change(&delta) < tolerance) && k < max_k {
+    // `tolerance` may be NaN (then refine to `max_k`): written so that NaN keeps refining.
+    while change(&delta).partial_cmp(&tolerance) != Some(std::cmp::Ordering::Less) && k < max_k {
         k = (2 * k).min(max_k);
         let active: Vec<usize> = (0..bins.len()).filter(|&b| delta[b] >= threshold).collect();
         if active.is_empty() {
