@@ -1,9 +1,16 @@
 //! Accuracy against speed for every glint method: the comparison harness of `examples/compare.rs`.
 //!
 //! For each procedural map and each method (× setting), it measures
-//! - the P-NDF's total-variation distance to the ground truth (`binned_pndf` of the interpolated normal
-//!   map, Gaussian kernel, 64² equal-area bins; the model averaged over each bin by `tv_distance`),
-//!   per footprint size, averaged over three footprint centres;
+//! - the P-NDF's total-variation distance to two ground truths, per footprint size, averaged over
+//!   the footprint centres (three; one with `--quick`) (Gaussian kernel, equal-area bins):
+//!   - the **Dirac truth** (`binned_pndf`): the P-NDF of the interpolated normal map itself;
+//!   - the **convolved truth** (`convolved_pndf`): the same surface with the material's micro-roughness,
+//!     each position's normal spread by the slope Gaussian of σ_ε = 0.01 ([`SIGMA_EPS`]);
+//!
+//!   both on 64² bins, and on 128² bins as well for footprints up to [`Settings::fine_up_to`] texels,
+//!   where 64² bins (~0.044 in slope near the pole, 4.4 σ_ε) blur the glints. Each model's bin masses
+//!   come from `adaptive_bin_masses` (midpoint grids refined per bin 2 × 2 → 4 × 4 → … until the
+//!   masses change by less than 10⁻³ in TV), and the grid reached is reported;
 //! - the cost: build time, bytes per texel, patch construction, one `d` and one BRDF evaluation
 //!   (single thread, precomputed inputs, mean over a batch);
 //! - per view angle θo (one footprint size): the relative error of the visible projected area
@@ -22,9 +29,10 @@ use super::{Artifact, Chart, Res, Scale, Series, line_chart, r2, view};
 use brdf::bxdf::{Bxdf, Masking};
 use brdf::fresnel::NoFresnel;
 use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, BinnedPndf, DEFAULT_LOD_LOBES, Footprint, GlintNdf,
-    HemisphereBins, Kernel, MaskingMode, MixtureParams, NormalMap, PatchOptions,
-    PositionNormalBrdf, PositionNormalMap, PositionNormalParams, binned_pndf, tv_distance,
+    BeckmannMixture, BinMap, BinMapParams, BinnedPndf, DEFAULT_LOD_LOBES, DEFAULT_MAX_QUADRATURE,
+    DEFAULT_QUADRATURE_TOLERANCE, Footprint, GlintNdf, HemisphereBins, Kernel, MaskingMode,
+    MixtureParams, NormalMap, PatchOptions, PositionNormalBrdf, PositionNormalMap,
+    PositionNormalParams, adaptive_bin_masses, binned_pndf, convolved_pndf,
 };
 use brdf::ndf::Ndf;
 use brdf::{MicrofacetBrdf, Vec2, Vec3};
@@ -34,6 +42,12 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
+/// σ_ε of the convolved truth: the paper's material (\[Chermain2019\] §5.2.2) and the mixture's default
+/// variance floor (`MixtureParams::sigma_min`, which floors each lobe's slope σ rather than adding to
+/// it). The position-normal baseline adds its own σ_r = 0.005 and the smoothed bin map α = 0.02
+/// (σ ≈ 0.014); one truth for all keeps the comparison about the surface, not each model's roughness.
+pub const SIGMA_EPS: f64 = brdf::ndf::DEFAULT_SIGMA_MIN as f64;
+
 /// One glint method at one setting, object-safe: the patch of a footprint as `&(dyn Ndf + Sync)`, and the
 /// method's BRDF for that footprint.
 pub trait Method: Sync {
@@ -41,12 +55,6 @@ pub trait Method: Sync {
     fn label(&self) -> String;
     /// Bytes held per texel of the map (the method's own structures).
     fn bytes_per_texel(&self) -> f64;
-    /// Model evaluations per ground-truth bin for the total variation (`tv_distance`'s
-    /// `sub_samples_per_bin`, a k × k midpoint rule). Default: 4 × 4 up to 256 texels, where patches
-    /// are spikier than a bin (lobes of σ_ε = 0.01 against bins ~0.04 rad wide), 2 × 2 above.
-    fn tv_sub(&self, area: f32) -> usize {
-        if area <= 256.0 { 16 } else { 4 }
-    }
     /// Calls `f` with the footprint's patch.
     fn with_patch(&self, footprint: &Footprint, f: &mut dyn FnMut(&(dyn Ndf + Sync)));
     /// Calls `f` with the footprint's BRDF (F = 1). Default: `MicrofacetBrdf` on the patch with
@@ -140,12 +148,6 @@ impl Method for BinMapMethod {
     }
     fn bytes_per_texel(&self) -> f64 {
         self.map.memory().total() as f64 / (self.map.width() * self.map.height()) as f64
-    }
-    /// 8 × 8: the map's D is piecewise constant on its own bins, which do not align with the
-    /// ground truth's, so each ground-truth bin needs enough points to see the edges (cheap: `d` is
-    /// ~1 µs whatever the footprint).
-    fn tv_sub(&self, _: f32) -> usize {
-        64
     }
     fn with_patch(&self, footprint: &Footprint, f: &mut dyn FnMut(&(dyn Ndf + Sync))) {
         match self.smoothing {
@@ -250,29 +252,38 @@ pub struct Settings {
     pub view_area: f32,
     /// Importance samples per furnace value.
     pub furnace_samples: usize,
-    /// Cap on the model evaluations per ground-truth bin ([`Method::tv_sub`]).
-    pub max_sub: usize,
+    /// Finest per-bin grid of the adaptive quadrature (k of k × k).
+    pub max_quadrature: usize,
+    /// Tolerance of the adaptive quadrature (change of the bin masses in TV).
+    pub quadrature_tolerance: f64,
+    /// Footprints up to this many texels are also compared on 128² bins.
+    pub fine_up_to: f32,
     /// Footprint centres averaged over (1 to 3, from [`CENTERS`]).
     pub centers: usize,
 }
 
 impl Settings {
-    /// `--quick`: 1024² maps, footprints up to 4096 texels; otherwise 2048² maps, footprints up to
-    /// 65536 texels (beyond the default level of detail) and 4× the reference samples.
+    /// `--quick`: 1024² maps, footprints up to 256 texels, one footprint centre, 128² bins up to 1
+    /// texel (the adaptive quadrature needs ≥ 20 evaluations per bin where a fixed 2 × 2 rule took 4,
+    /// and one `d` costs 0.3-1.3 ms at 4096 texels: that size alone took ~5 minutes per map);
+    /// otherwise 2048² maps, footprints up to 65536 texels (beyond the default level of detail), 4×
+    /// the reference samples, three centres and 128² bins up to 16 texels.
     pub fn new(quick: bool) -> Settings {
         Settings {
             size: if quick { 1024 } else { 2048 },
             reference_samples: if quick { 1_000_000 } else { 4_000_000 },
             areas: if quick {
-                vec![0.25, 1.0, 16.0, 256.0, 4096.0]
+                vec![0.25, 1.0, 16.0, 256.0]
             } else {
                 vec![0.25, 1.0, 16.0, 256.0, 4096.0, 16384.0, 65536.0]
             },
             thetas: vec![0.0, 30.0, 60.0, 75.0, 85.0, 89.0],
             view_area: 256.0,
             furnace_samples: if quick { 500 } else { 2000 },
-            max_sub: 64,
-            centers: 3,
+            max_quadrature: DEFAULT_MAX_QUADRATURE,
+            quadrature_tolerance: DEFAULT_QUADRATURE_TOLERANCE,
+            fine_up_to: if quick { 1.0 } else { 16.0 },
+            centers: if quick { 1 } else { 3 },
         }
     }
 
@@ -285,7 +296,9 @@ impl Settings {
             thetas: vec![0.0, 85.0],
             view_area: 16.0,
             furnace_samples: 64,
-            max_sub: 64,
+            max_quadrature: DEFAULT_MAX_QUADRATURE,
+            quadrature_tolerance: DEFAULT_QUADRATURE_TOLERANCE,
+            fine_up_to: 1.0,
             centers: 1,
         }
     }
@@ -294,14 +307,29 @@ impl Settings {
 /// Footprint centres (uv); TV is averaged over them.
 const CENTERS: [[f32; 2]; 3] = [[0.43, 0.57], [0.71, 0.23], [0.17, 0.81]];
 
+/// TV of a model to both truths on one binning, each truth's noise floor (`tv_error`), and the
+/// quadrature used (means over the footprint centres; `k` the finest grid, `change` the largest
+/// final change).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TwoTruths {
+    pub dirac: f64,
+    pub convolved: f64,
+    pub noise_dirac: f64,
+    pub noise_convolved: f64,
+    pub k: usize,
+    pub change: f64,
+}
+
 /// One row of the accuracy table.
 #[derive(Clone, Debug)]
 pub struct AccuracyRow {
     pub map: &'static str,
     pub method: String,
     pub area: f32,
-    pub tv: f64,
-    pub reference_noise: f64,
+    /// On 64² bins.
+    pub tv: TwoTruths,
+    /// On 128² bins (footprints up to [`Settings::fine_up_to`] texels).
+    pub tv_fine: Option<TwoTruths>,
     pub patch_s: f64,
     pub d_s: f64,
     pub eval_s: f64,
@@ -393,31 +421,93 @@ fn eval_pairs(patch: &(dyn Ndf + Sync), n: usize) -> Vec<(Vec3, Vec3)> {
 }
 
 /// Runs the comparison; `progress` receives one line per step.
+/// The Dirac and the convolved truth of one footprint on one binning.
+pub struct Truths {
+    pub bins: HemisphereBins,
+    pub dirac: BinnedPndf,
+    pub convolved: BinnedPndf,
+}
+
+impl Truths {
+    /// Both truths from the same positions (`samples`, `seed`); σ_ε = [`SIGMA_EPS`].
+    fn new(map: &NormalMap, fp: &Footprint, n_bins: usize, samples: usize, seed: u64) -> Res<Self> {
+        let bins = HemisphereBins::new(n_bins)?;
+        let dirac = binned_pndf(map, fp, Kernel::Gaussian, &bins, samples, seed);
+        let convolved = convolved_pndf(map, fp, Kernel::Gaussian, &bins, samples, seed, SIGMA_EPS)?;
+        Ok(Truths {
+            bins,
+            dirac,
+            convolved,
+        })
+    }
+
+    /// The model's TV to both truths, its bin masses from the adaptive quadrature.
+    fn compare(&self, model: &(dyn Ndf + Sync), settings: &Settings) -> TwoTruths {
+        let q = adaptive_bin_masses(
+            model,
+            &self.bins,
+            settings.quadrature_tolerance,
+            settings.max_quadrature,
+        );
+        let tv = |r: &BinnedPndf| r.tv_to_masses(&q.masses).unwrap_or(f64::NAN);
+        TwoTruths {
+            dirac: tv(&self.dirac),
+            convolved: tv(&self.convolved),
+            noise_dirac: self.dirac.tv_error(),
+            noise_convolved: self.convolved.tv_error(),
+            k: q.k_max,
+            change: q.change,
+        }
+    }
+}
+
+/// Mean of the TVs and noises over footprint centres; the finest grid and the largest change.
+fn mean_truths(v: &[TwoTruths]) -> TwoTruths {
+    let k = v.len().max(1) as f64;
+    let sum = |f: fn(&TwoTruths) -> f64| v.iter().map(f).sum::<f64>() / k;
+    TwoTruths {
+        dirac: sum(|t| t.dirac),
+        convolved: sum(|t| t.convolved),
+        noise_dirac: sum(|t| t.noise_dirac),
+        noise_convolved: sum(|t| t.noise_convolved),
+        k: v.iter().map(|t| t.k).max().unwrap_or(0),
+        change: v.iter().map(|t| t.change).fold(0.0, f64::max),
+    }
+}
+
+/// Ground truths of one footprint: 64² bins, and 128² bins (4× the positions, for the same noise
+/// per bin) when the footprint is small enough.
+struct Reference {
+    fp: Footprint,
+    coarse: Truths,
+    fine: Option<Truths>,
+}
+
 pub fn measure(settings: &Settings, progress: &mut dyn FnMut(&str)) -> Res<Results> {
     let bins = HemisphereBins::new(64)?;
     let mut results = Results::default();
     let n = settings.size;
     for (map_name, map) in maps(n)? {
-        // Ground truth per footprint size and centre (shared by every method).
+        // Ground truths per footprint size and centre (shared by every method).
         let mut references = Vec::new();
         for &area in &settings.areas {
-            let per_centre: Vec<(Footprint, BinnedPndf)> = CENTERS
+            let mut per_centre = Vec::new();
+            for (k, c) in CENTERS
                 .iter()
                 .take(settings.centers.clamp(1, CENTERS.len()))
                 .enumerate()
-                .map(|(k, c)| {
-                    let fp = Footprint::isotropic_texels(Vec2::new(c[0], c[1]), area, n, n);
-                    let r = binned_pndf(
-                        &map,
-                        &fp,
-                        Kernel::Gaussian,
-                        &bins,
-                        settings.reference_samples,
-                        17 + k as u64,
-                    );
-                    (fp, r)
-                })
-                .collect();
+            {
+                let fp = Footprint::isotropic_texels(Vec2::new(c[0], c[1]), area, n, n);
+                let samples = settings.reference_samples;
+                let seed = 17 + k as u64;
+                let coarse = Truths::new(&map, &fp, 64, samples, seed)?;
+                let fine = if area <= settings.fine_up_to {
+                    Some(Truths::new(&map, &fp, 128, 4 * samples, seed)?)
+                } else {
+                    None
+                };
+                per_centre.push(Reference { fp, coarse, fine });
+            }
             references.push((area, per_centre));
         }
         progress(&format!("{map_name}: ground truth done"));
@@ -449,20 +539,16 @@ pub fn measure(settings: &Settings, progress: &mut dyn FnMut(&str)) -> Res<Resul
                     bytes_per_texel: method.bytes_per_texel(),
                 });
                 for (area, per_centre) in &references {
-                    let mut tv = 0.0;
-                    let mut noise = 0.0;
-                    for (fp, reference) in per_centre {
-                        method.with_patch(fp, &mut |p| {
-                            tv += tv_distance(
-                                &p,
-                                reference,
-                                method.tv_sub(*area).min(settings.max_sub),
-                            )
+                    let (mut coarse, mut fine) = (Vec::new(), Vec::new());
+                    for r in per_centre {
+                        method.with_patch(&r.fp, &mut |p| {
+                            coarse.push(r.coarse.compare(p, settings));
+                            if let Some(t) = &r.fine {
+                                fine.push(t.compare(p, settings));
+                            }
                         });
-                        noise += reference.tv_error();
                     }
-                    let k = per_centre.len() as f64;
-                    let fp = &per_centre[0].0;
+                    let fp = &per_centre[0].fp;
                     // Costs: patch construction at jittered centres, d and BRDF eval on one patch.
                     let patches = 32;
                     let patch_s = time_per_call(patches, |k| {
@@ -491,8 +577,8 @@ pub fn measure(settings: &Settings, progress: &mut dyn FnMut(&str)) -> Res<Resul
                         map: map_name,
                         method: label.clone(),
                         area: *area,
-                        tv: tv / k,
-                        reference_noise: noise / k,
+                        tv: mean_truths(&coarse),
+                        tv_fine: (!fine.is_empty()).then(|| mean_truths(&fine)),
                         patch_s,
                         d_s,
                         eval_s,
@@ -563,13 +649,29 @@ pub fn pareto(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
 /// Writes the CSV files and charts into `out`; returns the artifacts and the markdown tables.
 pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Artifact>, String)> {
     std::fs::create_dir_all(out)?;
-    let mut csv =
-        String::from("map,method,footprint_texels,tv,reference_noise,patch_s,d_s,eval_s\n");
+    let mut csv = String::from(
+        "map,method,footprint_texels,tv_dirac,tv_convolved,noise_dirac,noise_convolved,quad_k,\
+         quad_change,tv_dirac_128,tv_convolved_128,noise_dirac_128,noise_convolved_128,quad_k_128,\
+         quad_change_128,patch_s,d_s,eval_s\n",
+    );
+    let cols = |t: &TwoTruths| {
+        format!(
+            "{:.5},{:.5},{:.5},{:.5},{},{:.2e}",
+            t.dirac, t.convolved, t.noise_dirac, t.noise_convolved, t.k, t.change
+        )
+    };
     for r in &results.accuracy {
         writeln!(
             csv,
-            "{},{},{},{:.5},{:.5},{:.3e},{:.3e},{:.3e}",
-            r.map, r.method, r.area, r.tv, r.reference_noise, r.patch_s, r.d_s, r.eval_s
+            "{},{},{},{},{},{:.3e},{:.3e},{:.3e}",
+            r.map,
+            r.method,
+            r.area,
+            cols(&r.tv),
+            r.tv_fine.as_ref().map_or(",,,,,".to_string(), cols),
+            r.patch_s,
+            r.d_s,
+            r.eval_s
         )?;
     }
     std::fs::write(out.join("compare_accuracy.csv"), csv)?;
@@ -597,9 +699,10 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
     let mut md = String::new();
     let size = settings.size;
 
-    // Accuracy against time: one point per method (mean TV over maps and footprints of ≥ 1 texel,
-    // geometric-mean BRDF eval time), and the Pareto front.
-    let per_method: Vec<(String, f64, f64)> = methods
+    // Accuracy against time, per truth: one point per method (mean TV over maps and footprints of
+    // ≥ 1 texel, geometric-mean BRDF eval time), and the Pareto front.
+    // (method, eval µs, mean TV Dirac, mean TV convolved)
+    let per_method: Vec<(String, f64, f64, f64)> = methods
         .iter()
         .map(|m| {
             let rows = || {
@@ -611,39 +714,51 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
             (
                 m.clone(),
                 geo_mean(rows().map(|r| r.eval_s * 1e6)),
-                mean(rows().map(|r| r.tv)),
+                mean(rows().map(|r| r.tv.dirac)),
+                mean(rows().map(|r| r.tv.convolved)),
             )
         })
         .collect();
-    let front = pareto(
-        &per_method
-            .iter()
-            .map(|(_, t, e)| (*t, *e))
-            .collect::<Vec<_>>(),
-    );
-    // The front first (underneath), then one marker per method on top.
-    let mut series = vec![Series::new("Pareto front", front)];
-    series.extend(
-        per_method
-            .iter()
-            .map(|(m, t, e)| Series::new(m.clone(), vec![(*t, *e)])),
-    );
-    let path = out.join("compare_accuracy_vs_time.png");
-    let title = format!("Accuracy against cost ({size}² maps)");
-    let mut chart = Chart::new(
-        &title,
-        "BRDF eval time (µs, geometric mean)",
-        "mean TV to ground truth",
-    );
-    chart.x_scale = Scale::Log;
-    chart.markers = true;
-    line_chart(&path, &chart, &series)?;
-    artifacts.push(Artifact::new(
-        path,
-        "Accuracy against cost: mean total variation to the ground truth over the four maps and \
-         footprints of 1 texel and more, against the geometric-mean time of one BRDF evaluation; \
-         the line joins the methods no other beats on both.",
-    ));
+    for (file, truth, pick) in [
+        (
+            "compare_accuracy_vs_time.png",
+            TRUTHS[0],
+            (|t: &(String, f64, f64, f64)| t.2) as fn(&(String, f64, f64, f64)) -> f64,
+        ),
+        ("compare_accuracy_vs_time_convolved.png", TRUTHS[1], |t| t.3),
+    ] {
+        let front = pareto(
+            &per_method
+                .iter()
+                .map(|t| (t.1, pick(t)))
+                .collect::<Vec<_>>(),
+        );
+        // The front first (underneath), then one marker per method on top.
+        let mut series = vec![Series::new("Pareto front", front)];
+        series.extend(
+            per_method
+                .iter()
+                .map(|t| Series::new(t.0.clone(), vec![(t.1, pick(t))])),
+        );
+        let path = out.join(file);
+        let title = format!("Accuracy against cost, {truth} ({size}² maps)");
+        let mut chart = Chart::new(
+            &title,
+            "BRDF eval time (µs, geometric mean)",
+            "mean TV (64² bins)",
+        );
+        chart.x_scale = Scale::Log;
+        chart.markers = true;
+        line_chart(&path, &chart, &series)?;
+        artifacts.push(Artifact::new(
+            path,
+            format!(
+                "Accuracy against cost: mean total variation to the {truth} (64² bins) over the \
+                 four maps and footprints of 1 texel and more, against the geometric-mean time of \
+                 one BRDF evaluation; the line joins the methods no other beats on both."
+            ),
+        ));
+    }
 
     // Per method, one point per footprint size: `stat` of `value` over the maps (and centres).
     let by_area = |value: &dyn Fn(&AccuracyRow) -> f64,
@@ -669,22 +784,33 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
             .collect()
     };
 
-    // Error against footprint size.
-    let series = by_area(&|r| r.tv, &|v| mean(v));
-    let path = out.join("compare_error_vs_footprint.png");
-    let mut chart = Chart::new(
-        "P-NDF error against footprint size",
-        "footprint (texels)",
-        "mean TV to ground truth",
-    );
-    chart.x_scale = Scale::Log;
-    chart.markers = true;
-    line_chart(&path, &chart, &series)?;
-    artifacts.push(Artifact::new(
-        path,
-        "Total variation to the ground truth against footprint size, mean over the four maps and \
-         three centres (the reference's own noise is in compare_accuracy.csv).",
-    ));
+    // Error against footprint size, per truth.
+    for (file, truth, value) in [
+        (
+            "compare_error_vs_footprint.png",
+            TRUTHS[0],
+            (|r: &AccuracyRow| r.tv.dirac) as fn(&AccuracyRow) -> f64,
+        ),
+        ("compare_error_vs_footprint_convolved.png", TRUTHS[1], |r| {
+            r.tv.convolved
+        }),
+    ] {
+        let series = by_area(&value, &|v| mean(v));
+        let path = out.join(file);
+        let title = format!("P-NDF error against footprint size, {truth}");
+        let mut chart = Chart::new(&title, "footprint (texels)", "mean TV (64² bins)");
+        chart.x_scale = Scale::Log;
+        chart.markers = true;
+        line_chart(&path, &chart, &series)?;
+        artifacts.push(Artifact::new(
+            path,
+            format!(
+                "Total variation to the {truth} (64² bins) against footprint size, mean over the \
+                 four maps and the footprint centres (noise floors, 128² bins and the quadrature used are \
+                 in compare_accuracy.csv)."
+            ),
+        ));
+    }
 
     // Cost against footprint size: the per-direction `d` and the per-shading-point `patch()`.
     for (name, value, what, caption) in [
@@ -768,41 +894,38 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
     // Markdown tables.
     writeln!(
         md,
-        "| method | mean TV (≥ 1 texel) | BRDF eval (µs, geo. mean) | bytes/texel | build (s, mean over maps) |"
+        "| method | mean TV, Dirac (≥ 1 texel) | mean TV, convolved | BRDF eval (µs, geo. mean) | \
+         bytes/texel | build (s, mean over maps) |"
     )?;
-    writeln!(md, "|---|---|---|---|---|")?;
-    for (m, t, e) in &per_method {
+    writeln!(md, "|---|---|---|---|---|---|")?;
+    for (m, t, e, c) in &per_method {
         let b = || results.build.iter().filter(|r| &r.method == m);
         writeln!(
             md,
-            "| {m} | {e:.3} | {t:.2} | {:.1} | {:.1} |",
+            "| {m} | {e:.3} | {c:.3} | {t:.2} | {:.1} | {:.1} |",
             mean(b().map(|r| r.bytes_per_texel)),
             mean(b().map(|r| r.build_s))
         )?;
     }
     writeln!(md)?;
+    md.push_str(&tv_table(results, settings, &methods, false));
+    writeln!(md)?;
+    md.push_str(&tv_table(results, settings, &methods, true));
+    writeln!(md)?;
     write!(md, "| method |")?;
-    for a in &settings.areas {
-        write!(md, " TV {a} |")?;
-    }
     for a in &settings.areas {
         write!(md, " d {a} (µs) |")?;
     }
     writeln!(md)?;
-    writeln!(md, "|---|{}", "---|".repeat(2 * settings.areas.len()))?;
+    writeln!(md, "|---|{}", "---|".repeat(settings.areas.len()))?;
     for m in &methods {
         write!(md, "| {m} |")?;
-        let rows = |a: f32| {
-            results
+        for &a in &settings.areas {
+            let rows = results
                 .accuracy
                 .iter()
-                .filter(move |r| &r.method == m && r.area == a)
-        };
-        for &a in &settings.areas {
-            write!(md, " {:.3} |", mean(rows(a).map(|r| r.tv)))?;
-        }
-        for &a in &settings.areas {
-            write!(md, " {:.2} |", geo_mean(rows(a).map(|r| r.d_s * 1e6)))?;
+                .filter(|r| &r.method == m && r.area == a);
+            write!(md, " {:.2} |", geo_mean(rows.map(|r| r.d_s * 1e6)))?;
         }
         writeln!(md)?;
     }
@@ -837,6 +960,73 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
     }
     std::fs::write(out.join("compare_tables.md"), &md)?;
     Ok((artifacts, md))
+}
+
+/// Names of the two truths, for titles and captions.
+const TRUTHS: [&str; 2] = [
+    "Dirac truth (interpolated map)",
+    "convolved truth (σ_ε = 0.01)",
+];
+
+/// Markdown table of the TV to both truths per footprint size (means over maps and centres), on 64²
+/// bins or (`fine`) on 128² bins for the footprints that have them; the last columns give the finest
+/// quadrature grid any bin needed (k of k × k, over maps, centres and sizes) and the largest final
+/// change of the masses.
+fn tv_table(results: &Results, settings: &Settings, methods: &[String], fine: bool) -> String {
+    let pick = |r: &AccuracyRow| if fine { r.tv_fine } else { Some(r.tv) };
+    let areas: Vec<f32> = settings
+        .areas
+        .iter()
+        .copied()
+        .filter(|&a| !fine || a <= settings.fine_up_to)
+        .collect();
+    let mut md = String::new();
+    let bins = if fine { "128²" } else { "64²" };
+    md.push_str(&format!("| method ({bins} bins) |"));
+    for a in &areas {
+        md.push_str(&format!(" {a}: Dirac | {a}: conv. |"));
+    }
+    md.push_str(" quadrature k | change |\n");
+    md.push_str(&format!(
+        "|---|{}---|---|\n",
+        "---|---|".repeat(areas.len())
+    ));
+    let (mut noise_d, mut noise_c) = (Vec::new(), Vec::new());
+    for m in methods {
+        md.push_str(&format!("| {m} |"));
+        let all: Vec<TwoTruths> = results
+            .accuracy
+            .iter()
+            .filter(|r| &r.method == m)
+            .filter_map(pick)
+            .collect();
+        for &a in &areas {
+            let rows: Vec<TwoTruths> = results
+                .accuracy
+                .iter()
+                .filter(|r| &r.method == m && r.area == a)
+                .filter_map(pick)
+                .collect();
+            md.push_str(&format!(
+                " {:.3} | {:.3} |",
+                mean(rows.iter().map(|t| t.dirac)),
+                mean(rows.iter().map(|t| t.convolved))
+            ));
+            if m == &methods[0] {
+                noise_d.push(mean(rows.iter().map(|t| t.noise_dirac)));
+                noise_c.push(mean(rows.iter().map(|t| t.noise_convolved)));
+            }
+        }
+        let k = all.iter().map(|t| t.k).max().unwrap_or(0);
+        let change = all.iter().map(|t| t.change).fold(0.0, f64::max);
+        md.push_str(&format!(" {k} × {k} | {change:.1e} |\n"));
+    }
+    md.push_str("| *reference noise* |");
+    for (d, c) in noise_d.iter().zip(&noise_c) {
+        md.push_str(&format!(" {d:.3} | {c:.3} |"));
+    }
+    md.push_str(" | |\n");
+    md
 }
 
 /// The example's entry point: measure, write, return the artifacts.

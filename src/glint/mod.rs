@@ -100,8 +100,9 @@ pub use procedural::{
     BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
 };
 pub use reference::{
-    BinnedPndf, FootprintBrdf, Kernel, REFERENCE_BATCHES, binned_pndf, footprint_brdf, naive_brdf,
-    tv_distance,
+    BinMasses, BinnedPndf, DEFAULT_MAX_QUADRATURE, DEFAULT_QUADRATURE_TOLERANCE, FootprintBrdf,
+    JITTERS, Kernel, REFERENCE_BATCHES, adaptive_bin_masses, bin_masses, binned_pndf,
+    convolved_pndf, footprint_brdf, naive_brdf, tv_distance,
 };
 pub use scratch::GlintScratch;
 

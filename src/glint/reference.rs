@@ -627,3 +627,12 @@ pub fn naive_brdf(map: &NormalMap, uv: Vec2, wo: Vec3, wi: Vec3, sigma_eps: f32)
     let f = lobe.d(wh) as f64 / (4.0 * vo as f64 * vi as f64);
     if f.is_finite() { f as f32 } else { f32::MAX }
 }
+
+// Issue #14, item 4: the σ_ε-convolved ground truth and the adaptive per-bin quadrature live in
+// their own file (a child module, so that they share this module's private estimator helpers).
+#[path = "truth.rs"]
+mod truth;
+pub use truth::{
+    BinMasses, DEFAULT_MAX_QUADRATURE, DEFAULT_QUADRATURE_TOLERANCE, JITTERS, adaptive_bin_masses,
+    bin_masses, convolved_pndf,
+};
