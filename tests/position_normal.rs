@@ -686,3 +686,73 @@ fn furnace_table() {
         }
     }
 }
+
+/// The level-of-detail chart behind `DEFAULT_MAX_QUERY_TEXELS`: on 512² procedural maps, for
+/// footprints of 1 to 65 536 texels, the distance of the P-NDF to the ground truth (64² bins,
+/// 4·10⁶ positions, one evaluation per bin) and the time of one `patch()` and one `d`, for query
+/// caps of 128 texels (the released code's), 512, 2048 and none.
+///
+/// `cargo test --test position_normal -- --ignored lod_table --nocapture` (the test profile is
+/// opt-level 3; times are single-threaded, from one run, so read them as ratios).
+#[test]
+#[ignore]
+fn lod_table() {
+    use brdf::glint::{HemisphereBins, Kernel, binned_pndf, tv_distance};
+    use std::time::Instant;
+    let n = 512;
+    let maps = support::procedural_maps(n);
+    let bins = HemisphereBins::new(64).unwrap();
+    let caps = [128.0f32, 512.0, 2048.0, f32::INFINITY];
+    println!(
+        "| map | footprint (texels) | cap (texels) | elements | TV | patch() | d | reference noise |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for (name, map) in &maps {
+        let models: Vec<PositionNormalMap> = caps
+            .iter()
+            .map(|&cap| {
+                let params = PositionNormalParams {
+                    max_query_texels: cap,
+                    ..PositionNormalParams::default()
+                };
+                PositionNormalMap::build(map, params).unwrap()
+            })
+            .collect();
+        for area in [1.0f32, 16.0, 256.0, 4096.0, 16384.0, 65536.0] {
+            let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
+            let reference = binned_pndf(map, &fp, Kernel::Gaussian, &bins, 4_000_000, 17);
+            for (cap, pn) in caps.iter().zip(&models) {
+                let patch = pn.patch(&fp);
+                let tv = tv_distance(&patch, &reference, 1);
+                // One thread, 512 normals (half from D_P cos, half the bins' centres).
+                let normals: Vec<Vec3> = (0..512)
+                    .map(|k| {
+                        let u = Vec2::new((k as f32 + 0.5) / 512.0, (k as f32 * 0.618_034).fract());
+                        if k % 2 == 0 {
+                            patch.sample_normal(u)
+                        } else {
+                            bins.center(k * 7 % bins.len())
+                        }
+                    })
+                    .collect();
+                let t = Instant::now();
+                let s: f32 = normals.iter().map(|&m| patch.d(m)).sum();
+                assert!(s.is_finite());
+                let t_d = t.elapsed().as_secs_f64() / normals.len() as f64;
+                let reps = 20;
+                let t = Instant::now();
+                for _ in 0..reps {
+                    std::hint::black_box(pn.patch(std::hint::black_box(&fp)).element_count());
+                }
+                let t_patch = t.elapsed().as_secs_f64() / reps as f64;
+                println!(
+                    "| {name} | {area} | {cap} | {} | {tv:.3} | {:.1} µs | {:.2} µs | {:.3} |",
+                    patch.element_count(),
+                    t_patch * 1e6,
+                    t_d * 1e6,
+                    reference.tv_error()
+                );
+            }
+        }
+    }
+}
