@@ -523,7 +523,8 @@ mod tests {
     }
 
     /// Whole builds (moments, boxes, hierarchy, mip chain) with the filter and with 256-node QMC,
-    /// alternated (QMC, filter, QMC, filter) on the four procedural maps at 2048², with their ratio.
+    /// alternated (QMC, filter, per round; BRDF_ROUNDS rounds, default 1) on the four procedural maps
+    /// at 2048², with their ratio.
     /// `cargo test --lib -- --ignored build_timing_2048 --nocapture` (the test profile is opt-level 3).
     #[test]
     #[ignore]
