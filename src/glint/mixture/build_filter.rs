@@ -14,8 +14,9 @@
 //! analytic map); measured against a converged QMC reference in docs/results.md ("Fast build").
 //!
 //! Work is done in bands of lobe rows, in parallel (rayon); a band holds only its node rows'
-//! horizontal sums (about 64 node rows × lobe columns × 40 bytes), so memory beyond the output is
-//! bounded by the band size times the thread count. The result does not depend on the thread count.
+//! horizontal sums (at most ~8 MiB, see `BAND_BYTES`, unless a single lobe row needs more), so memory
+//! beyond the output is bounded by that times the thread count. The result does not depend on the
+//! thread count (bands are independent; each lobe's sums run in a fixed order).
 
 use crate::glint::NormalMap;
 use crate::ndf::gauss;
@@ -27,9 +28,10 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// spacings use proportionally more, see [`nodes_per_texel`].
 pub const DEFAULT_SUPERSAMPLING: u32 = 4;
 
-/// Node rows a band aims at: enough to amortise the kernel's overlap between bands (≤ ~20 % extra
-/// horizontal work at h = 1) while its horizontal sums stay small (rows × lobe columns × 40 bytes).
-const BAND_NODE_ROWS: usize = 64;
+/// Bytes of horizontal sums a band may hold (node rows × lobe columns × 40 bytes): 8 MiB, so that the
+/// build's extra memory is ~8 MiB per thread whatever the map size, while a band of a 2048-wide map
+/// (h = 1) still spans ~100 node rows (the kernel's overlap between bands costs ~12 % extra work).
+const BAND_BYTES: usize = 8 << 20;
 
 /// Nodes per texel along an axis of lobe spacing `h` texels: the multiple of 4 ≥ `supersampling` / min(1, h),
 /// so that the node step never exceeds h / `supersampling` (the kernel's σ is 0.42 h) nor
@@ -156,7 +158,11 @@ pub(super) fn all_moments(
         nodes_per_texel(supersampling, spacing[1]),
     );
     let node_rows_per_lobe = (ay.s as f64 * spacing[1]).max(1e-9);
-    let band = ((BAND_NODE_ROWS as f64 / node_rows_per_lobe).ceil() as usize).clamp(1, ny);
+    let budget_rows = (BAND_BYTES / (nx * 40)).max(ay.len + 1);
+    let by_memory = ((budget_rows - ay.len) as f64 / node_rows_per_lobe).floor() as usize;
+    // At least 4 bands per thread when the map allows, for load balance.
+    let by_threads = ny.div_ceil(4 * rayon::current_num_threads());
+    let band = by_memory.min(by_threads).clamp(1, ny);
     let done = AtomicUsize::new(0);
     let mut out = vec![[0.0f32; 5]; nx * ny];
     out.par_chunks_mut(nx * band)
