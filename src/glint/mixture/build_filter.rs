@@ -13,10 +13,11 @@
 //! smooth there), and none for f quadratic in each axis between texel centres (tested on an
 //! analytic map); measured against a converged QMC reference in docs/results.md ("Fast build").
 //!
-//! Work is done in bands of lobe rows, in parallel (rayon); a band holds only its node rows'
-//! horizontal sums (at most ~8 MiB, see `BAND_BYTES`, unless a single lobe row needs more), so memory
-//! beyond the output is bounded by that times the thread count. The result does not depend on the
-//! thread count (bands are independent; each lobe's sums run in a fixed order).
+//! Work is done in bands of lobe rows, in parallel (rayon); a band keeps only the horizontal sums of
+//! the node rows one lobe row needs (a ring of ~12 rows × lobe columns × 40 bytes, 1 MB at 2048 lobe
+//! columns) and two texel rows of normals, so memory beyond the output is ~1 MB per thread. The
+//! result does not depend on the thread count (every node row and every lobe's sums are computed
+//! the same way in a fixed order whichever band holds them).
 
 use crate::glint::NormalMap;
 use crate::ndf::gauss;
@@ -27,11 +28,6 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// Default nodes per texel per axis of the filter build (even) for seed spacings h ≥ 1: 4. Finer
 /// spacings use proportionally more, see [`nodes_per_texel`].
 pub const DEFAULT_SUPERSAMPLING: u32 = 4;
-
-/// Bytes of horizontal sums a band may hold (node rows × lobe columns × 40 bytes): 8 MiB, so that the
-/// build's extra memory is ~8 MiB per thread whatever the map size, while a band of a 2048-wide map
-/// (h = 1) still spans ~100 node rows (the kernel's overlap between bands costs ~12 % extra work).
-const BAND_BYTES: usize = 8 << 20;
 
 /// Nodes per texel along an axis of lobe spacing `h` texels: the multiple of 4 ≥ `supersampling` / min(1, h),
 /// so that the node step never exceeds h / `supersampling` (the kernel's σ is 0.42 h) nor
@@ -157,12 +153,9 @@ pub(super) fn all_moments(
         t,
         nodes_per_texel(supersampling, spacing[1]),
     );
-    let node_rows_per_lobe = (ay.s as f64 * spacing[1]).max(1e-9);
-    let budget_rows = (BAND_BYTES / (nx * 40)).max(ay.len + 1);
-    let by_memory = ((budget_rows - ay.len) as f64 / node_rows_per_lobe).floor() as usize;
-    // At least 4 bands per thread when the map allows, for load balance.
-    let by_threads = ny.div_ceil(4 * rayon::current_num_threads());
-    let band = by_memory.min(by_threads).clamp(1, ny);
+    // 4 bands per thread, for load balance; a band re-filters only the kernel's overlap with the
+    // previous band (ay.len node rows), so larger bands waste less.
+    let band = ny.div_ceil(4 * rayon::current_num_threads()).clamp(1, ny);
     let done = AtomicUsize::new(0);
     let mut out = vec![[0.0f32; 5]; nx * ny];
     out.par_chunks_mut(nx * band)
@@ -180,6 +173,11 @@ pub(super) fn all_moments(
 }
 
 /// The moments of lobe rows `lobe_rows` into `out` (row major, nx per row).
+///
+/// Node rows are filtered horizontally in increasing order into a ring of `ay.len` rows (the most
+/// a lobe row needs; lobe rows need non-decreasing node rows, so a row is overwritten only once no
+/// later lobe row needs it), and the two texel rows of normals they interpolate are kept as a pair.
+/// Memory: ay.len × nx × 40 bytes plus a few rows of the map.
 fn band_moments(
     map: &NormalMap,
     ax: &AxisWeights,
@@ -189,18 +187,9 @@ fn band_moments(
 ) {
     let nx = ax.start.len();
     let width = map.width();
-    // Node rows of the band (unwrapped) and node columns of all lobes (unwrapped).
-    let b_lo = ay.start[lobe_rows.start];
-    let b_hi = ay.start[lobe_rows.end - 1] + ay.len as i64 - 1;
     let a_lo = ax.start[0];
     let a_hi = ax.start[nx - 1] + ax.len as i64 - 1;
     let n_cols = (a_hi - a_lo + 1) as usize;
-    // Texel rows the node rows interpolate between, as unit normals.
-    let t_lo = ay.texel_of(b_lo).0;
-    let t_hi = ay.texel_of(b_hi).0 + 1;
-    let normals: Vec<Vec3> = (t_lo..=t_hi)
-        .flat_map(|j| (0..width as i64).map(move |i| map.texel_normal(i, j)))
-        .collect();
     // Node columns: left texel (wrapped) and fraction.
     let cols: Vec<(usize, usize, f32)> = (a_lo..=a_hi)
         .map(|a| {
@@ -210,47 +199,65 @@ fn band_moments(
             (i0, i1, f as f32)
         })
         .collect();
-    // Horizontal pass: per node row, the five weighted sums of each lobe column.
-    let n_rows = (b_hi - b_lo + 1) as usize;
-    let mut h = vec![[0.0f64; 5]; n_rows * nx];
+    let texel_row = |j: i64, row: &mut Vec<Vec3>| {
+        row.clear();
+        row.extend((0..width as i64).map(|i| map.texel_normal(i, j)));
+    };
+    let ring_len = ay.len;
+    let mut ring = vec![[0.0f64; 5]; ring_len * nx];
+    let (mut lower, mut upper) = (Vec::with_capacity(width), Vec::with_capacity(width));
+    let mut pair_row = i64::MIN;
     let mut blend = vec![Vec3::ZERO; width];
     let mut sx = vec![0.0f64; n_cols];
     let mut sy = vec![0.0f64; n_cols];
-    for (r, hr) in h.chunks_mut(nx).enumerate() {
-        let (j, fy) = ay.texel_of(b_lo + r as i64);
-        let fy = fy as f32;
-        let lower = &normals[(j - t_lo) as usize * width..][..width];
-        let upper = &normals[(j + 1 - t_lo) as usize * width..][..width];
-        for ((m, &n0), &n1) in blend.iter_mut().zip(lower).zip(upper) {
-            *m = n0 * (1.0 - fy) + n1 * fy;
-        }
-        for ((&(i0, i1, fx), x), y) in cols.iter().zip(&mut sx).zip(&mut sy) {
-            let n = blend[i0] * (1.0 - fx) + blend[i1] * fx;
-            // n.z > 0: a convex combination of upper-hemisphere unit normals.
-            (*x, *y) = ((-n.x / n.z) as f64, (-n.y / n.z) as f64);
-        }
-        for (i, acc) in hr.iter_mut().enumerate() {
-            let o = (ax.start[i] - a_lo) as usize;
-            let mut m = [0.0f64; 5];
-            for ((&w, &x), &y) in ax.weights(i).iter().zip(&sx[o..]).zip(&sy[o..]) {
-                let (wx, wy) = (w * x, w * y);
-                m[0] += wx;
-                m[1] += wy;
-                m[2] += wx * x;
-                m[3] += wy * y;
-                m[4] += wx * y;
-            }
-            *acc = m;
-        }
-    }
-    // Vertical pass: each lobe row from its node rows.
+    // Next node row to filter.
+    let mut next = ay.start[lobe_rows.start];
     let mut acc = vec![[0.0f64; 5]; nx];
     for (j, row) in lobe_rows.zip(out.chunks_mut(nx)) {
+        let first = ay.start[j];
+        let end = first + ay.len as i64;
+        // Horizontal pass for the node rows this lobe row adds.
+        while next < end {
+            let (t, fy) = ay.texel_of(next);
+            if t != pair_row {
+                if t == pair_row + 1 {
+                    std::mem::swap(&mut lower, &mut upper);
+                } else {
+                    texel_row(t, &mut lower);
+                }
+                texel_row(t + 1, &mut upper);
+                pair_row = t;
+            }
+            let fy = fy as f32;
+            for ((m, &n0), &n1) in blend.iter_mut().zip(&lower).zip(&upper) {
+                *m = n0 * (1.0 - fy) + n1 * fy;
+            }
+            for ((&(i0, i1, fx), x), y) in cols.iter().zip(&mut sx).zip(&mut sy) {
+                let n = blend[i0] * (1.0 - fx) + blend[i1] * fx;
+                // n.z > 0: a convex combination of upper-hemisphere unit normals.
+                (*x, *y) = ((-n.x / n.z) as f64, (-n.y / n.z) as f64);
+            }
+            let slot = next.rem_euclid(ring_len as i64) as usize;
+            for (i, h) in ring[slot * nx..][..nx].iter_mut().enumerate() {
+                let o = (ax.start[i] - a_lo) as usize;
+                let mut m = [0.0f64; 5];
+                for ((&w, &x), &y) in ax.weights(i).iter().zip(&sx[o..]).zip(&sy[o..]) {
+                    let (wx, wy) = (w * x, w * y);
+                    m[0] += wx;
+                    m[1] += wy;
+                    m[2] += wx * x;
+                    m[3] += wy * y;
+                    m[4] += wx * y;
+                }
+                *h = m;
+            }
+            next += 1;
+        }
+        // Vertical pass: this lobe row from its node rows.
         acc.iter_mut().for_each(|a| *a = [0.0; 5]);
-        let o = (ay.start[j] - b_lo) as usize;
         for (k, &w) in ay.weights(j).iter().enumerate() {
-            let hr = &h[(o + k) * nx..][..nx];
-            for (a, hv) in acc.iter_mut().zip(hr) {
+            let slot = (first + k as i64).rem_euclid(ring_len as i64) as usize;
+            for (a, hv) in acc.iter_mut().zip(&ring[slot * nx..][..nx]) {
                 for c in 0..5 {
                     a[c] += w * hv[c];
                 }
