@@ -1,6 +1,7 @@
 //! The position-normal baseline (Yan 2016): bad input, the closed-form element integral against a
 //! quadrature over positions, normalisation per footprint, totality, samplers (chi-square), the
-//! published BRDF's formula and its known energy gain, and (ignored) the accuracy and furnace tables.
+//! published BRDF's formula and its known energy gain, the query cap as a level of detail, and (ignored)
+//! the accuracy, furnace and level-of-detail tables.
 //!
 //! Integrals of the spiky P-NDF are taken in slope space, where D cos θ dω = P(ñ) dñ with
 //! P(ñ) = D(m(ñ)) cos⁴θ: the trapezoid rule on a grid whose step is half the narrowest element
