@@ -143,5 +143,45 @@ fn queries(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, build, queries);
+/// Issue 15 item 3: the build with the default separable filter against the 256-node QMC build of
+/// earlier versions, on the four procedural maps at 512² and 1024² (2048²:
+/// `cargo test --lib -- --ignored build_timing_2048 --nocapture`, which alternates the two).
+/// Run: `cargo bench --bench mixture -- mixture_build_method --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+fn build_method(c: &mut Criterion) {
+    use brdf::glint::{BrushedParams, FlakesParams, MomentMethod, brushed, flakes};
+    for n in [512usize, 1024] {
+        let maps = [
+            ("bumpy", bumpy(n, n, 0.25, 4.0, 1).unwrap()),
+            (
+                "brushed",
+                brushed(n, n, BrushedParams::default(), 2).unwrap(),
+            ),
+            (
+                "scratched",
+                scratched(n, n, ScratchedParams::default(), 3).unwrap(),
+            ),
+            ("flakes", flakes(n, n, FlakesParams::default(), 4).unwrap()),
+        ];
+        let mut g = c.benchmark_group(format!("mixture_build_method/{n}"));
+        g.sample_size(10);
+        g.throughput(Throughput::Elements((n * n) as u64));
+        for (name, map) in &maps {
+            for (label, moments) in [
+                ("filter", MomentMethod::default()),
+                ("qmc256", MomentMethod::Qmc),
+            ] {
+                let p = MixtureParams {
+                    moments,
+                    ..MixtureParams::default()
+                };
+                g.bench_function(BenchmarkId::new(label, name), |b| {
+                    b.iter(|| BeckmannMixture::build(black_box(map), p).unwrap())
+                });
+            }
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, build, queries, build_method);
 criterion_main!(benches);

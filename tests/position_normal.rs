@@ -1,6 +1,7 @@
 //! The position-normal baseline (Yan 2016): bad input, the closed-form element integral against a
 //! quadrature over positions, normalisation per footprint, totality, samplers (chi-square), the
-//! published BRDF's formula and its known energy gain, and (ignored) the accuracy and furnace tables.
+//! published BRDF's formula and its known energy gain, the query cap as a level of detail, and (ignored)
+//! the accuracy, furnace and level-of-detail tables.
 //!
 //! Integrals of the spiky P-NDF are taken in slope space, where D cos θ dω = P(ñ) dñ with
 //! P(ñ) = D(m(ñ)) cos⁴θ: the trapezoid rule on a grid whose step is half the narrowest element
@@ -587,6 +588,43 @@ fn published_brdf_creates_energy_on_tilted_surfaces() {
     );
 }
 
+/// The query cap as an explicit level of detail: `patch()` is `patch_with_cap` at the map's cap,
+/// `query_scale` is the σ ratio the cap imposes (k_w σ ≤ cap), no cap keeps every element, and a
+/// degenerate cap shrinks the footprint to its centre without breaking totality.
+#[test]
+fn query_cap_is_an_explicit_level_of_detail() {
+    let n = 64;
+    let map = noise(n, 0.3, 5);
+    let pn = build(&map);
+    // A square footprint of area A has σ = √(A/12) per axis: 1024 texels → σ = 9.24, k_w σ = 27.7.
+    let fp = Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 1024.0, n, n);
+    let sigma = (1024.0f64 / 12.0).sqrt();
+    let default = pn.patch(&fp);
+    let same = pn.patch_with_cap(&fp, PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS);
+    assert_eq!(default.query_scale(), 1.0);
+    assert_eq!(default.element_count(), same.element_count());
+    let m = Vec3::new(0.1, -0.05, 1.0).normalize();
+    assert_eq!(default.d(m).to_bits(), same.d(m).to_bits());
+    // Cap 12 texels: σ → 4, scale 4 / 9.24 (f32 footprint covariance: 1e-5 relative).
+    let capped = pn.patch_with_cap(&fp, 12.0);
+    let want = 4.0 / sigma;
+    assert!(
+        (capped.query_scale() as f64 - want).abs() < 1e-5,
+        "{}",
+        capped.query_scale()
+    );
+    assert!(capped.element_count() < default.element_count());
+    let uncapped = pn.patch_with_cap(&fp, f32::INFINITY);
+    assert_eq!(uncapped.query_scale(), 1.0);
+    assert_eq!(uncapped.element_count(), default.element_count());
+    for cap in [0.0, -1.0, f32::NAN] {
+        let p = pn.patch_with_cap(&fp, cap);
+        assert_eq!(p.query_scale(), 0.0);
+        assert!(p.element_count() >= 1);
+        assert!(p.d(m).is_finite() && p.lambda(m).is_finite());
+    }
+}
+
 /// Accuracy against the ground truth (same maps, footprints and bins as the mixture's table).
 /// `cargo test --release --test position_normal -- --ignored accuracy_table --nocapture`
 #[test]
@@ -685,4 +723,79 @@ fn furnace_table() {
             }
         }
     }
+}
+
+/// The level-of-detail chart behind `DEFAULT_MAX_QUERY_TEXELS`: on 512² procedural maps, for
+/// footprints of 1 to 65 536 texels, the distance of the P-NDF to the ground truth (64² bins,
+/// 4·10⁶ positions, one evaluation per bin) and the time of one `patch()` and one `d` (one thread,
+/// 512 normals, half from D_P cos, half bin centres), with the query cap of 128 texels (the
+/// released code's) and without a cap. Where the cap does not bite (`query_scale` 1) the two
+/// patches are the same computation and one row is printed. Maps run in parallel (rayon).
+///
+/// `cargo test --test position_normal -- --ignored lod_table --nocapture` (the test profile is
+/// opt-level 3; times from one run on a loaded machine: read them as ratios).
+#[test]
+#[ignore]
+fn lod_table() {
+    use brdf::glint::{HemisphereBins, Kernel, binned_pndf, tv_distance};
+    use rayon::prelude::*;
+    use std::time::Instant;
+    let n = 512;
+    let maps = support::procedural_maps(n);
+    let bins = HemisphereBins::new(64).unwrap();
+    println!(
+        "| map | footprint (texels) | cap (texels) | σ scale | elements | TV | patch() | d | reference noise |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    maps.par_iter().for_each(|(name, map)| {
+        let pn = build(map);
+        for area in [1.0f32, 16.0, 256.0, 4096.0, 16384.0, 65536.0] {
+            let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
+            let reference = binned_pndf(map, &fp, Kernel::Gaussian, &bins, 4_000_000, 17);
+            let capped = pn.patch(&fp).query_scale() < 1.0;
+            let caps: &[f32] = if capped {
+                &[128.0, f32::INFINITY]
+            } else {
+                &[128.0]
+            };
+            for &cap in caps {
+                let patch = pn.patch_with_cap(&fp, cap);
+                let tv = tv_distance(&patch, &reference, 1);
+                let normals: Vec<Vec3> = (0..512)
+                    .map(|k| {
+                        let u = Vec2::new((k as f32 + 0.5) / 512.0, (k as f32 * 0.618_034).fract());
+                        if k % 2 == 0 {
+                            patch.sample_normal(u)
+                        } else {
+                            bins.center(k * 7 % bins.len())
+                        }
+                    })
+                    .collect();
+                let t = Instant::now();
+                let s: f32 = normals.iter().map(|&m| patch.d(m)).sum();
+                assert!(s.is_finite());
+                let t_d = t.elapsed().as_secs_f64() / normals.len() as f64;
+                let reps = 10;
+                let t = Instant::now();
+                for _ in 0..reps {
+                    let p = pn.patch_with_cap(std::hint::black_box(&fp), cap);
+                    std::hint::black_box(p.element_count());
+                }
+                let t_patch = t.elapsed().as_secs_f64() / reps as f64;
+                println!(
+                    "| {name} | {area} | {} | {:.3} | {} | {tv:.3} | {:.1} µs | {:.1} µs | {:.3} |",
+                    match (capped, cap.is_finite()) {
+                        (false, _) => "any".to_string(),
+                        (true, true) => format!("{cap}"),
+                        (true, false) => "none".to_string(),
+                    },
+                    patch.query_scale(),
+                    patch.element_count(),
+                    t_patch * 1e6,
+                    t_d * 1e6,
+                    reference.tv_error()
+                );
+            }
+        }
+    });
 }

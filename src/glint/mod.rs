@@ -88,6 +88,7 @@ pub use mixture::{
     MAX_TRUNCATION_SIGMAS, MIN_SPACING, MaskingMode, MixtureMemory, MixtureParams, MixturePatch,
     PatchOptions,
 };
+pub use mixture::{DEFAULT_SUPERSAMPLING, MAX_SUPERSAMPLING, MomentMethod};
 pub use model::{GlintModel, GlintPatch};
 pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,

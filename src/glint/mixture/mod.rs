@@ -13,10 +13,12 @@
 //! measurements are in docs/mixture.md.
 
 mod build;
+mod build_filter;
 mod hierarchy;
 mod patch;
 mod store;
 
+pub use build_filter::DEFAULT_SUPERSAMPLING;
 pub use patch::MixturePatch;
 pub(crate) use patch::MixtureScratch;
 
@@ -40,7 +42,8 @@ pub const MIN_SPACING: f32 = 0.125;
 /// (`kernel_sigmas`, `weight_sigmas`, and the position-normal map's `weight_sigmas`): 10.
 pub const MAX_TRUNCATION_SIGMAS: f32 = 10.0;
 
-/// Default number of quasi-Monte Carlo nodes per lobe for the moments (eq. 6).
+/// Default number of quasi-Monte Carlo nodes per lobe for the moments (eq. 6) when
+/// [`MixtureParams::moments`] is [`MomentMethod::Qmc`].
 ///
 /// Measured (docs/results.md, `accuracy_table` test, 64² crops of the four procedural maps): the
 /// largest error of any lobe's slope standard deviation against 16384 nodes is 0.29-0.87 σ_ε at 256
@@ -76,6 +79,40 @@ pub const DEFAULT_SLOPE_TAIL: f32 = 1.0e-6;
 /// measured (up to 65536 texels). Set `f32::INFINITY` to keep the mixture at any distance, lower it to
 /// bound the time of a query. See docs/mixture.md.
 pub const DEFAULT_LOD_LOBES: f32 = 16384.0;
+
+/// How the build integrates each lobe's five slope moments (\[Chermain2019\] eq. 6).
+///
+/// Both integrate the same quantity (the interpolated map's slopes under the seed kernel truncated
+/// at ±`kernel_sigmas` σ per axis); they differ in cost and quadrature error. Measured against a
+/// converged 65 536-node QMC reference (docs/mixture.md, docs/results.md "Fast build (issue 15)").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MomentMethod {
+    /// A separable filter of the interpolated map sampled on a grid of `supersampling` nodes per
+    /// texel per axis (rounded up to even; multiplied by 1/h for spacings h < 1), linear between nodes
+    /// and integrated exactly against the kernel; processed in parallel bands of lobe rows. Cost per
+    /// lobe ~ (supersampling · h)² node lookups plus two short 1D filters; error O(1/supersampling²).
+    /// `supersampling` in [1, 64].
+    Filter {
+        /// Nodes per texel per axis ([`DEFAULT_SUPERSAMPLING`]).
+        supersampling: u32,
+    },
+    /// Quasi-Monte Carlo with [`MixtureParams::samples`] nodes per lobe (an R2 point set mapped
+    /// through the truncated Gaussian's inverse cdf): the build of versions before issue 15, kept
+    /// for reproducing their moments bit for bit.
+    Qmc,
+}
+
+impl Default for MomentMethod {
+    fn default() -> Self {
+        MomentMethod::Filter {
+            supersampling: DEFAULT_SUPERSAMPLING,
+        }
+    }
+}
+
+/// Largest accepted [`MomentMethod::Filter`] supersampling: 64 nodes per texel per axis (the
+/// node rows a band holds grow with it; the quadrature error is already ~1e-3 of 4's).
+pub const MAX_SUPERSAMPLING: u32 = 64;
 
 /// Default masking mode of patches.
 pub const DEFAULT_MASKING: MaskingMode = MaskingMode::Exact;
@@ -123,7 +160,8 @@ pub struct MixtureParams {
     pub spacing: f32,
     /// Floor σ_ε of the lobes' slope standard deviation (> 0).
     pub sigma_min: f32,
-    /// Quasi-Monte Carlo nodes per lobe for the moments (≥ 1).
+    /// Quasi-Monte Carlo nodes per lobe for the moments (≥ 1), used when `moments` is
+    /// [`MomentMethod::Qmc`].
     pub samples: usize,
     /// Truncation of k_i for the moment integral, in σ (in (0, [`MAX_TRUNCATION_SIGMAS`]]).
     pub kernel_sigmas: f32,
@@ -133,6 +171,9 @@ pub struct MixtureParams {
     pub slope_tail: f32,
     /// Options of the patches made by [`GlintNdf::patch`].
     pub patch: PatchOptions,
+    /// How the moments are integrated ([`MomentMethod::default`]: the filter). Not stored in saved
+    /// files (a loaded mixture reads its moments and reports the default here).
+    pub moments: MomentMethod,
 }
 
 impl Default for MixtureParams {
@@ -145,6 +186,7 @@ impl Default for MixtureParams {
             weight_sigmas: DEFAULT_WEIGHT_SIGMAS,
             slope_tail: DEFAULT_SLOPE_TAIL,
             patch: PatchOptions::default(),
+            moments: MomentMethod::default(),
         }
     }
 }
@@ -178,6 +220,15 @@ impl MixtureParams {
                 name: "samples",
                 value: 0.0,
                 reason: "must be at least 1",
+            });
+        }
+        if let MomentMethod::Filter { supersampling } = self.moments
+            && !(1..=MAX_SUPERSAMPLING).contains(&supersampling)
+        {
+            return Err(Error::InvalidParameter {
+                name: "supersampling",
+                value: supersampling as f64,
+                reason: "must be in [1, 64] (MAX_SUPERSAMPLING)",
             });
         }
         if !(self.slope_tail > 0.0 && self.slope_tail < 1.0) {
@@ -266,7 +317,8 @@ impl BeckmannMixture {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming the field of `params` that is invalid (`spacing`,
-    /// `sigma_min`, `samples`, `kernel_sigmas`, `weight_sigmas`, `slope_tail`, `lod_lobes`);
+    /// `sigma_min`, `samples`, `supersampling`, `kernel_sigmas`, `weight_sigmas`, `slope_tail`,
+    /// `lod_lobes`);
     /// [`Error::InvalidSize`] if the lobe grid would exceed 2³¹ lobes.
     pub fn build(map: &NormalMap, params: MixtureParams) -> Result<Self> {
         Self::build_with_progress(map, params, None)
@@ -285,7 +337,18 @@ impl BeckmannMixture {
         params.validate()?;
         let (width, height) = (map.width(), map.height());
         let (grid, spacing) = lobe_grid(width, height, &params)?;
-        let lobes = build::all_moments(map, &params, grid, spacing, progress);
+        let lobes = match params.moments {
+            MomentMethod::Qmc => build::all_moments(map, &params, grid, spacing, progress),
+            MomentMethod::Filter { supersampling } => build_filter::all_moments(
+                map,
+                grid,
+                spacing,
+                spacing.map(build::kernel_sigma),
+                params.kernel_sigmas as f64,
+                supersampling,
+                progress,
+            ),
+        };
         Ok(Self::assemble(width, height, grid, spacing, params, lobes))
     }
 

@@ -84,6 +84,7 @@ impl BeckmannMixture {
             weight_sigmas,
             slope_tail,
             patch: PatchOptions { masking, lod_lobes },
+            ..MixtureParams::default()
         };
         let refused = |e: crate::Error| store::invalid(format!("stored mixture refused: {e}"));
         params.validate().map_err(refused)?;

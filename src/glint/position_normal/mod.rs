@@ -294,6 +294,18 @@ impl PositionNormalMap {
     }
 
     /// Bytes held by the elements and the hierarchy.
+    /// The patch of a footprint with an explicit level of detail: the query cap `max_query_texels`
+    /// (texels, `weight_sigmas` · σ_footprint ≤ cap) in place of the map's
+    /// [`PositionNormalParams::max_query_texels`]; `f32::INFINITY` keeps the exact footprint. See
+    /// [`PositionNormalPatch::with_cap`] and docs/position_normal.md for the cost against accuracy.
+    pub fn patch_with_cap(
+        &self,
+        footprint: &Footprint,
+        max_query_texels: f32,
+    ) -> PositionNormalPatch<'_> {
+        PositionNormalPatch::with_cap(self, footprint, max_query_texels, None)
+    }
+
     pub fn memory(&self) -> PositionNormalMemory {
         PositionNormalMemory {
             elements: self.elements.len(),

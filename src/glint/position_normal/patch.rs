@@ -38,6 +38,8 @@ struct Geometry {
     kw2: f64,
     /// Half-widths of the rectangle of candidate elements, k_w √Σ_eff,kk.
     half: [f64; 2],
+    /// Footprint σ after the query cap over σ before, along the major axis (1 if the cap did not bite).
+    query_scale: f64,
 }
 
 /// Symmetric 2 × 2 eigen decomposition: eigenvalues (λ1 ≥ λ2) and the unit eigenvector of λ1.
@@ -74,13 +76,24 @@ fn clamp_covariance(c: [f64; 3], max_var: f64) -> [f64; 3] {
 }
 
 impl Geometry {
-    fn new(map: &PositionNormalMap, footprint: &Footprint) -> Geometry {
+    /// `max_query_texels` not > 0 (NaN included) acts as 0: the footprint shrinks to its centre.
+    fn new(map: &PositionNormalMap, footprint: &Footprint, max_query_texels: f32) -> Geometry {
         let p = &map.params;
         let (c, s) = footprint.gaussian_texels(map.width, map.height);
         let cov = [s.x_axis.x as f64, s.y_axis.x as f64, s.y_axis.y as f64];
         let kw = p.weight_sigmas as f64;
-        let cap = p.max_query_texels as f64 / kw;
+        let cap = if max_query_texels > 0.0 {
+            max_query_texels as f64 / kw
+        } else {
+            0.0
+        };
+        let major = eigen(cov).0[0];
         let cov = clamp_covariance(cov, cap * cap);
+        let query_scale = if major > 0.0 {
+            (eigen(cov).0[0] / major).sqrt().min(1.0)
+        } else {
+            1.0
+        };
         let h = map.spacing;
         let (h2, sh) = (h * h, SIGMA_H_PER_SPACING);
         let sh2 = sh * sh;
@@ -100,6 +113,7 @@ impl Geometry {
             var_r: (p.sigma_r as f64).powi(2),
             kw2: kw * kw,
             half: [kw * a.sqrt(), kw * d.sqrt()],
+            query_scale,
         }
     }
 
@@ -244,6 +258,23 @@ impl<'a> PositionNormalPatch<'a> {
         Self::new_in(map, footprint, None)
     }
 
+    /// [`PositionNormalPatch::new`] with an explicit level of detail: the query cap `max_query_texels`
+    /// in place of the map's [`PositionNormalParams::max_query_texels`](super::PositionNormalParams)
+    /// (`f32::INFINITY`: the exact footprint whatever its size; values not > 0, NaN included, shrink the
+    /// footprint to its centre). No allocation (the samplers' buffers are built on first use).
+    pub fn with_cap(
+        map: &'a PositionNormalMap,
+        footprint: &Footprint,
+        max_query_texels: f32,
+        scratch: Option<&'a mut GlintScratch>,
+    ) -> PositionNormalPatch<'a> {
+        Self::build(
+            map,
+            Geometry::new(map, footprint, max_query_texels),
+            scratch,
+        )
+    }
+
     /// [`PositionNormalPatch::new`] with its per-element buffers lent by `scratch` (given back when
     /// the patch drops): no heap allocation once the scratch has grown to the footprint's size.
     pub fn new_in(
@@ -251,7 +282,14 @@ impl<'a> PositionNormalPatch<'a> {
         footprint: &Footprint,
         scratch: Option<&'a mut GlintScratch>,
     ) -> PositionNormalPatch<'a> {
-        let geo = Geometry::new(map, footprint);
+        Self::with_cap(map, footprint, map.params.max_query_texels, scratch)
+    }
+
+    fn build(
+        map: &'a PositionNormalMap,
+        geo: Geometry,
+        scratch: Option<&'a mut GlintScratch>,
+    ) -> PositionNormalPatch<'a> {
         let rect = [geo.range(0), geo.range(1)];
         let mut total = 0.0f64;
         let mut count = 0usize;
@@ -301,6 +339,12 @@ impl<'a> PositionNormalPatch<'a> {
                 f(w, mean, cov);
             }
         }
+    }
+
+    /// The level of detail the query cap applied: the footprint's standard deviation along its major
+    /// axis after the cap over before (1 when the cap did not bite; `k_w σ ≤ max_query_texels`).
+    pub fn query_scale(&self) -> f32 {
+        self.geo.query_scale as f32
     }
 
     /// Number of elements kept in the footprint (inside the weight ellipse).
