@@ -52,7 +52,6 @@
 mod binmap;
 mod bins;
 mod cdf;
-mod position_normal;
 mod footprint;
 #[cfg(feature = "image")]
 mod image_io;
@@ -60,6 +59,7 @@ mod mixture;
 mod model;
 mod moments;
 mod normal_map;
+mod position_normal;
 mod procedural;
 mod reference;
 mod scratch;
@@ -72,10 +72,6 @@ pub use binmap::{
     EXACT_MASKING_TEXELS, MASKING_FIRST_LEVEL, MAX_SUBDIVISIONS, QueryStats,
 };
 pub use bins::HemisphereBins;
-pub use position_normal::{
-    DEFAULT_MASKING_ALPHA, EXACT_MASKING_ELEMENTS, PositionNormalBrdf, PositionNormalMap,
-    PositionNormalMemory, PositionNormalParams, PositionNormalPatch,
-};
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 #[cfg(feature = "image")]
 pub use image_io::{
@@ -91,6 +87,10 @@ pub use mixture::{
 pub use model::{GlintModel, GlintPatch};
 pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
+};
+pub use position_normal::{
+    DEFAULT_MASKING_ALPHA, EXACT_MASKING_ELEMENTS, PositionNormalBrdf, PositionNormalMap,
+    PositionNormalMemory, PositionNormalParams, PositionNormalPatch,
 };
 pub use procedural::{
     BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
