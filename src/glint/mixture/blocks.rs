@@ -135,7 +135,7 @@ pub(super) fn exp2_lanes(x: f32) -> f32 {
     // Taylor coefficients (ln 2)^k / k!.
     const C: [f32; 8] = [
         1.0,
-        0.693_147_2,
+        std::f32::consts::LN_2,
         0.240_226_5,
         0.055_504_11,
         0.009_618_129,

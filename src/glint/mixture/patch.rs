@@ -878,7 +878,7 @@ impl Ndf for MixturePatch<'_> {
             }
             blocks::visible_lanes(b, wts, wo, &mut v);
             let sum: f64 = v.iter().map(|&x| x as f64).sum();
-            if !(sum > 0.0) {
+            if sum.is_nan() || sum <= 0.0 {
                 return;
             }
             if acc + sum <= target {
