@@ -143,7 +143,8 @@ pub(super) fn exp2_lanes(x: f32) -> f32 {
         0.000_154_035_3,
         1.525_273_4e-5,
     ];
-    let keep = x >= -126.0; // false for NaN too
+    // All-ones if x ≥ −126, else 0 (NaN too): a bit mask, not a branch.
+    let keep = ((x >= -126.0) as u32).wrapping_neg();
     let x = x.clamp(-126.0, 0.0);
     let t = x + ROUND;
     let n = t - ROUND;
@@ -153,23 +154,28 @@ pub(super) fn exp2_lanes(x: f32) -> f32 {
     // n ∈ [−126, 0]: the bits of t are 0x4B40_0000 + n, so n + 127 ∈ [1, 127] is a normal exponent.
     let e = (t.to_bits() as i32 - 0x4B40_0000 + 127) as u32;
     let r = p * f32::from_bits(e << 23);
-    if keep { r } else { 0.0 }
+    f32::from_bits(r.to_bits() & keep)
+}
+
+/// `v` where `keep`, else +0.0, by a bit mask (branch-free; vectorises as an `and`).
+#[inline(always)]
+fn select(keep: bool, v: f32) -> f32 {
+    f32::from_bits(v.to_bits() & (keep as u32).wrapping_neg())
 }
 
 /// Σ over the 16 lanes of `w[lane] · P22_lane(s)` into the lane accumulators `acc`, where P22 is
 /// taken without its 1/(2π) factor (`× NORM_OF_J` is applied by the caller via [`p22_scale`]).
-/// With `boxed`, a lane contributes only if s lies in its slope box |s − μ| ≤ k (√Σxx, √Σyy)
+/// With `BOXED`, a lane contributes only if s lies in its slope box |s − μ| ≤ k (√Σxx, √Σyy)
 /// (`k2` = k²), as the scalar walk does.
 ///
 /// # Reference
 /// \[Chermain2019\] eq. 4 (P22 of each lobe), §5 (the box).
 #[inline(always)]
-pub(super) fn p22_lanes(
+pub(super) fn p22_lanes<const BOXED: bool>(
     b: &LobeBlock,
     w: &[f32; LANES],
     s: Vec2,
     k2: f32,
-    boxed: bool,
     acc: &mut [f64; LANES],
 ) {
     let mut p = [0.0f32; LANES];
@@ -180,10 +186,10 @@ pub(super) fn p22_lanes(
         let zy = b.j21[i] * dx + b.j22[i] * dy;
         let e = exp2_lanes(-(zx * zx + zy * zy));
         let (l11, l21, l22) = (b.l11[i], b.l21[i], b.l22[i]);
-        let inside =
-            !boxed || (dx * dx <= k2 * (l11 * l11) && dy * dy <= k2 * (l21 * l21 + l22 * l22));
+        // `&`, not `&&`: both tests are evaluated, so the lane loop has no branch.
+        let inside = (dx * dx <= k2 * (l11 * l11)) & (dy * dy <= k2 * (l21 * l21 + l22 * l22));
         let v = w[i] * (b.j11[i] * b.j22[i]) * e;
-        p[i] = if inside { v } else { 0.0 };
+        p[i] = if BOXED { select(inside, v) } else { v };
     }
     for i in 0..LANES {
         acc[i] += p[i] as f64;
@@ -204,7 +210,8 @@ pub(super) fn p22_scale() -> f64 {
 /// R = Q/φ = √(π/2) τ e^{P(τ)}, τ = 1/(1 + t/(2√2)), P the exponent of Numerical Recipes' `erfcc`
 /// (fractional error < 1.2·10⁻⁷). Where t > 4, 1 − t R loses (t² + 1)× relative accuracy to
 /// cancellation; there it is formed as ε R with ε(t) = 1/(t + 2/(t + 3/(t + …))) (Laplace's continued
-/// fraction to depth 12, < 1e-7 relative for t ≥ 4), only for blocks that have such a lane.
+/// fraction to depth 12 by its forward recurrence). Both forms are computed for every lane and one is
+/// selected: no per-lobe branch.
 /// s_w = 0 (normal incidence): V = max(A_s, 0).
 ///
 /// # Reference
@@ -216,55 +223,60 @@ pub(super) fn visible_lanes(b: &LobeBlock, w: &[f32; LANES], d: Vec3, out: &mut 
     const INV_SQRT_2PI: f32 = 0.398_942_3;
     const HALF_LOG2E: f32 = 0.721_347_5; // ½ log₂ e
     const T_CF: f32 = 4.0;
+    const T_MAX: f32 = 1.0e4;
     const LOG2E: f32 = std::f32::consts::LOG2_E;
     // A_s, s_w and t in f64: V's relative sensitivity to t is ~t·Δt, so t needs more than f32's
     // relative accuracy where A_s cancels (grazing views, tilted lobes).
     let mut t = [0.0f32; LANES];
     let mut sw = [0.0f64; LANES];
     let mut base = [0.0f64; LANES];
-    let mut far = false;
     let (wx, wy, wz) = (d.x as f64, d.y as f64, d.z as f64);
     for i in 0..LANES {
         let a = wz - (b.mx[i] as f64 * wx + b.my[i] as f64 * wy);
         let vx = b.l11[i] as f64 * wx + b.l21[i] as f64 * wy;
         let vy = b.l22[i] as f64 * wy;
         let s = (vx * vx + vy * vy).sqrt();
-        // s = 0 gives t = ∞ (or NaN for a = 0); both end in the selects below (s > 0 is required).
-        let ti = (a.abs() / s) as f32;
-        t[i] = if ti < 1.0e4 { ti } else { 1.0e4 };
+        // s = 0 gives t = ∞ or NaN: `min` maps both to T_MAX, where φ(t) is 0 and so is G.
+        t[i] = ((a.abs() / s) as f32).min(T_MAX);
         sw[i] = s;
         base[i] = a.max(0.0);
-        far |= ti > T_CF;
     }
+    // φ(t), Q(t) = φ R and the near form φ (1 − t R), lane by lane.
     let mut q = [0.0f32; LANES];
+    let mut near = [0.0f32; LANES];
     for i in 0..LANES {
         let ti = t[i];
-        let tau = 1.0 / (1.0 + ti * std::f32::consts::FRAC_1_SQRT_2 * 0.5);
+        let tau = 1.0 / (1.0 + ti * (0.5 * std::f32::consts::FRAC_1_SQRT_2));
         let mills = SQRT_HALF_PI * tau * exp2_lanes(crate::math::erfc_exponent(tau) * LOG2E);
         let phi = INV_SQRT_2PI * exp2_lanes(-HALF_LOG2E * ti * ti);
-        q[i] = phi * mills; // φ(t) R(t) = Q(t), kept for the far branch
-        let g = phi * (1.0 - ti * mills).max(0.0);
-        let v = if sw[i] > 0.0 {
-            base[i] + sw[i] * g as f64
-        } else {
-            base[i]
-        };
-        out[i] = w[i] * v as f32;
+        q[i] = phi * mills;
+        near[i] = phi * (1.0 - ti * mills).max(0.0);
     }
-    if far {
+    // ε(t) = 1/T₁, T₁ = t + 2/(t + 3/(t + … + 13/t)), by the forward recurrence of the convergents
+    // (one division), at t clamped to [T_CF, 16] (φ = 0 in f32 beyond 13.3, and 16¹² stays far
+    // inside f32's range). The step loop is outside the lane loop, so the lanes vectorise.
+    let tc: [f32; LANES] = std::array::from_fn(|i| t[i].clamp(T_CF, 16.0));
+    let (mut a0, mut a1) = ([1.0f32; LANES], tc);
+    let (mut b0, mut b1) = ([0.0f32; LANES], [1.0f32; LANES]);
+    for k in 2..=13 {
+        let kf = k as f32;
         for i in 0..LANES {
-            let ti = t[i];
-            if ti > T_CF && sw[i] > 0.0 {
-                // T_k = t + (k + 1)/T_{k+1} from T_13 = t down to T_1; ε = 1/T_1.
-                let mut tk = ti;
-                for k in (1..=12).rev() {
-                    tk = ti + (k + 1) as f32 / tk;
-                }
-                let eps = 1.0 / tk;
-                // G(−t) = φ (1 − t R) = ε φ R = ε Q.
-                out[i] = w[i] * (base[i] + sw[i] * (eps * q[i]) as f64) as f32;
-            }
+            let a2 = tc[i] * a1[i] + kf * a0[i];
+            let b2 = tc[i] * b1[i] + kf * b0[i];
+            (a0[i], a1[i], b0[i], b1[i]) = (a1[i], a2, b1[i], b2);
         }
+    }
+    // G(−t) = φ (1 − t R) = ε φ R = ε Q beyond T_CF, where 1 − t R cancels.
+    let mut g = [0.0f32; LANES];
+    for i in 0..LANES {
+        let far = (b1[i] / a1[i]) * q[i];
+        let ti = t[i];
+        g[i] = f32::from_bits(
+            select(ti > T_CF, far).to_bits() | select(ti <= T_CF, near[i]).to_bits(),
+        );
+    }
+    for i in 0..LANES {
+        out[i] = w[i] * (base[i] + sw[i] * g[i] as f64) as f32;
     }
 }
 

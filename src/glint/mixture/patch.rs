@@ -610,7 +610,7 @@ impl<'a> MixturePatch<'a> {
             blocks::for_each_block(&mix.tree, r.x, r.y, s, |bx, by| {
                 blocks_seen += 1;
                 let w = r.weights(bw, bx, by);
-                blocks::p22_lanes(mix.blocks.block(bx, by), w, s, k2, true, &mut acc);
+                blocks::p22_lanes::<true>(mix.blocks.block(bx, by), w, s, k2, &mut acc);
             });
         }
         (
@@ -955,7 +955,7 @@ impl MixturePatch<'_> {
         }
         let mut acc = [0.0f64; LANES];
         self.for_each_patch_block(g, |b, wts, _, _| {
-            blocks::p22_lanes(b, wts, s, 0.0, false, &mut acc);
+            blocks::p22_lanes::<false>(b, wts, s, 0.0, &mut acc);
         });
         let c = 1.0 + s.length_squared() as f64;
         acc.iter().sum::<f64>() * blocks::p22_scale() * c * c
