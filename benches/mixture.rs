@@ -1,7 +1,9 @@
 //! Cost of the Beckmann mixture of \[Chermain2019\]: the build, and per footprint size the patch
 //! construction, D_P, the exact and approximate Λ_P and the visible sampler, each per-direction query
-//! timed by the lobe blocks (`blocks`) and by the former scalar path (`scalar`, one lobe at a time
-//! rebuilt from its moments; kept as `#[doc(hidden)]` methods) in the same run.
+//! timed by the lobe blocks (`blocks`) and by the scalar path (`scalar`, one lobe at a time rebuilt
+//! from its moments) in the same run. D_P's blocks path is the patch's `d`; exact Λ_P and the visible
+//! sampler stay scalar in the patch (their lane kernels, `lambda_blocks` / `sample_visible_blocks`,
+//! measured slower) and `d_scalar` is the former `d`, all `#[doc(hidden)]`.
 //!
 //! Maps: the four procedural maps (bumpy, brushed, scratched, flakes) at 512², default parameters,
 //! built before timing. Footprints: isotropic, 1 to 65 536 texels, the level of detail off (so that
@@ -140,7 +142,7 @@ fn queries(c: &mut Criterion) {
             g.bench_with_input(BenchmarkId::new("blocks", area), &w, |b, w| {
                 b.iter(|| {
                     w.iter()
-                        .map(|&(v, _)| patch.lambda(black_box(v)))
+                        .map(|&(v, _)| patch.lambda_blocks(black_box(v)))
                         .sum::<f32>()
                 })
             });
@@ -162,7 +164,7 @@ fn queries(c: &mut Criterion) {
             g.bench_with_input(BenchmarkId::new("blocks", area), &w, |b, w| {
                 b.iter(|| {
                     w.iter()
-                        .map(|&(v, u)| patch.sample_visible(black_box(v), u).z)
+                        .map(|&(v, u)| patch.sample_visible_blocks(black_box(v), u).z)
                         .sum::<f32>()
                 })
             });

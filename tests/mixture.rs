@@ -960,8 +960,9 @@ proptest::proptest! {
         );
     }
 
-    /// Exact V_P(w) by the lobe blocks = Σ W_i V_i(w) summed here in f64 (libm erfc) over the
-    /// patch's public lobes, to 1e-5 relative, for views from normal incidence to 89°.
+    /// Exact V_P(w) by the lobe blocks' lane kernel (`visible_area_blocks`, not yet the patch's
+    /// default) = Σ W_i V_i(w) summed here in f64 (libm erfc) over the patch's public lobes, to 1e-5
+    /// relative, for views from normal incidence to 89°.
     #[test]
     fn block_visible_area_equals_the_f64_sum_of_the_lobes(
         which in 0usize..5, cx in 0.0f32..1.0, cy in 0.0f32..1.0,
@@ -975,7 +976,7 @@ proptest::proptest! {
             .weighted_lobes()
             .map(|(wi, g)| wi as f64 * visible_f64(&g, w))
             .sum();
-        let v = patch.visible_area(w) as f64;
+        let v = patch.visible_area_blocks(w) as f64;
         // 1e-5 relative: the lanes' f32 Mills-ratio form (NR's erfcc exponent, 1.2e-7, and its f32
         // roundings amplified ≤ 17× by 1 − tR below t = 4; the continued fraction beyond).
         proptest::prop_assert!(

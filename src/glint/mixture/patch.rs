@@ -688,9 +688,38 @@ impl<'a> MixturePatch<'a> {
         }
     }
 
-    /// Exact V_P(w) = Σ W_i V_i(w) over the lobe blocks (0 for invalid w); lanes in `f32`
-    /// ([`blocks::visible_lanes`]), the sum in `f64`.
+    /// Exact V_P(w) = Σ W_i V_i(w) (0 for invalid w): the scalar sum, one lobe at a time. The lane
+    /// kernel ([`MixturePatch::visible_area_blocks`]) was measured slower than this (0.5-1.5×,
+    /// docs/results.md "Lobe blocks"), so the exact masking and the visible sampler keep it.
     fn exact_visible_area(&self, g: &Gathered, w: Vec3) -> f64 {
+        self.exact_visible_area_scalar(g, w)
+    }
+
+    /// V_P(w) by the lobe blocks ([`blocks::visible_lanes`]: `f32` lanes, the sum in `f64`), the
+    /// filtered lobe's under the level of detail. Not used by the patch yet (slower than the scalar
+    /// sum, docs/results.md); kept for the benches and the property test.
+    #[doc(hidden)]
+    pub fn visible_area_blocks(&self, w: Vec3) -> f32 {
+        match &self.gathered {
+            Some(g) => finite_or_zero(self.exact_visible_area_blocks(g, w)),
+            None => self.filtered.visible_area(w),
+        }
+    }
+
+    /// Λ_P(w) with [`MixturePatch::visible_area_blocks`] (the benches' lane-kernel column).
+    #[doc(hidden)]
+    pub fn lambda_blocks(&self, w: Vec3) -> f32 {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let a = self.projected_area(w);
+        if a.is_nan() || a <= 0.0 {
+            return f32::MAX;
+        }
+        ((self.visible_area_blocks(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
+    }
+
+    fn exact_visible_area_blocks(&self, g: &Gathered, w: Vec3) -> f64 {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
         }
@@ -846,14 +875,74 @@ impl Ndf for MixturePatch<'_> {
     }
 
     /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
+    /// visible normal. Two passes over the lobes (total, then the pick), no allocation; the scalar
+    /// V_i (see [`MixturePatch::sample_visible_blocks`] for the lane version, measured slower).
+    /// Invalid wo: [`Ndf::sample_normal`].
+    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        self.sample_visible_scalar(wo, u)
+    }
+
+    /// Σ W_i D_i(m) cos θ_m over **every** gathered lobe (no slope-box truncation): exactly the
+    /// density of [`Ndf::sample_normal`]. Differs from `d(m) cos θ_m` by at most the truncated tail
+    /// (`slope_tail` of each lobe's mass). O(lobes).
+    fn pdf_normal(&self, m: Vec3) -> f32 {
+        let Some(g) = &self.gathered else {
+            return self.filtered.pdf_normal(m);
+        };
+        if !(m.z > 0.0 && m.is_finite()) {
+            return 0.0;
+        }
+        let p = self.untruncated_d(g, m) * m.z as f64;
+        let p = p as f32;
+        if p.is_finite() { p } else { 0.0 }
+    }
+
+    /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe, with the exact V_P in every masking
+    /// mode: exactly the density of [`Ndf::sample_visible`]. O(lobes).
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        let Some(g) = &self.gathered else {
+            return self.filtered.pdf_visible(wo, m);
+        };
+        let c = wo.dot(m);
+        if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
+            return 0.0;
+        }
+        let v = self.exact_visible_area(g, wo);
+        if v.is_nan() || v <= 0.0 {
+            return 0.0;
+        }
+        let p = (c as f64 * self.untruncated_d(g, m) / v) as f32;
+        if p.is_finite() { p } else { 0.0 }
+    }
+}
+
+impl MixturePatch<'_> {
+    /// Σ W_i D_i(m) over every gathered lobe (no slope box), lanes in `f32`, the sum in `f64`.
+    fn untruncated_d(&self, g: &Gathered, m: Vec3) -> f64 {
+        let Some(s) = normal_to_slope(m) else {
+            return 0.0;
+        };
+        if !s.is_finite() {
+            return 0.0;
+        }
+        let mut acc = [0.0f64; LANES];
+        self.for_each_patch_block(g, |b, wts, _, _| {
+            blocks::p22_lanes::<false>(b, wts, s, 0.0, &mut acc);
+        });
+        let c = 1.0 + s.length_squared() as f64;
+        acc.iter().sum::<f64>() * blocks::p22_scale() * c * c
+    }
+
+    /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
     /// visible normal. Two passes over the lobe blocks (the total, then the pick: block by block,
     /// then lane by lane in the block that holds the target), no allocation. Invalid wo:
-    /// [`Ndf::sample_normal`].
-    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+    /// [`Ndf::sample_normal`]. Not used by the patch (slower than the scalar sampler, docs/results.md).
+    #[doc(hidden)]
+    pub fn sample_visible_blocks(&self, wo: Vec3, u: Vec2) -> Vec3 {
         let Some(g) = &self.gathered else {
             return self.filtered.sample_visible(wo, u);
         };
-        let total = self.exact_visible_area(g, wo);
+        let total = self.exact_visible_area_blocks(g, wo);
         if !(total > 0.0 && total.is_finite()) {
             return self.sample_normal(u);
         }
@@ -910,58 +999,7 @@ impl Ndf for MixturePatch<'_> {
             .sample_visible(wo, Vec2::new(r, u.y))
     }
 
-    /// Σ W_i D_i(m) cos θ_m over **every** gathered lobe (no slope-box truncation): exactly the
-    /// density of [`Ndf::sample_normal`]. Differs from `d(m) cos θ_m` by at most the truncated tail
-    /// (`slope_tail` of each lobe's mass). O(lobes).
-    fn pdf_normal(&self, m: Vec3) -> f32 {
-        let Some(g) = &self.gathered else {
-            return self.filtered.pdf_normal(m);
-        };
-        if !(m.z > 0.0 && m.is_finite()) {
-            return 0.0;
-        }
-        let p = self.untruncated_d(g, m) * m.z as f64;
-        let p = p as f32;
-        if p.is_finite() { p } else { 0.0 }
-    }
-
-    /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe, with the exact V_P in every masking
-    /// mode: exactly the density of [`Ndf::sample_visible`]. O(lobes).
-    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
-        let Some(g) = &self.gathered else {
-            return self.filtered.pdf_visible(wo, m);
-        };
-        let c = wo.dot(m);
-        if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
-            return 0.0;
-        }
-        let v = self.exact_visible_area(g, wo);
-        if v.is_nan() || v <= 0.0 {
-            return 0.0;
-        }
-        let p = (c as f64 * self.untruncated_d(g, m) / v) as f32;
-        if p.is_finite() { p } else { 0.0 }
-    }
-}
-
-impl MixturePatch<'_> {
-    /// Σ W_i D_i(m) over every gathered lobe (no slope box), lanes in `f32`, the sum in `f64`.
-    fn untruncated_d(&self, g: &Gathered, m: Vec3) -> f64 {
-        let Some(s) = normal_to_slope(m) else {
-            return 0.0;
-        };
-        if !s.is_finite() {
-            return 0.0;
-        }
-        let mut acc = [0.0f64; LANES];
-        self.for_each_patch_block(g, |b, wts, _, _| {
-            blocks::p22_lanes::<false>(b, wts, s, 0.0, &mut acc);
-        });
-        let c = 1.0 + s.length_squared() as f64;
-        acc.iter().sum::<f64>() * blocks::p22_scale() * c * c
-    }
-
-    /// The former scalar visible sampler (the reference of the benches):
+    /// The scalar visible sampler (the patch's `sample_visible`):
     /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
     /// visible normal. Two passes over the lobes (total, then the pick), no allocation. Invalid wo:
     /// [`Ndf::sample_normal`].
