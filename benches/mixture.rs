@@ -1,18 +1,24 @@
 //! Cost of the Beckmann mixture of \[Chermain2019\]: the build, and per footprint size the patch
-//! construction, D_P, and the exact and approximate Λ_P.
+//! construction, D_P, the exact and approximate Λ_P and the visible sampler, each per-direction query
+//! timed by the lobe blocks (`blocks`) and by the scalar path (`scalar`, one lobe at a time rebuilt
+//! from its moments) in the same run. D_P's blocks path is the patch's `d`; exact Λ_P and the visible
+//! sampler stay scalar in the patch (their lane kernels, `lambda_blocks` / `sample_visible_blocks`,
+//! measured slower) and `d_scalar` is the former `d`, all `#[doc(hidden)]`.
 //!
-//! Maps: the procedural bumpy (RMS slope 0.25, correlation 4 texels) and scratched maps at 512², built
-//! before timing. Footprints: isotropic, 1 to 16 384 texels, the level of detail off (so that every
-//! size times the mixture itself) plus one row with the default level of detail. Each `d` iteration
-//! evaluates 256 precomputed normals (half drawn from the patch's own D_P cos, half uniform in a 40°
-//! cone: where a renderer's half vectors fall), so criterion's throughput is the time per call.
+//! Maps: the four procedural maps (bumpy, brushed, scratched, flakes) at 512², default parameters,
+//! built before timing. Footprints: isotropic, 1 to 65 536 texels, the level of detail off (so that
+//! every size times the mixture itself). Each `d` iteration evaluates 32 precomputed normals (half
+//! drawn from the patch's own D_P cos, half uniform in a 40° cone: where a renderer's half vectors
+//! fall), each Λ / sampler iteration 32 cosine-distributed views, so criterion's throughput is the
+//! time per call.
 //!
-//! Run: `cargo bench --bench mixture -- --warm-up-time 0.5 --measurement-time 2`
-//! (build times at 2048²: `cargo test --release --test mixture -- --ignored build_2048 --nocapture`).
+//! Run: `cargo bench --bench mixture -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+//! (one map: append e.g. `/bumpy`; build times at 2048²:
+//! `cargo test --release --test mixture -- --ignored build_2048 --nocapture`).
 
 use brdf::glint::{
-    BeckmannMixture, Footprint, GlintNdf, MaskingMode, MixtureParams, NormalMap, PatchOptions,
-    ScratchedParams, bumpy, scratched,
+    BeckmannMixture, BrushedParams, FlakesParams, Footprint, GlintNdf, MaskingMode, MixtureParams,
+    NormalMap, PatchOptions, ScratchedParams, brushed, bumpy, flakes, scratched,
 };
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
@@ -21,24 +27,33 @@ use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
 
 const SIZE: usize = 512;
-const AREAS: [f32; 5] = [1.0, 16.0, 256.0, 4096.0, 16384.0];
-const BATCH: usize = 256;
+const AREAS: [f32; 6] = [1.0, 16.0, 256.0, 4096.0, 16384.0, 65536.0];
+const BATCH: usize = 32;
 
+/// The four procedural maps with the parameters and seeds of the tests and the gallery.
 fn maps() -> Vec<(&'static str, NormalMap)> {
     vec![
         ("bumpy", bumpy(SIZE, SIZE, 0.25, 4.0, 1).unwrap()),
         (
+            "brushed",
+            brushed(SIZE, SIZE, BrushedParams::default(), 2).unwrap(),
+        ),
+        (
             "scratched",
-            scratched(SIZE, SIZE, ScratchedParams::default(), 1).unwrap(),
+            scratched(SIZE, SIZE, ScratchedParams::default(), 3).unwrap(),
+        ),
+        (
+            "flakes",
+            flakes(SIZE, SIZE, FlakesParams::default(), 4).unwrap(),
         ),
     ]
 }
 
-fn params(lod_lobes: f32) -> MixtureParams {
+fn params() -> MixtureParams {
     MixtureParams {
         patch: PatchOptions {
             masking: MaskingMode::Exact,
-            lod_lobes,
+            lod_lobes: f32::INFINITY,
         },
         ..MixtureParams::default()
     }
@@ -66,15 +81,16 @@ fn normals(patch: &impl Ndf, seed: u64) -> Vec<Vec3> {
         .collect()
 }
 
-/// View directions for Λ: cosine-distributed.
-fn views(seed: u64) -> Vec<Vec3> {
+/// View directions (and random pairs) for Λ and the sampler: cosine-distributed views.
+fn views(seed: u64) -> Vec<(Vec3, Vec2)> {
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
     (0..BATCH)
         .map(|_| {
             let (a, b): (f32, f32) = (rng.random(), rng.random());
             let r = a.sqrt();
             let p = std::f32::consts::TAU * b;
-            Vec3::new(r * p.cos(), r * p.sin(), (1.0 - a).max(1e-6).sqrt())
+            let w = Vec3::new(r * p.cos(), r * p.sin(), (1.0 - a).max(1e-6).sqrt());
+            (w, Vec2::new(rng.random(), rng.random()))
         })
         .collect()
 }
@@ -92,8 +108,7 @@ fn build(c: &mut Criterion) {
 
 fn queries(c: &mut Criterion) {
     for (name, map) in maps() {
-        let mix = BeckmannMixture::build(&map, params(f32::INFINITY)).unwrap();
-        let mix_lod = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
+        let mix = BeckmannMixture::build(&map, params()).unwrap();
 
         let mut g = c.benchmark_group(format!("mixture_patch/{name}"));
         for area in AREAS {
@@ -109,37 +124,77 @@ fn queries(c: &mut Criterion) {
         for area in AREAS {
             let patch = mix.patch(&footprint(area));
             let m = normals(&patch, 7);
-            g.bench_with_input(BenchmarkId::from_parameter(area), &m, |b, m| {
+            g.bench_with_input(BenchmarkId::new("blocks", area), &m, |b, m| {
                 b.iter(|| m.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
             });
+            g.bench_with_input(BenchmarkId::new("scalar", area), &m, |b, m| {
+                b.iter(|| m.iter().map(|&h| patch.d_scalar(black_box(h))).sum::<f32>())
+            });
         }
-        let patch = mix_lod.patch(&footprint(16384.0));
-        let m = normals(&patch, 7);
-        g.bench_with_input(BenchmarkId::new("default_lod", 16384), &m, |b, m| {
-            b.iter(|| m.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
-        });
         g.finish();
 
-        for (mode, label) in [
-            (MaskingMode::Exact, "exact"),
-            (MaskingMode::Approximate, "approximate"),
-        ] {
-            let mut g = c.benchmark_group(format!("mixture_lambda_{label}/{name}"));
-            g.throughput(Throughput::Elements(BATCH as u64));
-            let w = views(3);
-            for area in AREAS {
-                let options = PatchOptions {
-                    masking: mode,
-                    lod_lobes: f32::INFINITY,
-                };
-                let patch = mix.patch_with(&footprint(area), options);
-                let _ = patch.lambda(Vec3::Z); // build the lazily gathered lobes before timing
-                g.bench_with_input(BenchmarkId::from_parameter(area), &w, |b, w| {
-                    b.iter(|| w.iter().map(|&v| patch.lambda(black_box(v))).sum::<f32>())
-                });
-            }
-            g.finish();
+        let w = views(3);
+        let mut g = c.benchmark_group(format!("mixture_lambda_exact/{name}"));
+        g.throughput(Throughput::Elements(BATCH as u64));
+        for area in AREAS {
+            let patch = mix.patch(&footprint(area));
+            let _ = patch.lambda_scalar(Vec3::Z); // build the scalar path's lazy lobes before timing
+            g.bench_with_input(BenchmarkId::new("blocks", area), &w, |b, w| {
+                b.iter(|| {
+                    w.iter()
+                        .map(|&(v, _)| patch.lambda_blocks(black_box(v)))
+                        .sum::<f32>()
+                })
+            });
+            g.bench_with_input(BenchmarkId::new("scalar", area), &w, |b, w| {
+                b.iter(|| {
+                    w.iter()
+                        .map(|&(v, _)| patch.lambda_scalar(black_box(v)))
+                        .sum::<f32>()
+                })
+            });
         }
+        g.finish();
+
+        let mut g = c.benchmark_group(format!("mixture_sample_visible/{name}"));
+        g.throughput(Throughput::Elements(BATCH as u64));
+        for area in AREAS {
+            let patch = mix.patch(&footprint(area));
+            let _ = patch.lambda_scalar(Vec3::Z);
+            g.bench_with_input(BenchmarkId::new("blocks", area), &w, |b, w| {
+                b.iter(|| {
+                    w.iter()
+                        .map(|&(v, u)| patch.sample_visible_blocks(black_box(v), u).z)
+                        .sum::<f32>()
+                })
+            });
+            g.bench_with_input(BenchmarkId::new("scalar", area), &w, |b, w| {
+                b.iter(|| {
+                    w.iter()
+                        .map(|&(v, u)| patch.sample_visible_scalar(black_box(v), u).z)
+                        .sum::<f32>()
+                })
+            });
+        }
+        g.finish();
+
+        let mut g = c.benchmark_group(format!("mixture_lambda_approximate/{name}"));
+        g.throughput(Throughput::Elements(BATCH as u64));
+        for area in AREAS {
+            let options = PatchOptions {
+                masking: MaskingMode::Approximate,
+                lod_lobes: f32::INFINITY,
+            };
+            let patch = mix.patch_with(&footprint(area), options);
+            g.bench_with_input(BenchmarkId::from_parameter(area), &w, |b, w| {
+                b.iter(|| {
+                    w.iter()
+                        .map(|&(v, _)| patch.lambda(black_box(v)))
+                        .sum::<f32>()
+                })
+            });
+        }
+        g.finish();
     }
 }
 

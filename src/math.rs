@@ -122,7 +122,7 @@ pub(crate) fn erfcx_small(x: f32) -> f32 {
 
 /// The Chebyshev-fitted exponent P(t) of Numerical Recipes' `erfcc`: erfc(x) = t e^(−x² + P(t)).
 #[inline(always)]
-fn erfc_exponent(t: f32) -> f32 {
+pub(crate) fn erfc_exponent(t: f32) -> f32 {
     -1.265_512_2
         + t * (1.000_023_7
             + t * (0.374_091_96

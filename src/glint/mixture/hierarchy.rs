@@ -5,7 +5,8 @@
 //! Lobes sit on a regular grid, so positions are implicit: a node of level l ≥ 1 is the block of
 //! 2^l × 2^l lobes starting at lobe (x·2^l, y·2^l) (clipped at the grid's edge), and stores only the
 //! union of its lobes' slope boxes as [x_min, y_min, x_max, y_max] in `f32` (16 bytes). Level 0 (the
-//! lobes' own boxes) is not stored: it is rebuilt from the moments at query time by [`lobe_box`].
+//! lobes' own boxes) is not stored: queries descend to level 2, whose nodes are the lobe blocks
+//! (blocks.rs), and test each lane's box there; [`lobe_box`] gives the boxes the tree is built from.
 
 use crate::glint::slope_tree::level_sizes;
 use crate::ndf::SlopeGaussian;

@@ -4,7 +4,9 @@
 //!
 //! - [`BeckmannMixture::build`] integrates the five slope moments of the *interpolated* normal map
 //!   under each seed kernel k_i (eq. 5-6) and stores them (5 `f32` per lobe), with an implicit
-//!   quadtree of slope boxes (§5) and a mip chain of the moments (§4.2.2).
+//!   quadtree of slope boxes (§5), a mip chain of the moments (§4.2.2), and the lobes again as
+//!   structure-of-arrays blocks of 4 × 4 with their P22 and masking coefficients precomputed in `f32`
+//!   (blocks.rs), which the per-direction queries evaluate 16 lanes at a time.
 //! - [`BeckmannMixture::patch`] turns a [`Footprint`] into a [`MixturePatch`], an [`Ndf`](crate::ndf::Ndf) whose
 //!   D_P(h) = Σ W_i D_i(h) (eq. 9) and whose masking terms are exact (eq. 10-17) or approximate
 //!   (§4.2.2), so that `MicrofacetBrdf::new(patch, fresnel)` is the P-BRDF of eq. 7.
@@ -12,6 +14,7 @@
 //! The model, the hierarchy layout, the deviations from the paper and the defaults with their
 //! measurements are in docs/mixture.md.
 
+mod blocks;
 mod build;
 mod build_filter;
 mod hierarchy;
@@ -26,6 +29,7 @@ use crate::error::{Error, Result, positive};
 use crate::glint::slope_tree::SlopeTree;
 use crate::glint::{Footprint, GlintNdf, NormalMap};
 use crate::ndf::SlopeGaussian;
+use blocks::LobeBlocks;
 use hierarchy::{LobePyramid, lobe_box};
 
 /// Default seed spacing h = 1 texel: one lobe per texel, at the texel centres (\[Chermain2019\] §5.1.1).
@@ -260,6 +264,17 @@ pub struct MixtureMemory {
     pub hierarchy_bytes: usize,
     /// The moment mip chain above the lobes (20 bytes per node), for approximate masking and LOD.
     pub mip_bytes: usize,
+    /// The lobe blocks: per lobe the mean, the Cholesky factor and its scaled inverse in `f32`
+    /// (32 bytes per lobe, in tiles of 4 × 4 lobes; edge tiles padded), what `d`, the exact masking
+    /// and the samplers read.
+    pub block_bytes: usize,
+}
+
+impl MixtureMemory {
+    /// Total bytes (lobes, hierarchy, mip chain and blocks).
+    pub fn total(&self) -> usize {
+        self.lobe_bytes + self.hierarchy_bytes + self.mip_bytes + self.block_bytes
+    }
 }
 
 /// The Beckmann-mixture glint representation of a normal map (\[Chermain2019\]).
@@ -270,8 +285,11 @@ pub struct MixtureMemory {
 /// the moments of the interpolated map's slopes under k_i (eq. 5-6), built with
 /// [`SlopeGaussian::from_moments`] (σ floored at σ_ε, covariance kept positive definite).
 ///
-/// Stored per lobe: the 5 moments as `f32` (20 bytes); plus the quadtree of slope boxes (~5.3 bytes
-/// per lobe) and the moment mip chain (~6.7 bytes per lobe), see [`BeckmannMixture::memory`].
+/// Stored per lobe: the 5 moments as `f32` (20 bytes, what files hold); the lobe blocks derived from
+/// them (32 bytes: mean, Cholesky factor and its scaled inverse in `f32`, structure-of-arrays tiles of
+/// 4 × 4 lobes that `d`, the exact masking and the samplers evaluate 16 lanes at a time); the quadtree
+/// of slope boxes (~5.3 bytes per lobe) and the moment mip chain (~6.7 bytes per lobe), see
+/// [`BeckmannMixture::memory`] and docs/mixture.md ("Lobe blocks").
 ///
 /// # Reference
 /// \[Chermain2019\] §3 (eq. 1-6), §4 (eq. 7-17), §5 (hierarchy).
@@ -283,6 +301,8 @@ pub struct BeckmannMixture {
     /// Texels per lobe along x and y.
     spacing: [f64; 2],
     lobes: Vec<[f32; 5]>,
+    /// The lobes as structure-of-arrays blocks of 4 × 4 (derived from `lobes`).
+    blocks: LobeBlocks,
     tree: SlopeTree,
     pyramid: LobePyramid,
     params: MixtureParams,
@@ -387,11 +407,14 @@ impl BeckmannMixture {
         use rayon::prelude::*;
         let [nx, ny] = grid;
         let box_k = (-2.0 * (params.slope_tail as f64).ln()).sqrt() as f32;
-        let leaf: Vec<[f32; 4]> = lobes
+        let gaussians: Vec<SlopeGaussian> = lobes
             .par_iter()
-            .map(|m| lobe_box(&SlopeGaussian::from_moments(*m, params.sigma_min), box_k))
+            .map(|m| SlopeGaussian::from_moments(*m, params.sigma_min))
             .collect();
+        let leaf: Vec<[f32; 4]> = gaussians.par_iter().map(|g| lobe_box(g, box_k)).collect();
         let tree = SlopeTree::build(nx, ny, &leaf);
+        let pad = SlopeGaussian::from_moments([0.0; 5], params.sigma_min);
+        let blocks = LobeBlocks::build(nx, ny, &gaussians, &pad);
         let pyramid = LobePyramid::build(nx, ny, &lobes);
         BeckmannMixture {
             width,
@@ -399,6 +422,7 @@ impl BeckmannMixture {
             grid,
             spacing,
             lobes,
+            blocks,
             tree,
             pyramid,
             params,
@@ -459,6 +483,7 @@ impl BeckmannMixture {
             lobe_bytes: self.lobes.len() * 20,
             hierarchy_bytes: self.tree.bytes(),
             mip_bytes: self.pyramid.bytes(),
+            block_bytes: self.blocks.bytes(),
         }
     }
 

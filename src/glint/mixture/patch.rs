@@ -8,6 +8,7 @@
 //! folded onto the lobe grid (a lobe's slot then carries the sum of its periodic images' weights),
 //! so a patch never holds more slots than the map has lobes.
 
+use super::blocks::{self, LANES, SIDE};
 use super::hierarchy::lobe_box;
 use super::{BeckmannMixture, MaskingMode, PatchOptions, build::kernel_sigma};
 use crate::frame::normal_to_slope;
@@ -119,6 +120,33 @@ pub(crate) struct SlotBuffers {
     weights: Vec<f32>,
     /// Cumulative weights (f64), last = Σ of `weights` in f64.
     cdf: Vec<f64>,
+    /// The weights again in the lobe blocks' layout: per [`BlockRect`], its blocks row major, 16
+    /// lanes each (0 for lanes outside the rectangle or the grid).
+    block_weights: Vec<f32>,
+}
+
+/// One (x segment × y segment) rectangle of a patch's lobes, with its blocks.
+#[derive(Clone, Copy, Debug, Default)]
+struct BlockRect {
+    /// Lobe ranges [lo, hi) along x and y.
+    x: (usize, usize),
+    y: (usize, usize),
+    /// First block and the block counts along x and y.
+    bx0: usize,
+    by0: usize,
+    bw: usize,
+    bh: usize,
+    /// Offset of the rectangle's first block in `block_weights`, in lanes.
+    offset: usize,
+}
+
+impl BlockRect {
+    /// The lane weights of block (bx, by) (absolute block coordinates, inside the rectangle).
+    #[inline]
+    fn weights<'w>(&self, bw: &'w [f32], bx: usize, by: usize) -> &'w [f32; LANES] {
+        let o = self.offset + ((by - self.by0) * self.bw + (bx - self.bx0)) * LANES;
+        bw[o..o + LANES].try_into().expect("16 lanes")
+    }
 }
 
 /// The mixture's share of [`GlintScratch`]: the buffers a patch borrows.
@@ -132,8 +160,11 @@ pub(crate) struct MixtureScratch {
 #[derive(Clone, Debug)]
 struct Gathered<'a> {
     axes: [AxisSlots; 2],
-    /// Weights and their cdf, per slot.
+    /// Weights and their cdf, per slot, and the weights per block.
     bufs: Lent<'a, SlotBuffers>,
+    /// The lobe rectangles (one per x segment × y segment) and how many there are.
+    rects: [BlockRect; 4],
+    n_rects: usize,
     /// Σ W_i μ_i: the patch mean slope.
     mean_slope: Vec2,
     /// The patch's slope covariance Σ_P = Σ W_i (Σ_i + μ_i μ_iᵀ) − μ_P μ_Pᵀ, [xx, xy, yy] (f64), with
@@ -169,8 +200,9 @@ fn clamped_covariance(vx: f64, vy: f64, c: f64, s2: f64) -> f64 {
 
 /// The P-NDF of one footprint of a [`BeckmannMixture`]: an [`Ndf`] with D_P(h) = Σ W_i D_i(h).
 ///
-/// - `d`: \[Chermain2019\] eq. 9 through the slope-box quadtree; lobes whose slope box (1 −
-///   `slope_tail` of their mass) does not contain h's slope are skipped.
+/// - `d`: \[Chermain2019\] eq. 9 through the slope-box quadtree down to the lobe blocks (4 × 4
+///   lobes), then 16 lanes at a time; lobes whose slope box (1 − `slope_tail` of their mass) does
+///   not contain h's slope contribute 0 (a masked lane).
 /// - Masking, [`MaskingMode::Exact`]: V_P(w) = Σ W_i V_i(w) (V_i = ∫⟨w,m⟩⁺D_i, always ≥ 0), and the
 ///   **signed** patch projected area A_P(w) = Σ W_i (cos θ − w_xy·μ_i) = cos θ − w_xy·μ_P (μ_P the
 ///   patch mean slope), clamped at 0; Λ_P = V_P/A_P − 1, G1 = A_P/V_P (eq. 10-17, see
@@ -382,7 +414,7 @@ impl<'a> MixturePatch<'a> {
         ];
         let (lx, ly) = (axes[0].len, axes[1].len);
         // Raw weights are summed into the cdf buffer, then normalised and accumulated in place.
-        let SlotBuffers { weights, cdf } = &mut *bufs;
+        let SlotBuffers { weights, cdf, .. } = &mut *bufs;
         weights.clear();
         cdf.clear();
         cdf.resize(lx * ly, 0.0);
@@ -423,6 +455,7 @@ impl<'a> MixturePatch<'a> {
             m2[2] += wn * (cov[2] + mu[1] * mu[1]);
             wn as f32
         }));
+        let (rects, n_rects) = Self::block_weights(&axes, &mut bufs);
         // Σ W = 1 up to rounding; the covariance is floored at 0 against cancellation.
         let slope_cov = [
             (m2[0] - m1[0] * m1[0]).max(0.0),
@@ -432,9 +465,60 @@ impl<'a> MixturePatch<'a> {
         Gathered {
             axes,
             bufs,
+            rects,
+            n_rects,
             mean_slope: Vec2::new(m1[0] as f32, m1[1] as f32),
             slope_cov,
         }
+    }
+
+    /// Lays the slot weights out per lobe block: one [`BlockRect`] per (x segment × y segment) of
+    /// the slots (at most 4, disjoint in lobe space), each covering the blocks its lobes touch.
+    fn block_weights(axes: &[AxisSlots; 2], bufs: &mut SlotBuffers) -> ([BlockRect; 4], usize) {
+        let (xs, nxs) = axes[0].segments();
+        let (ys, nys) = axes[1].segments();
+        let mut rects = [BlockRect::default(); 4];
+        let mut offs = [(0i64, 0i64); 4];
+        let mut n = 0;
+        let mut total = 0;
+        for &(x_lo, x_hi, x_off) in &xs[..nxs] {
+            for &(y_lo, y_hi, y_off) in &ys[..nys] {
+                let (bx0, by0) = (x_lo / SIDE, y_lo / SIDE);
+                let (bw, bh) = (x_hi.div_ceil(SIDE) - bx0, y_hi.div_ceil(SIDE) - by0);
+                rects[n] = BlockRect {
+                    x: (x_lo, x_hi),
+                    y: (y_lo, y_hi),
+                    bx0,
+                    by0,
+                    bw,
+                    bh,
+                    offset: total,
+                };
+                offs[n] = (x_off, y_off);
+                total += bw * bh * LANES;
+                n += 1;
+            }
+        }
+        let SlotBuffers {
+            weights,
+            block_weights,
+            ..
+        } = bufs;
+        block_weights.clear();
+        block_weights.resize(total, 0.0);
+        let lx = axes[0].len;
+        for (r, &(x_off, y_off)) in rects[..n].iter().zip(&offs[..n]) {
+            for y in r.y.0..r.y.1 {
+                let sy = (y as i64 + y_off) as usize;
+                let row = r.offset + (y / SIDE - r.by0) * r.bw * LANES + (y % SIDE) * SIDE;
+                for x in r.x.0..r.x.1 {
+                    let sx = (x as i64 + x_off) as usize;
+                    let o = row + (x / SIDE - r.bx0) * LANES + x % SIDE;
+                    block_weights[o] = weights[sy * lx + sx];
+                }
+            }
+        }
+        (rects, n)
     }
 
     /// The masking mode.
@@ -480,11 +564,24 @@ impl<'a> MixturePatch<'a> {
         self.mixture.lobe_at(k)
     }
 
-    /// D_P(m) and the number of lobes whose D_i was evaluated (the hierarchy's leaves reached).
+    /// D_P(m) and the number of lobes whose D_i was evaluated: 16 per lobe block whose box (and
+    /// whose ancestors' boxes) contain m's slope.
     ///
     /// # Reference
     /// \[Chermain2019\] eq. 9, §5.
     pub fn d_with_stats(&self, m: Vec3) -> (f32, usize) {
+        self.d_by(m, Self::sum_p22)
+    }
+
+    /// D_P(m) by the former scalar path (one lobe at a time, each rebuilt from its moments in `f64`):
+    /// kept as the reference of the benches and tests. Equal to [`Ndf::d`] to ~1e-6 relative.
+    #[doc(hidden)]
+    pub fn d_scalar(&self, m: Vec3) -> f32 {
+        self.d_by(m, Self::sum_p22_scalar).0
+    }
+
+    #[inline]
+    fn d_by(&self, m: Vec3, sum: impl Fn(&Self, &Gathered, Vec2) -> (f64, usize)) -> (f32, usize) {
         let Some(g) = &self.gathered else {
             return (self.filtered.d(m), 0);
         };
@@ -494,15 +591,37 @@ impl<'a> MixturePatch<'a> {
         if !s.is_finite() {
             return (0.0, 0);
         }
-        let (p22, touched) = self.sum_p22(g, s);
+        let (p22, touched) = sum(self, g, s);
         let c = 1.0 + s.length_squared() as f64;
         let d = (p22 * c * c) as f32;
         (if d.is_finite() { d } else { f32::MAX }, touched)
     }
 
-    /// Σ W_i P22_i(s) over the lobes whose slope box contains s, by a depth-first walk of the
-    /// quadtree restricted to each (x segment × y segment) of the footprint's slots.
+    /// Σ W_i P22_i(s) over the lobes whose slope box contains s: a depth-first walk of the quadtree
+    /// down to the lobe blocks (level 2) restricted to each lobe rectangle of the footprint, then
+    /// the 16 lanes of each block reached at once ([`blocks::p22_lanes`]).
     fn sum_p22(&self, g: &Gathered, s: Vec2) -> (f64, usize) {
+        let mix = self.mixture;
+        let k2 = mix.box_k * mix.box_k;
+        let bw = &g.bufs.block_weights;
+        let mut acc = [0.0f64; LANES];
+        let mut blocks_seen = 0usize;
+        for r in &g.rects[..g.n_rects] {
+            blocks::for_each_block(&mix.tree, r.x, r.y, s, |bx, by| {
+                blocks_seen += 1;
+                let w = r.weights(bw, bx, by);
+                blocks::p22_lanes::<true>(mix.blocks.block(bx, by), w, s, k2, &mut acc);
+            });
+        }
+        (
+            acc.iter().sum::<f64>() * blocks::p22_scale(),
+            blocks_seen * LANES,
+        )
+    }
+
+    /// The scalar walk (former path): Σ W_i P22_i(s) over the lobes whose slope box contains s, by
+    /// a depth-first walk of the quadtree to its leaves, each lobe rebuilt from its moments.
+    fn sum_p22_scalar(&self, g: &Gathered, s: Vec2) -> (f64, usize) {
         let mix = self.mixture;
         let tree = &mix.tree;
         let [nx, _] = mix.grid;
@@ -547,8 +666,100 @@ impl<'a> MixturePatch<'a> {
         })
     }
 
-    /// Exact V_P(w) = Σ W_i V_i(w) in `f64` (0 for invalid w).
+    /// Calls `f(block, lane weights, bx, by)` for every lobe block of the patch.
+    #[inline]
+    fn for_each_patch_block(
+        &self,
+        g: &Gathered,
+        mut f: impl FnMut(&blocks::LobeBlock, &[f32; LANES], usize, usize),
+    ) {
+        let bw = &g.bufs.block_weights;
+        for r in &g.rects[..g.n_rects] {
+            for by in r.by0..r.by0 + r.bh {
+                for bx in r.bx0..r.bx0 + r.bw {
+                    f(
+                        self.mixture.blocks.block(bx, by),
+                        r.weights(bw, bx, by),
+                        bx,
+                        by,
+                    );
+                }
+            }
+        }
+    }
+
+    /// Exact V_P(w) = Σ W_i V_i(w) (0 for invalid w): the scalar sum, one lobe at a time. The lane
+    /// kernel ([`MixturePatch::visible_area_blocks`]) was measured slower than this (0.5-1.5×,
+    /// docs/results.md "Lobe blocks"), so the exact masking and the visible sampler keep it.
     fn exact_visible_area(&self, g: &Gathered, w: Vec3) -> f64 {
+        self.exact_visible_area_scalar(g, w)
+    }
+
+    /// V_P(w) by the lobe blocks ([`blocks::visible_lanes`]: `f32` lanes, the sum in `f64`), the
+    /// filtered lobe's under the level of detail. Not used by the patch yet (slower than the scalar
+    /// sum, docs/results.md); kept for the benches and the property test.
+    #[doc(hidden)]
+    pub fn visible_area_blocks(&self, w: Vec3) -> f32 {
+        match &self.gathered {
+            Some(g) => finite_or_zero(self.exact_visible_area_blocks(g, w)),
+            None => self.filtered.visible_area(w),
+        }
+    }
+
+    /// Λ_P(w) with [`MixturePatch::visible_area_blocks`] (the benches' lane-kernel column).
+    #[doc(hidden)]
+    pub fn lambda_blocks(&self, w: Vec3) -> f32 {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let a = self.projected_area(w);
+        if a.is_nan() || a <= 0.0 {
+            return f32::MAX;
+        }
+        ((self.visible_area_blocks(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
+    }
+
+    fn exact_visible_area_blocks(&self, g: &Gathered, w: Vec3) -> f64 {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let mut acc = [0.0f64; LANES];
+        let mut v = [0.0f32; LANES];
+        self.for_each_patch_block(g, |b, wts, _, _| {
+            blocks::visible_lanes(b, wts, w, &mut v);
+            for i in 0..LANES {
+                acc[i] += v[i] as f64;
+            }
+        });
+        acc.iter().sum()
+    }
+
+    /// V_P(w) by the former scalar path (one [`SlopeGaussian`] per slot, `f64`): the reference of
+    /// the benches and tests.
+    #[doc(hidden)]
+    pub fn visible_area_scalar(&self, w: Vec3) -> f32 {
+        match &self.gathered {
+            Some(g) => finite_or_zero(self.exact_visible_area_scalar(g, w)),
+            None => self.filtered.visible_area(w),
+        }
+    }
+
+    /// Λ_P(w) with the former scalar V_P ([`MixturePatch::visible_area_scalar`]) in exact masking:
+    /// the reference of the benches.
+    #[doc(hidden)]
+    pub fn lambda_scalar(&self, w: Vec3) -> f32 {
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let a = self.projected_area(w);
+        if a.is_nan() || a <= 0.0 {
+            return f32::MAX;
+        }
+        ((self.visible_area_scalar(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
+    }
+
+    /// Exact V_P(w) = Σ W_i V_i(w) in `f64`, one lobe at a time (0 for invalid w).
+    fn exact_visible_area_scalar(&self, g: &Gathered, w: Vec3) -> f64 {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
         }
@@ -664,38 +875,11 @@ impl Ndf for MixturePatch<'_> {
     }
 
     /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
-    /// visible normal. Two passes over the lobes (total, then the pick), no allocation. Invalid wo:
-    /// [`Ndf::sample_normal`].
+    /// visible normal. Two passes over the lobes (total, then the pick), no allocation; the scalar
+    /// V_i (see [`MixturePatch::sample_visible_blocks`] for the lane version, measured slower).
+    /// Invalid wo: [`Ndf::sample_normal`].
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
-        let Some(g) = &self.gathered else {
-            return self.filtered.sample_visible(wo, u);
-        };
-        let total = self.exact_visible_area(g, wo);
-        if !(total > 0.0 && total.is_finite()) {
-            return self.sample_normal(u);
-        }
-        let ux = if u.x.is_nan() {
-            0.5
-        } else {
-            u.x.clamp(0.0, 1.0)
-        } as f64;
-        let target = ux * total;
-        let mut acc = 0.0;
-        let mut chosen = (0, 0.5f32);
-        let lobes = self.slot_lobes(g);
-        for (s, lobe) in lobes.iter().enumerate() {
-            let v = g.bufs.weights[s] as f64 * lobe.visible_area(wo) as f64;
-            if v > 0.0 {
-                chosen = (s, ((target - acc) / v) as f32);
-                if acc + v > target {
-                    break;
-                }
-            }
-            acc += v;
-        }
-        let (s, r) = chosen;
-        let r = r.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-        lobes[s].sample_visible(wo, Vec2::new(r, u.y))
+        self.sample_visible_scalar(wo, u)
     }
 
     /// Σ W_i D_i(m) cos θ_m over **every** gathered lobe (no slope-box truncation): exactly the
@@ -733,14 +917,123 @@ impl Ndf for MixturePatch<'_> {
 }
 
 impl MixturePatch<'_> {
-    /// Σ W_i D_i(m) over every gathered lobe, in `f64`.
+    /// Σ W_i D_i(m) over every gathered lobe (no slope box), lanes in `f32`, the sum in `f64`.
     fn untruncated_d(&self, g: &Gathered, m: Vec3) -> f64 {
-        g.bufs
-            .weights
-            .iter()
-            .zip(self.slot_lobes(g))
-            .map(|(&w, lobe)| w as f64 * lobe.d(m) as f64)
-            .sum()
+        let Some(s) = normal_to_slope(m) else {
+            return 0.0;
+        };
+        if !s.is_finite() {
+            return 0.0;
+        }
+        let mut acc = [0.0f64; LANES];
+        self.for_each_patch_block(g, |b, wts, _, _| {
+            blocks::p22_lanes::<false>(b, wts, s, 0.0, &mut acc);
+        });
+        let c = 1.0 + s.length_squared() as f64;
+        acc.iter().sum::<f64>() * blocks::p22_scale() * c * c
+    }
+
+    /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
+    /// visible normal. Two passes over the lobe blocks (the total, then the pick: block by block,
+    /// then lane by lane in the block that holds the target), no allocation. Invalid wo:
+    /// [`Ndf::sample_normal`]. Not used by the patch (slower than the scalar sampler, docs/results.md).
+    #[doc(hidden)]
+    pub fn sample_visible_blocks(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        let Some(g) = &self.gathered else {
+            return self.filtered.sample_visible(wo, u);
+        };
+        let total = self.exact_visible_area_blocks(g, wo);
+        if !(total > 0.0 && total.is_finite()) {
+            return self.sample_normal(u);
+        }
+        let ux = if u.x.is_nan() {
+            0.5
+        } else {
+            u.x.clamp(0.0, 1.0)
+        } as f64;
+        let target = ux * total;
+        let nx = self.mixture.grid[0];
+        let lobe = |bx: usize, by: usize, lane: usize| {
+            (by * SIDE + lane / SIDE) * nx + bx * SIDE + lane % SIDE
+        };
+        let mut acc = 0.0f64;
+        // (lobe index, rescaled u.x); the last lobe with V > 0 if rounding leaves the target unmet.
+        let mut chosen = (usize::MAX, 0.5f32);
+        let mut done = false;
+        let mut v = [0.0f32; LANES];
+        self.for_each_patch_block(g, |b, wts, bx, by| {
+            if done {
+                return;
+            }
+            blocks::visible_lanes(b, wts, wo, &mut v);
+            let sum: f64 = v.iter().map(|&x| x as f64).sum();
+            if sum.is_nan() || sum <= 0.0 {
+                return;
+            }
+            if acc + sum <= target {
+                if let Some(last) = (0..LANES).rev().find(|&i| v[i] > 0.0) {
+                    chosen = (lobe(bx, by, last), 1.0);
+                }
+                acc += sum;
+                return;
+            }
+            for (lane, &vi) in v.iter().enumerate() {
+                let vi = vi as f64;
+                if vi > 0.0 {
+                    chosen = (lobe(bx, by, lane), ((target - acc) / vi) as f32);
+                    if acc + vi > target {
+                        done = true;
+                        return;
+                    }
+                }
+                acc += vi;
+            }
+        });
+        let (k, r) = chosen;
+        if k == usize::MAX {
+            return self.sample_normal(u);
+        }
+        let r = r.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        self.mixture
+            .lobe_at(k)
+            .sample_visible(wo, Vec2::new(r, u.y))
+    }
+
+    /// The scalar visible sampler (the patch's `sample_visible`):
+    /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
+    /// visible normal. Two passes over the lobes (total, then the pick), no allocation. Invalid wo:
+    /// [`Ndf::sample_normal`].
+    #[doc(hidden)]
+    pub fn sample_visible_scalar(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        let Some(g) = &self.gathered else {
+            return self.filtered.sample_visible(wo, u);
+        };
+        let total = self.exact_visible_area_scalar(g, wo);
+        if !(total > 0.0 && total.is_finite()) {
+            return self.sample_normal(u);
+        }
+        let ux = if u.x.is_nan() {
+            0.5
+        } else {
+            u.x.clamp(0.0, 1.0)
+        } as f64;
+        let target = ux * total;
+        let mut acc = 0.0;
+        let mut chosen = (0, 0.5f32);
+        let lobes = self.slot_lobes(g);
+        for (s, lobe) in lobes.iter().enumerate() {
+            let v = g.bufs.weights[s] as f64 * lobe.visible_area(wo) as f64;
+            if v > 0.0 {
+                chosen = (s, ((target - acc) / v) as f32);
+                if acc + v > target {
+                    break;
+                }
+            }
+            acc += v;
+        }
+        let (s, r) = chosen;
+        let r = r.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        lobes[s].sample_visible(wo, Vec2::new(r, u.y))
     }
 }
 
