@@ -26,7 +26,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Default nodes per texel per axis of the filter build (even) for seed spacings h ≥ 1: 4. Finer
-/// spacings use proportionally more, see [`nodes_per_texel`].
+/// spacings use proportionally more, see `nodes_per_texel` in the build code.
 pub const DEFAULT_SUPERSAMPLING: u32 = 4;
 
 /// Nodes per texel along an axis of lobe spacing `h` texels: the multiple of 4 ≥ `supersampling` / min(1, h),
