@@ -32,7 +32,7 @@
 //! # Reference
 //! \[Chermain2019\] eq. 2 (the lobe), eq. 8 (P-NDF), §5.2.2 (σ_ε = 0.01).
 
-use super::{BinnedPndf, Kernel, REFERENCE_BATCHES, cholesky, summarise};
+use super::{BinnedPndf, Kernel, REFERENCE_BATCHES, kernel_position, summarise};
 use crate::error::{Error, Result};
 use crate::glint::{Footprint, HemisphereBins, NormalMap};
 use crate::ndf::Ndf;
@@ -95,7 +95,7 @@ pub fn convolved_pndf(
     }
     let batches = REFERENCE_BATCHES;
     let m = ((samples / batches) as f64).sqrt().floor().max(1.0) as usize;
-    let position = positions(map, footprint, kernel);
+    let position = kernel_position(map, footprint, kernel);
     let jitters = if sigma_eps > 0.0 { JITTERS } else { 1 };
     let nb = bins.len();
     let rows_per_task = MIN_ROWS_PER_TASK.max(m.div_ceil(MAX_TASKS_PER_BATCH));
@@ -166,45 +166,6 @@ fn box_muller(s: f64, t: f64) -> (f64, f64) {
     let r = (-2.0 * (-s).ln_1p()).sqrt();
     let (sn, cs) = (std::f64::consts::TAU * t).sin_cos();
     (r * cs, r * sn)
-}
-
-/// The texel position of the stratum point (s, t) ∈ [0, 1)², wrapped into the map: the same map from
-/// the unit square to the footprint as `binned_pndf` (parallelogram: affine; Gaussian: Cholesky factor
-/// of Σ times Box–Muller).
-fn positions(
-    map: &NormalMap,
-    footprint: &Footprint,
-    kernel: Kernel,
-) -> Box<dyn Fn(f64, f64) -> Vec2 + Sync> {
-    let (w, h) = (map.width(), map.height());
-    let (wf, hf) = (w as f64, h as f64);
-    match kernel {
-        Kernel::Parallelogram => {
-            let (c, a, b) = footprint.parallelogram_texels(w, h);
-            let (c, a, b) = (
-                c.to_array().map(f64::from),
-                a.to_array().map(f64::from),
-                b.to_array().map(f64::from),
-            );
-            Box::new(move |s, t| {
-                let (s, t) = (s - 0.5, t - 0.5);
-                let x = c[0] + s * a[0] + t * b[0];
-                let y = c[1] + s * a[1] + t * b[1];
-                Vec2::new(x.rem_euclid(wf) as f32, y.rem_euclid(hf) as f32)
-            })
-        }
-        Kernel::Gaussian => {
-            let (c, cov) = footprint.gaussian_texels(w, h);
-            let c = c.to_array().map(f64::from);
-            let l = cholesky(cov);
-            Box::new(move |s, t| {
-                let (z1, z2) = box_muller(s, t);
-                let x = c[0] + l[0] * z1;
-                let y = c[1] + l[1] * z1 + l[2] * z2;
-                Vec2::new(x.rem_euclid(wf) as f32, y.rem_euclid(hf) as f32)
-            })
-        }
-    }
 }
 
 /// A model's bin masses M(b) = ∫_b D cos θ dω with a k × k midpoint grid on each bin's square cell
