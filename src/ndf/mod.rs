@@ -124,14 +124,24 @@ pub trait Ndf {
 /// eq. 15). 0 for a below-horizon or non-finite `w`; `f32::MAX` where A(w) ≤ 0 < w_z (a patch leaning
 /// away from `w`: nothing of it is seen).
 pub(crate) fn lambda_from_areas<N: Ndf + ?Sized>(ndf: &N, w: Vec3) -> f32 {
+    lambda_of(w, |w| ndf.projected_area(w), |w| ndf.visible_area(w))
+}
+
+/// [`lambda_from_areas`] with the two areas given as functions (for a patch that has several ways
+/// of computing V, e.g. the mixture's scalar and block sums).
+pub(crate) fn lambda_of(
+    w: Vec3,
+    projected_area: impl FnOnce(Vec3) -> f32,
+    visible_area: impl FnOnce(Vec3) -> f32,
+) -> f32 {
     if !(w.z > 0.0 && w.is_finite()) {
         return 0.0;
     }
-    let a = ndf.projected_area(w);
+    let a = projected_area(w);
     if a.is_nan() || a <= 0.0 {
         return f32::MAX;
     }
-    ((ndf.visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
+    ((visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
 }
 
 /// A reference to an NDF is an NDF (so a BRDF can borrow a patch or a shared lobe).

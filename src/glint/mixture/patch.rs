@@ -709,14 +709,11 @@ impl<'a> MixturePatch<'a> {
     /// Λ_P(w) with [`MixturePatch::visible_area_blocks`] (the benches' lane-kernel column).
     #[doc(hidden)]
     pub fn lambda_blocks(&self, w: Vec3) -> f32 {
-        if !(w.z > 0.0 && w.is_finite()) {
-            return 0.0;
-        }
-        let a = self.projected_area(w);
-        if a.is_nan() || a <= 0.0 {
-            return f32::MAX;
-        }
-        ((self.visible_area_blocks(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
+        crate::ndf::lambda_of(
+            w,
+            |w| self.projected_area(w),
+            |w| self.visible_area_blocks(w),
+        )
     }
 
     fn exact_visible_area_blocks(&self, g: &Gathered, w: Vec3) -> f64 {
@@ -748,14 +745,11 @@ impl<'a> MixturePatch<'a> {
     /// the reference of the benches.
     #[doc(hidden)]
     pub fn lambda_scalar(&self, w: Vec3) -> f32 {
-        if !(w.z > 0.0 && w.is_finite()) {
-            return 0.0;
-        }
-        let a = self.projected_area(w);
-        if a.is_nan() || a <= 0.0 {
-            return f32::MAX;
-        }
-        ((self.visible_area_scalar(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
+        crate::ndf::lambda_of(
+            w,
+            |w| self.projected_area(w),
+            |w| self.visible_area_scalar(w),
+        )
     }
 
     /// Exact V_P(w) = Σ W_i V_i(w) in `f64`, one lobe at a time (0 for invalid w).
