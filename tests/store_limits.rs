@@ -31,32 +31,10 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static A: Counting = Counting;
 
-/// The documented checksum (docs/format.md, format version 2), as in tests/store.rs.
-fn reseal(mut file: Vec<u8>) -> Vec<u8> {
-    let n = file.len() - 8;
-    let mix = |h: u64, w: u64| (h ^ w).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(29);
-    let mut lanes = [0u64; 4];
-    for (j, lane) in lanes.iter_mut().enumerate() {
-        *lane = 0xCBF2_9CE4_8422_2325u64 + j as u64;
-    }
-    for (k, chunk) in file[..n].chunks(8).enumerate() {
-        let mut w = [0u8; 8];
-        w[..chunk.len()].copy_from_slice(chunk);
-        lanes[k % 4] = mix(lanes[k % 4], u64::from_le_bytes(w));
-    }
-    let mut h = lanes[0];
-    for lane in &lanes[1..] {
-        h = mix(h, *lane);
-    }
-    h ^= n as u64;
-    h ^= h >> 30;
-    h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    h ^= h >> 27;
-    h = h.wrapping_mul(0x94D0_49BB_1331_11EB);
-    h ^= h >> 31;
-    file[n..].copy_from_slice(&h.to_le_bytes());
-    file
-}
+/// The documented checksum (docs/format.md), shared with tests/store.rs.
+#[path = "support/format.rs"]
+mod format;
+use format::reseal;
 
 /// Peak heap growth (bytes) while running `f`.
 fn peak_during<T>(f: impl FnOnce() -> T) -> (T, usize) {

@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod chi2;
+pub mod format;
 pub mod quadrature;
 pub mod totality;
 
