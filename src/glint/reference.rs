@@ -253,18 +253,24 @@ pub fn binned_pndf(
                 hist
             })
             .collect();
-        let mut counts = vec![0u64; nb];
-        let mut inv = vec![0.0f64; nb];
-        for hist in &hists {
-            for (k, (c, s)) in hist.iter().enumerate() {
-                counts[k] += c;
-                inv[k] += s;
-            }
-        }
+        let (counts, inv) = merge_histograms(&hists, nb);
         batch_counts.push(counts);
         batch_inv.push(inv);
     }
     summarise(bins, &batch_counts, &batch_inv, m * m)
+}
+
+/// The sum of per-thread histograms of one batch: (sample count, Σ 1/cos θ) per bin, as two arrays.
+fn merge_histograms(hists: &[Vec<(u64, f64)>], nb: usize) -> (Vec<u64>, Vec<f64>) {
+    let mut counts = vec![0u64; nb];
+    let mut inv = vec![0.0f64; nb];
+    for hist in hists {
+        for (k, (c, s)) in hist.iter().enumerate() {
+            counts[k] += c;
+            inv[k] += s;
+        }
+    }
+    (counts, inv)
 }
 
 /// Estimates and batch standard errors from per-batch histograms of `per_batch` samples each.

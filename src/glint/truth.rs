@@ -32,7 +32,7 @@
 //! # Reference
 //! \[Chermain2019\] eq. 2 (the lobe), eq. 8 (P-NDF), §5.2.2 (σ_ε = 0.01).
 
-use super::{BinnedPndf, Kernel, REFERENCE_BATCHES, kernel_position, summarise};
+use super::{BinnedPndf, Kernel, REFERENCE_BATCHES, kernel_position, merge_histograms, summarise};
 use crate::error::{Error, Result};
 use crate::glint::{Footprint, HemisphereBins, NormalMap};
 use crate::ndf::Ndf;
@@ -147,14 +147,7 @@ pub fn convolved_pndf(
                 hist
             })
             .collect();
-        let mut counts = vec![0u64; nb];
-        let mut inv = vec![0.0f64; nb];
-        for hist in &hists {
-            for (k, (c, s)) in hist.iter().enumerate() {
-                counts[k] += c;
-                inv[k] += s;
-            }
-        }
+        let (counts, inv) = merge_histograms(&hists, nb);
         batch_counts.push(counts);
         batch_inv.push(inv);
     }
