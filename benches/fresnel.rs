@@ -79,15 +79,15 @@ fn table_mode() {
     println!("# inputs hash {:016x}", table::hash(&inp));
     let mut of = vec![0.0f32; table::N];
     let mut ov = vec![Vec3::ZERO; table::N];
-    table::time_it("fresnel/dielectric", 1.5, || {
-        for (o, &c) in of.iter_mut().zip(&inp.cos_signed) {
+    table::time_it("fresnel/dielectric", 1.5, |r| {
+        for (o, &c) in of.iter_mut().zip(&inp.cos_signed[r]) {
             *o = dielectric(table::opaque(c), 1.5);
         }
         black_box(&mut of);
     });
     let gold = ConductorFresnel::GOLD;
-    table::time_it("fresnel/conductor", 0.0, || {
-        for (o, &c) in ov.iter_mut().zip(&inp.cos_unit) {
+    table::time_it("fresnel/conductor", 0.0, |r| {
+        for (o, &c) in ov.iter_mut().zip(&inp.cos_unit[r]) {
             *o = conductor(table::opaque(c), gold.eta, gold.k);
         }
         black_box(&mut ov);

@@ -136,26 +136,26 @@ fn table_rows<N: Ndf>(family: &str, alpha: f32, ndf: &N) {
     let (w, m, u) = (&inp.w, &inp.m, &inp.u);
     let mut of = vec![0.0f32; table::N];
     let mut ov = vec![Vec3::ZERO; table::N];
-    table::time_it(&format!("{family}/d"), alpha, || {
-        for (o, &m) in of.iter_mut().zip(m) {
+    table::time_it(&format!("{family}/d"), alpha, |r| {
+        for (o, &m) in of.iter_mut().zip(&m[r]) {
             *o = ndf.d(table::bb3(m));
         }
         black_box(&mut of);
     });
-    table::time_it(&format!("{family}/g1"), alpha, || {
-        for (o, (&w, &m)) in of.iter_mut().zip(w.iter().zip(m)) {
+    table::time_it(&format!("{family}/g1"), alpha, |r| {
+        for (o, (&w, &m)) in of.iter_mut().zip(w[r.clone()].iter().zip(&m[r])) {
             *o = ndf.g1(table::bb3(w), table::bb3(m));
         }
         black_box(&mut of);
     });
-    table::time_it(&format!("{family}/pdf_visible"), alpha, || {
-        for (o, (&w, &m)) in of.iter_mut().zip(w.iter().zip(m)) {
+    table::time_it(&format!("{family}/pdf_visible"), alpha, |r| {
+        for (o, (&w, &m)) in of.iter_mut().zip(w[r.clone()].iter().zip(&m[r])) {
             *o = ndf.pdf_visible(table::bb3(w), table::bb3(m));
         }
         black_box(&mut of);
     });
-    table::time_it(&format!("{family}/sample_visible"), alpha, || {
-        for (o, (&w, &u)) in ov.iter_mut().zip(w.iter().zip(u)) {
+    table::time_it(&format!("{family}/sample_visible"), alpha, |r| {
+        for (o, (&w, &u)) in ov.iter_mut().zip(w[r.clone()].iter().zip(&u[r])) {
             *o = ndf.sample_visible(table::bb3(w), table::bb2(u));
         }
         black_box(&mut ov);

@@ -66,6 +66,9 @@ struct SplitMix {
 };
 
 constexpr int N = 1024;
+// Blocks of N inputs in the pool; batch k uses block k mod g_pool (table_common.rs says why: a
+// repeated block lets the branch predictor learn every data-dependent branch). argv[3], default 16.
+int g_pool = 16;
 
 struct Inputs {
     std::vector<V3> w, m;
@@ -76,18 +79,19 @@ struct Inputs {
 Inputs make_inputs(float alpha) {
     Inputs in;
     SplitMix rng{1};
-    for (int i = 0; i < N; ++i) {
+    const int n = N * g_pool;
+    for (int i = 0; i < n; ++i) {
         float a = rng.f(), b = rng.f();
         float r = std::sqrt(a), phi = 6.28318548f * b;
         in.w.push_back({r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(1.0f - a, 1e-6f))});
     }
     for (V3 w : in.w) in.m.push_back(normalize({alpha * w.x, alpha * w.y, w.z}));
-    for (int i = 0; i < N; ++i) {
+    for (int i = 0; i < n; ++i) {
         float a = rng.f(), b = rng.f();
         in.u.push_back({a, b});
     }
-    for (int i = 0; i < N; ++i) in.cos_signed.push_back(2.0f * rng.f() - 1.0f);
-    for (int i = 0; i < N; ++i) in.cos_unit.push_back(rng.f());
+    for (int i = 0; i < n; ++i) in.cos_signed.push_back(2.0f * rng.f() - 1.0f);
+    for (int i = 0; i < n; ++i) in.cos_unit.push_back(rng.f());
     return in;
 }
 
@@ -98,7 +102,7 @@ uint64_t hash_inputs(const Inputs& in) {
         std::memcpy(&b, &v, 4);
         h = (h ^ b) * 1099511628211ull;
     };
-    for (int i = 0; i < N; ++i) {
+    for (size_t i = 0; i < in.w.size(); ++i) {
         mix(in.w[i].x), mix(in.w[i].y), mix(in.w[i].z);
         mix(in.m[i].x), mix(in.m[i].y), mix(in.m[i].z);
         mix(in.u[i].x), mix(in.u[i].y);
@@ -419,13 +423,14 @@ int g_rounds = 5, g_batches = 1000;
 
 template <class F>
 void time_it(const char* name, const char* variant, float alpha, F batch) {
-    for (int i = 0; i < 200; ++i) batch();  // warm-up
+    for (int i = 0; i < 200; ++i) batch((i % g_pool) * N);  // warm-up
     std::vector<double> ns;
     ns.reserve(g_rounds * g_batches);
     for (int r = 0; r < g_rounds; ++r)
         for (int b = 0; b < g_batches; ++b) {
+            const int off = ((r * g_batches + b) % g_pool) * N;
             auto t0 = std::chrono::steady_clock::now();
-            batch();
+            batch(off);
             auto t1 = std::chrono::steady_clock::now();
             ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / N);
         }
@@ -444,6 +449,7 @@ void sink(std::vector<T>& out) {
 int main(int argc, char** argv) {
     if (argc > 1) g_rounds = std::atoi(argv[1]);
     if (argc > 2) g_batches = std::atoi(argv[2]);
+    if (argc > 3 && std::atoi(argv[3]) > 0) g_pool = std::atoi(argv[3]);
     std::vector<float> of(N);
     std::vector<V3> ov(N);
     std::printf("# function               variant  alpha   min_ns  median_ns\n");
@@ -457,10 +463,10 @@ int main(int argc, char** argv) {
         const V3* m = in.m.data();
         const V2* u = in.u.data();
 #define ROW(NAME, VARIANT, OUT, EXPR)                                      \
-    time_it(NAME, VARIANT, alpha, [&] {                                     \
+    time_it(NAME, VARIANT, alpha, [&](int off) {                            \
         for (int i = 0; i < N; ++i) {                                       \
-            V3 wi = opaque3(w[i]), mi = opaque3(m[i]);                        \
-            V2 ui = opaque2(u[i]);                                           \
+            V3 wi = opaque3(w[off + i]), mi = opaque3(m[off + i]);            \
+            V2 ui = opaque2(u[off + i]);                                     \
             (void)wi, (void)mi, (void)ui;                                   \
             OUT[i] = EXPR;                                                  \
         }                                                                   \
@@ -486,17 +492,17 @@ int main(int argc, char** argv) {
         if (alpha == 1.0f) {
             const float* cs = in.cos_signed.data();
             const float* cu = in.cos_unit.data();
-            time_it("fresnel/dielectric", "pbrt4", 1.5f, [&] {
-                for (int i = 0; i < N; ++i) of[i] = pbrt_fr_dielectric(opaque(cs[i]), 1.5f);
+            time_it("fresnel/dielectric", "pbrt4", 1.5f, [&](int off) {
+                for (int i = 0; i < N; ++i) of[i] = pbrt_fr_dielectric(opaque(cs[off + i]), 1.5f);
                 sink(of);
             });
-            time_it("fresnel/dielectric", "mitsuba3", 1.5f, [&] {
-                for (int i = 0; i < N; ++i) of[i] = mitsuba_fresnel(opaque(cs[i]), 1.5f);
+            time_it("fresnel/dielectric", "mitsuba3", 1.5f, [&](int off) {
+                for (int i = 0; i < N; ++i) of[i] = mitsuba_fresnel(opaque(cs[off + i]), 1.5f);
                 sink(of);
             });
-            time_it("fresnel/conductor", "pbrt4", 0, [&] {
+            time_it("fresnel/conductor", "pbrt4", 0, [&](int off) {
                 for (int i = 0; i < N; ++i) {
-                    float c = opaque(cu[i]);
+                    float c = opaque(cu[off + i]);
                     V3 r;
                     r.x = pbrt_fr_complex(c, Cx{kGoldEta[0], kGoldK[0]});
                     r.y = pbrt_fr_complex(c, Cx{kGoldEta[1], kGoldK[1]});
@@ -505,9 +511,9 @@ int main(int argc, char** argv) {
                 }
                 sink(ov);
             });
-            time_it("fresnel/conductor", "mitsuba3", 0, [&] {
+            time_it("fresnel/conductor", "mitsuba3", 0, [&](int off) {
                 for (int i = 0; i < N; ++i) {
-                    float c = opaque(cu[i]);
+                    float c = opaque(cu[off + i]);
                     V3 r;
                     r.x = mitsuba_fresnel_conductor(c, kGoldEta[0], kGoldK[0]);
                     r.y = mitsuba_fresnel_conductor(c, kGoldEta[1], kGoldK[1]);
