@@ -4,6 +4,7 @@
 //! the surface. Every NDF is normalised so that ∫ D(m) (m·ω_g) dm = 1 over the hemisphere.
 
 mod beckmann;
+mod beckmann_guess;
 mod blinn_phong;
 mod ggx;
 mod masking;
