@@ -170,7 +170,8 @@ fn select(keep: bool, v: f32) -> f32 {
 /// Σ over the 16 lanes of `w[lane] · P22_lane(s)` into the lane accumulators `acc`, where P22 is
 /// taken without its 1/(2π) factor (`× NORM_OF_J` is applied by the caller via [`p22_scale`]).
 /// With `BOXED`, a lane contributes only if s lies in its slope box |s − μ| ≤ k (√Σxx, √Σyy)
-/// (`k2` = k²), as the scalar walk does.
+/// (`k2` = k²), as the scalar walk does, and a block with no such weighted lane returns before
+/// its exponentials (one branch per block, none per lane).
 ///
 /// # Reference
 /// \[Chermain2019\] eq. 4 (P22 of each lobe), §5 (the box).
@@ -182,6 +183,22 @@ pub(super) fn p22_lanes<const BOXED: bool>(
     k2: f32,
     acc: &mut [f64; LANES],
 ) {
+    if BOXED {
+        // The box test alone first (a few operations per lane, vectorised): a block that passed
+        // the tree's test but holds no weighted lobe whose own box contains s (common where a
+        // block's lobes point different ways, e.g. flakes) ends here, before the exponentials.
+        let mut any = 0u32;
+        for i in 0..LANES {
+            let dx = s.x - b.mx[i];
+            let dy = s.y - b.my[i];
+            let (l11, l21, l22) = (b.l11[i], b.l21[i], b.l22[i]);
+            let inside = (dx * dx <= k2 * (l11 * l11)) & (dy * dy <= k2 * (l21 * l21 + l22 * l22));
+            any |= (inside & (w[i] > 0.0)) as u32;
+        }
+        if any == 0 {
+            return;
+        }
+    }
     let mut p = [0.0f32; LANES];
     for i in 0..LANES {
         let dx = s.x - b.mx[i];
