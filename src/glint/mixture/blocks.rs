@@ -1,6 +1,6 @@
 //! Lobe blocks: the mixture's lobes stored as structure-of-arrays tiles of 4 × 4 lobes, with the
-//! coefficients every per-direction query needs precomputed in `f32`, and the branch-free lane
-//! kernels (D_P, the exact visible area V_P) that LLVM vectorises.
+//! coefficients every per-direction query needs precomputed in `f32`, and the lane kernels (D_P, the
+//! exact visible area V_P) that LLVM vectorises: no branch per lane, at most one per block.
 //!
 //! A block is the tile of lobes [4·bx, 4·bx + 4) × [4·by, 4·by + 4) of the lobe grid: exactly a
 //! level-2 node of the slope-box quadtree (src/glint/slope_tree.rs), so the tree's level-2 box is
@@ -11,7 +11,8 @@
 //! The kernels work on `[f32; 16]` arrays lane by lane with selects instead of branches, and sum
 //! into 16 `f64` lane accumulators (vertical adds only, so the reductions vectorise too; the lanes
 //! are added together once per query). The exponential is [`exp2_lanes`], a polynomial of stated
-//! error that vectorises (std's `exp` is a library call per lane).
+//! error that vectorises (std's `exp` is a library call per lane); V_P's ramp term G(−t) is
+//! [`ramp_neg_lanes`], one fitted exponent and one such exponential (no `erfc` call).
 
 use crate::glint::slope_tree::{SlopeTree, contains};
 use crate::ndf::SlopeGaussian;
@@ -170,8 +171,7 @@ fn select(keep: bool, v: f32) -> f32 {
 /// Σ over the 16 lanes of `w[lane] · P22_lane(s)` into the lane accumulators `acc`, where P22 is
 /// taken without its 1/(2π) factor (`× NORM_OF_J` is applied by the caller via [`p22_scale`]).
 /// With `BOXED`, a lane contributes only if s lies in its slope box |s − μ| ≤ k (√Σxx, √Σyy)
-/// (`k2` = k²), as the scalar walk does, and a block with no such weighted lane returns before
-/// its exponentials (one branch per block, none per lane).
+/// (`k2` = k²), as the scalar walk does.
 ///
 /// # Reference
 /// \[Chermain2019\] eq. 4 (P22 of each lobe), §5 (the box).
@@ -183,22 +183,6 @@ pub(super) fn p22_lanes<const BOXED: bool>(
     k2: f32,
     acc: &mut [f64; LANES],
 ) {
-    if BOXED {
-        // The box test alone first (a few operations per lane, vectorised): a block that passed
-        // the tree's test but holds no weighted lobe whose own box contains s (common where a
-        // block's lobes point different ways, e.g. flakes) ends here, before the exponentials.
-        let mut any = 0u32;
-        for i in 0..LANES {
-            let dx = s.x - b.mx[i];
-            let dy = s.y - b.my[i];
-            let (l11, l21, l22) = (b.l11[i], b.l21[i], b.l22[i]);
-            let inside = (dx * dx <= k2 * (l11 * l11)) & (dy * dy <= k2 * (l21 * l21 + l22 * l22));
-            any |= (inside & (w[i] > 0.0)) as u32;
-        }
-        if any == 0 {
-            return;
-        }
-    }
     let mut p = [0.0f32; LANES];
     for i in 0..LANES {
         let dx = s.x - b.mx[i];
@@ -292,7 +276,8 @@ pub(super) fn visible_lanes(b: &LobeBlock, w: &[f32; LANES], d: Vec3, acc: &mut 
 /// G(−t) = φ(t) h(t), h = 1 − t R(t) (R Mills' ratio), is formed as τ² e^{P(τ) − t²/2}/√(2π) with
 /// τ = 1/(1 + t/4) ∈ (0, 1] and P a degree-9 polynomial in τ − 0.6 fitted (weighted least squares in
 /// the Chebyshev basis, Lawson iterations toward minimax) to ln(h/τ²) over τ ∈ [0.2, 1] (t ∈ [0, 16];
-/// h from erfc below t = 3, from Laplace's continued fraction above). Fit error < 9.4·10⁻⁸ in the
+/// h from erfc below t = 3, from Laplace's continued fraction above; `tools/fit_mixture_ramp.py`
+/// reproduces the coefficients). Fit error < 9.4·10⁻⁸ in the
 /// exponent; the exponent is assembled and range-reduced in `f64` ([`exp2_split`]), so t²/2
 /// loses nothing to `f32` at large t. Measured maximum relative error against the `f64` G(−t)
 /// (libm's erfc) over t ∈ [0, 13]: see `tests::ramp_neg_lanes_error` (bound 1·10⁻⁶ asserted).
@@ -480,8 +465,16 @@ mod tests {
                 }
             }
         }
-        println!("ramp_neg_lanes: max relative error {:e} at t = {}", worst.0, worst.1);
-        assert!(worst.0 < 1e-6, "max relative error {:e} at t = {}", worst.0, worst.1);
+        println!(
+            "ramp_neg_lanes: max relative error {:e} at t = {}",
+            worst.0, worst.1
+        );
+        assert!(
+            worst.0 < 1e-6,
+            "max relative error {:e} at t = {}",
+            worst.0,
+            worst.1
+        );
         assert_eq!(ramp_neg_one(1.0e4), 0.0);
         assert_eq!(ramp_neg_one(f64::INFINITY), 0.0);
         assert_eq!(ramp_neg_one(f64::NAN), 0.0);
@@ -577,4 +570,3 @@ mod tests {
         assert!(worst < 1e-6, "{worst:e} at {at}");
     }
 }
-
