@@ -1,9 +1,9 @@
 //! Cost of the Beckmann mixture of \[Chermain2019\]: the build, and per footprint size the patch
 //! construction, D_P, the exact and approximate Λ_P and the visible sampler, each per-direction query
 //! timed by the lobe blocks (`blocks`) and by the scalar path (`scalar`, one lobe at a time rebuilt
-//! from its moments) in the same run. D_P's blocks path is the patch's `d`; exact Λ_P and the visible
-//! sampler stay scalar in the patch (their lane kernels, `lambda_blocks` / `sample_visible_blocks`,
-//! measured slower) and `d_scalar` is the former `d`, all `#[doc(hidden)]`.
+//! from its moments) in the same run. The blocks paths are the patch's `d`, exact `lambda` and
+//! `sample_visible` (`lambda_blocks` / `sample_visible_blocks` are the same code, callable by name);
+//! `d_scalar`, `lambda_scalar` and `sample_visible_scalar` are the former paths, all `#[doc(hidden)]`.
 //!
 //! Maps: the four procedural maps (bumpy, brushed, scratched, flakes) at 512², default parameters,
 //! built before timing. Footprints: isotropic, 1 to 65 536 texels, the level of detail off (so that

@@ -688,16 +688,15 @@ impl<'a> MixturePatch<'a> {
         }
     }
 
-    /// Exact V_P(w) = Σ W_i V_i(w) (0 for invalid w): the scalar sum, one lobe at a time. The lane
-    /// kernel ([`MixturePatch::visible_area_blocks`]) was measured slower than this (0.5-1.5×,
-    /// docs/results.md "Lobe blocks"), so the exact masking and the visible sampler keep it.
+    /// Exact V_P(w) = Σ W_i V_i(w) (0 for invalid w) by the lobe blocks
+    /// ([`MixturePatch::visible_area_blocks`]; relative error ≤ 1e-6, docs/mixture.md "Lobe blocks").
     fn exact_visible_area(&self, g: &Gathered, w: Vec3) -> f64 {
-        self.exact_visible_area_scalar(g, w)
+        self.exact_visible_area_blocks(g, w)
     }
 
-    /// V_P(w) by the lobe blocks ([`blocks::visible_lanes`]: `f32` lanes, the sum in `f64`), the
-    /// filtered lobe's under the level of detail. Not used by the patch yet (slower than the scalar
-    /// sum, docs/results.md); kept for the benches and the property test.
+    /// V_P(w) by the lobe blocks ([`blocks::visible_lanes`]: the ramp term G(−t) in lanes only in
+    /// blocks that hold a lobe seen at z = A_s/s_w < 5, the sum in `f64`), the filtered lobe's under
+    /// the level of detail: the patch's exact V_P (kept callable for the benches and tests).
     #[doc(hidden)]
     pub fn visible_area_blocks(&self, w: Vec3) -> f32 {
         match &self.gathered {
@@ -706,7 +705,8 @@ impl<'a> MixturePatch<'a> {
         }
     }
 
-    /// Λ_P(w) with [`MixturePatch::visible_area_blocks`] (the benches' lane-kernel column).
+    /// Λ_P(w) with [`MixturePatch::visible_area_blocks`] (the benches' lane-kernel column; equal to
+    /// [`Ndf::lambda`] in exact masking).
     #[doc(hidden)]
     pub fn lambda_blocks(&self, w: Vec3) -> f32 {
         crate::ndf::lambda_of(
@@ -721,12 +721,8 @@ impl<'a> MixturePatch<'a> {
             return 0.0;
         }
         let mut acc = [0.0f64; LANES];
-        let mut v = [0.0f32; LANES];
         self.for_each_patch_block(g, |b, wts, _, _| {
-            blocks::visible_lanes(b, wts, w, &mut v);
-            for i in 0..LANES {
-                acc[i] += v[i] as f64;
-            }
+            blocks::visible_lanes(b, wts, w, &mut acc);
         });
         acc.iter().sum()
     }
@@ -869,11 +865,10 @@ impl Ndf for MixturePatch<'_> {
     }
 
     /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
-    /// visible normal. Two passes over the lobes (total, then the pick), no allocation; the scalar
-    /// V_i (see [`MixturePatch::sample_visible_blocks`] for the lane version, measured slower).
-    /// Invalid wo: [`Ndf::sample_normal`].
+    /// visible normal: [`MixturePatch::sample_visible_blocks`] (V_i by the lobe blocks, as
+    /// [`Ndf::pdf_visible`]'s V_P). Invalid wo: [`Ndf::sample_normal`].
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
-        self.sample_visible_scalar(wo, u)
+        self.sample_visible_blocks(wo, u)
     }
 
     /// Σ W_i D_i(m) cos θ_m over **every** gathered lobe (no slope-box truncation): exactly the
@@ -930,7 +925,8 @@ impl MixturePatch<'_> {
     /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
     /// visible normal. Two passes over the lobe blocks (the total, then the pick: block by block,
     /// then lane by lane in the block that holds the target), no allocation. Invalid wo:
-    /// [`Ndf::sample_normal`]. Not used by the patch (slower than the scalar sampler, docs/results.md).
+    /// [`Ndf::sample_normal`]. The patch's `sample_visible`; its density is `pdf_visible` (which
+    /// divides by the same block V_P) up to the lanes' 1e-6 relative error on each V_i.
     #[doc(hidden)]
     pub fn sample_visible_blocks(&self, wo: Vec3, u: Vec2) -> Vec3 {
         let Some(g) = &self.gathered else {
@@ -954,13 +950,13 @@ impl MixturePatch<'_> {
         // (lobe index, rescaled u.x); the last lobe with V > 0 if rounding leaves the target unmet.
         let mut chosen = (usize::MAX, 0.5f32);
         let mut done = false;
-        let mut v = [0.0f32; LANES];
         self.for_each_patch_block(g, |b, wts, bx, by| {
             if done {
                 return;
             }
+            let mut v = [0.0f64; LANES];
             blocks::visible_lanes(b, wts, wo, &mut v);
-            let sum: f64 = v.iter().map(|&x| x as f64).sum();
+            let sum: f64 = v.iter().sum();
             if sum.is_nan() || sum <= 0.0 {
                 return;
             }
@@ -972,7 +968,6 @@ impl MixturePatch<'_> {
                 return;
             }
             for (lane, &vi) in v.iter().enumerate() {
-                let vi = vi as f64;
                 if vi > 0.0 {
                     chosen = (lobe(bx, by, lane), ((target - acc) / vi) as f32);
                     if acc + vi > target {
@@ -993,7 +988,8 @@ impl MixturePatch<'_> {
             .sample_visible(wo, Vec2::new(r, u.y))
     }
 
-    /// The scalar visible sampler (the patch's `sample_visible`):
+    /// The scalar visible sampler (the patch's `sample_visible` before the lobe blocks; kept for the
+    /// benches):
     /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
     /// visible normal. Two passes over the lobes (total, then the pick), no allocation. Invalid wo:
     /// [`Ndf::sample_normal`].
