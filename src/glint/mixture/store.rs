@@ -116,9 +116,11 @@ impl BeckmannMixture {
     /// Reads a mixture written by [`BeckmannMixture::save`]. Its patches answer `d`, `lambda`,
     /// `projected_area`, `sample_visible` and `pdf_visible` bit-identically to the saved mixture's.
     ///
-    /// Cost: one pass over the file plus the O(lobes) hierarchy and mip chain (parallel); no moment
-    /// integration. Memory is allocated only as data arrive (in 64 KiB steps), whatever the header
-    /// claims.
+    /// Cost: one pass over the file (read, checksum and range check together) plus the O(lobes) lobe
+    /// blocks, quadtree and mip chain (parallel, derived in bands of 4 lobe rows); no moment integration.
+    /// On a 2-core machine the time is mostly the page faults of the model's fresh 64 bytes per lobe
+    /// (docs/results.md, "Format version 2 and the faster loaders"). Memory is allocated only as data
+    /// arrive (in 64 KiB steps), whatever the header claims.
     ///
     /// # Errors
     /// [`crate::Error::BadMagic`], [`crate::Error::UnsupportedVersion`],
