@@ -553,7 +553,9 @@ fn values_in_later_chunks_are_checked_after_the_checksum() {
     let mixture = BeckmannMixture::build(&m, MixtureParams::default()).unwrap();
     let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
     type Load = fn(&[u8]) -> brdf::Result<()>;
-    let cases: [(&str, Vec<u8>, usize, usize, usize, f32, Load); 2] = [
+    /// Name in the error, file, record bytes, record index, component, bad value, loader.
+    type Case = (&'static str, Vec<u8>, usize, usize, usize, f32, Load);
+    let cases: [Case; 2] = [
         (
             "lobes[4000][2]",
             saved(|w| mixture.save(w)),
