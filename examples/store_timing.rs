@@ -6,6 +6,11 @@
 //! `mixture`, `pn`, `binmap`). Builds and loads alternate (build, loads, build, loads) so that a change of
 //! machine load hits both; files are saved to and loaded from memory (a `Vec<u8>`), so disk speed is
 //! left out. Prints a Markdown table (docs/results.md, "Saving and loading built maps").
+//!
+//! With each load it times two floors in the same process: filling fresh memory of the loaded model's
+//! size (allocate and write every byte once: the page faults and stores any load must pay, since the
+//! model's memory is new) and copying the file into fresh memory. Their ratio to the build is the
+//! most that any loader of this in-memory layout could reach on the machine.
 
 use brdf::glint::{BeckmannMixture, BinMap, BinMapParams, MixtureParams, NormalMap};
 use brdf::glint::{PositionNormalMap, PositionNormalParams, bumpy};
@@ -44,8 +49,21 @@ struct Row {
     name: &'static str,
     builds: Vec<f64>,
     loads: Vec<f64>,
+    /// Filling fresh memory of the loaded model's size.
+    fills: Vec<f64>,
+    /// Copying the file into fresh memory.
+    copies: Vec<f64>,
     file_bytes: usize,
     memory_bytes: usize,
+}
+
+/// Seconds taken by `f`, its result kept alive until timed.
+fn timed<T>(f: impl FnOnce() -> T) -> f64 {
+    let t = Instant::now();
+    let v = f();
+    let s = t.elapsed().as_secs_f64();
+    std::hint::black_box(&v);
+    s
 }
 
 /// Times `rounds` × (one build, `loads` loads of its saved file).
@@ -62,6 +80,8 @@ fn measure<M>(
         name,
         builds: Vec::new(),
         loads: Vec::new(),
+        fills: Vec::new(),
+        copies: Vec::new(),
         file_bytes: 0,
         memory_bytes: 0,
     };
@@ -79,6 +99,10 @@ fn measure<M>(
             let m = load(&file);
             row.loads.push(t.elapsed().as_secs_f64());
             std::hint::black_box(&m);
+            drop(m);
+            row.fills
+                .push(timed(|| vec![1u8; std::hint::black_box(row.memory_bytes)]));
+            row.copies.push(timed(|| file.to_vec()));
         }
         eprintln!(
             "{name}: build {:.3} s, last load {:.4} s",
@@ -114,10 +138,7 @@ fn main() {
                 || BeckmannMixture::build(&map, MixtureParams::default()).unwrap(),
                 |m, f| m.save(f).unwrap(),
                 |f| BeckmannMixture::load(&mut &f[..]).unwrap(),
-                |m| {
-                    let b = m.memory();
-                    b.lobe_bytes + b.hierarchy_bytes + b.mip_bytes
-                },
+                |m| m.memory().total(),
             )
         }),
         wanted("pn").then(|| {
@@ -154,17 +175,22 @@ fn main() {
     );
     println!();
     println!(
-        "| model | build (median) | load (median) | build / load | file B/texel | memory B/texel |"
+        "| model | build (median) | load (median) | build / load | fill model memory | copy file | \
+         build / fill | file B/texel | memory B/texel |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for r in &rows {
         let (b, l) = (median(r.builds.clone()), median(r.loads.clone()));
+        let (fill, copy) = (median(r.fills.clone()), median(r.copies.clone()));
         println!(
-            "| {} | {:.3} s | {:.1} ms | {:.0}× | {:.2} | {:.2} |",
+            "| {} | {:.3} s | {:.1} ms | {:.1}× | {:.1} ms | {:.1} ms | {:.0}× | {:.2} | {:.2} |",
             r.name,
             b,
             1e3 * l,
             b / l,
+            1e3 * fill,
+            1e3 * copy,
+            b / fill,
             r.file_bytes as f64 / texels,
             r.memory_bytes as f64 / texels
         );

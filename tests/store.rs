@@ -544,6 +544,54 @@ fn inconsistent_contents_with_valid_checksums_are_errors() {
     );
 }
 
+/// Values are checked chunk by chunk while they are read (64 KiB chunks: 3276 lobes, 2730
+/// position-normal elements): a bad value far into a later chunk is found and named by its index in
+/// the whole array, and only after the checksum (a damaged file is a checksum error first).
+#[test]
+fn values_in_later_chunks_are_checked_after_the_checksum() {
+    let m = map(64);
+    let mixture = BeckmannMixture::build(&m, MixtureParams::default()).unwrap();
+    let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
+    type Load = fn(&[u8]) -> brdf::Result<()>;
+    /// Name in the error, file, record bytes, record index, component, bad value, loader.
+    type Case = (&'static str, Vec<u8>, usize, usize, usize, f32, Load);
+    let cases: [Case; 2] = [
+        (
+            "lobes[4000][2]",
+            saved(|w| mixture.save(w)),
+            20,
+            4000,
+            2,
+            -1.0,
+            |f| load_mixture(f).map(|_| ()),
+        ),
+        (
+            "elements[3000][4]",
+            saved(|w| pn.save(w)),
+            24,
+            3000,
+            4,
+            1e30,
+            |f| PositionNormalMap::load(&mut &f[..]).map(|_| ()),
+        ),
+    ];
+    for (needle, file, record, index, component, value, load) in cases {
+        let count = 64 * 64;
+        let start = file.len() - 8 - count * record;
+        let mut f = file.clone();
+        let at = start + index * record + 4 * component;
+        f[at..at + 4].copy_from_slice(&value.to_le_bytes());
+        let e = load(&f).unwrap_err();
+        assert!(matches!(e, Error::ChecksumMismatch { .. }), "{needle}: {e}");
+        let e = load(&reseal(f)).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidFile { .. }) && e.to_string().contains(needle),
+            "{needle}: {e}"
+        );
+        load(&file).unwrap();
+    }
+}
+
 #[test]
 fn sizes_beyond_the_file_are_refused_before_allocating() {
     // A 40000² map (1.6·10⁹ lobes, 32 GB) declared in a file of a few hundred bytes: refused from the

@@ -44,37 +44,82 @@ pub(crate) struct SlopeTree {
     pub boxes: Vec<Vec<[f32; 4]>>,
 }
 
+/// Fills `out` (one row of ⌈pw/2⌉ nodes) with row `y` of the level above a `pw × ph` grid whose
+/// boxes `child(k)` gives (k = row · pw + column): each parent is the union of its (up to) 2 × 2
+/// children, taken in the order (row 2y: 2x, 2x + 1), (row 2y + 1: 2x, 2x + 1).
+///
+/// Every way of building a tree goes through this one function, so trees built from stored boxes,
+/// from boxes computed on the fly, or band by band are bit-identical (min/max of ±0 depends on the
+/// order of the operands, so the order is part of the result).
+#[inline]
+pub(crate) fn parent_row(
+    pw: usize,
+    ph: usize,
+    y: usize,
+    child: impl Fn(usize) -> [f32; 4],
+    out: &mut [[f32; 4]],
+) {
+    let rows = [2 * y, 2 * y + 1];
+    for (x, o) in out.iter_mut().enumerate() {
+        let mut b = [
+            f32::INFINITY,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        for cy in rows.into_iter().filter(|&cy| cy < ph) {
+            b = union(b, child(cy * pw + 2 * x));
+            if 2 * x + 1 < pw {
+                b = union(b, child(cy * pw + 2 * x + 1));
+            }
+        }
+        *o = b;
+    }
+}
+
 impl SlopeTree {
     /// Builds the tree from the level-0 boxes (row major over the element grid).
     pub fn build(nx: usize, ny: usize, leaf: &[[f32; 4]]) -> SlopeTree {
+        Self::build_with(nx, ny, |k| leaf[k])
+    }
+
+    /// Builds the tree from level-0 boxes computed on the fly: `leaf(k)` is the box of element k
+    /// (row major), called once per element, rows of level 1 in parallel. The same tree as
+    /// [`SlopeTree::build`] over the boxes `leaf` gives, without holding level 0 (16 bytes per
+    /// element) in memory.
+    pub fn build_with(nx: usize, ny: usize, leaf: impl Fn(usize) -> [f32; 4] + Sync) -> SlopeTree {
         let sizes = level_sizes(nx, ny);
+        if sizes.len() < 2 {
+            return SlopeTree {
+                sizes,
+                boxes: Vec::new(),
+            };
+        }
+        let [w, h] = sizes[1];
+        let mut level1 = vec![[0.0f32; 4]; w * h];
+        level1
+            .par_chunks_mut(w)
+            .enumerate()
+            .for_each(|(y, out)| parent_row(nx, ny, y, &leaf, out));
+        Self::from_level1(nx, ny, level1)
+    }
+
+    /// Builds the levels ≥ 2 above a given level 1 (⌈nx/2⌉ × ⌈ny/2⌉ boxes, row major, as
+    /// [`parent_row`] computes it from level 0), rows in parallel.
+    pub fn from_level1(nx: usize, ny: usize, level1: Vec<[f32; 4]>) -> SlopeTree {
+        let sizes = level_sizes(nx, ny);
+        debug_assert!(sizes.len() >= 2 && level1.len() == sizes[1][0] * sizes[1][1]);
         let mut boxes: Vec<Vec<[f32; 4]>> = Vec::with_capacity(sizes.len().saturating_sub(1));
-        for l in 1..sizes.len() {
+        boxes.push(level1);
+        for l in 2..sizes.len() {
             let [pw, ph] = sizes[l - 1];
             let [w, h] = sizes[l];
-            let prev: &[[f32; 4]] = if l == 1 { leaf } else { &boxes[l - 2] };
+            let prev = &boxes[l - 2];
             let mut level = vec![[0.0f32; 4]; w * h];
-            // Each parent is the union of its (up to) 2 × 2 children, taken in the order (row 2y:
-            // 2x, 2x + 1), (row 2y + 1: 2x, 2x + 1); rows in parallel.
-            level.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
-                let row = |cy: usize| (cy < ph).then(|| &prev[cy * pw..(cy + 1) * pw]);
-                let (r0, r1) = (row(2 * y), row(2 * y + 1));
-                for (x, o) in out.iter_mut().enumerate() {
-                    let mut b = [
-                        f32::INFINITY,
-                        f32::INFINITY,
-                        f32::NEG_INFINITY,
-                        f32::NEG_INFINITY,
-                    ];
-                    for r in [r0, r1].into_iter().flatten() {
-                        b = union(b, r[2 * x]);
-                        if let Some(&c) = r.get(2 * x + 1) {
-                            b = union(b, c);
-                        }
-                    }
-                    *o = b;
-                }
-            });
+            level
+                .par_chunks_mut(w)
+                .enumerate()
+                .for_each(|(y, out)| parent_row(pw, ph, y, |k| prev[k], out));
             boxes.push(level);
         }
         SlopeTree { sizes, boxes }
@@ -138,5 +183,50 @@ impl SlopeTree {
     /// Bytes held by the tree's boxes.
     pub fn bytes(&self) -> usize {
         self.boxes.iter().map(|b| b.len() * 16).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `build_with` (boxes computed on the fly, level 1 by rows in parallel) equals, bit for bit,
+    /// the quadtree built by the straightforward loop over whole levels, including the order of the
+    /// min/max of ±0 bounds, on grids with odd sizes.
+    #[test]
+    fn build_with_matches_the_straightforward_tree() {
+        for (nx, ny) in [(1, 1), (2, 1), (1, 9), (7, 5), (16, 16), (33, 10)] {
+            let leaf: Vec<[f32; 4]> = (0..nx * ny)
+                .map(|k| {
+                    let z: f32 = if k % 3 == 0 { -0.0 } else { 0.0 };
+                    let v = ((k * 37 % 11) as f32 - 5.0) * 0.1;
+                    [z.min(v), -z, z.max(v + 0.5), z]
+                })
+                .collect();
+            let tree = SlopeTree::build_with(nx, ny, |k| leaf[k]);
+            let sizes = level_sizes(nx, ny);
+            assert_eq!(tree.sizes, sizes);
+            assert_eq!(tree.boxes.len(), sizes.len() - 1);
+            let mut level = leaf.clone();
+            for l in 1..sizes.len() {
+                let ([pw, ph], [w, h]) = (sizes[l - 1], sizes[l]);
+                let mut up = Vec::new();
+                for y in 0..h {
+                    for x in 0..w {
+                        let mut b = [f32::INFINITY, f32::INFINITY, -f32::INFINITY, -f32::INFINITY];
+                        for cy in [2 * y, 2 * y + 1].into_iter().filter(|&c| c < ph) {
+                            for cx in [2 * x, 2 * x + 1].into_iter().filter(|&c| c < pw) {
+                                b = union(b, level[cy * pw + cx]);
+                            }
+                        }
+                        up.push(b);
+                    }
+                }
+                let bits =
+                    |v: &[[f32; 4]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&tree.boxes[l - 1]), bits(&up), "{nx}×{ny} level {l}");
+                level = up;
+            }
+        }
     }
 }

@@ -298,6 +298,9 @@ pub(crate) struct Decoder<'a> {
     sum: Checksum,
     /// Payload bytes not read yet (as declared by the header).
     remaining: u64,
+    /// The first value found out of range by [`Decoder::array_in_range`], reported by
+    /// [`Decoder::finish`] once the checksum has been checked.
+    out_of_range: Option<Error>,
 }
 
 impl<'a> Decoder<'a> {
@@ -334,6 +337,7 @@ impl<'a> Decoder<'a> {
             r,
             sum,
             remaining: u64::get(&head[16..]),
+            out_of_range: None,
         })
     }
 
@@ -400,14 +404,57 @@ impl<'a> Decoder<'a> {
         self.records(what, n)
     }
 
-    /// Reads `expected` records: bytes go from the reader into a chunk of records (no per-scalar
-    /// decoding), are hashed there and appended to the vector, which grows as data arrive (so a
-    /// file that declares more than it holds allocates at most about twice what it did hold). The
-    /// bytes are reordered in place only on a big-endian target.
+    /// [`Decoder::array`] of `f32` records whose values must all be finite and within
+    /// `bound(component)` = [lo, hi], checked chunk by chunk as the records are read (while they
+    /// are in cache, instead of a second pass over the array). A value out of range is reported by
+    /// [`Decoder::finish`] after the payload length and the checksum (so a damaged file still gets
+    /// [`Error::ChecksumMismatch`]), as the [`Error::InvalidFile`] [`check_range`] gives.
+    pub(crate) fn array_in_range<const N: usize>(
+        &mut self,
+        what: &'static str,
+        expected: usize,
+        bound: impl Fn(usize) -> (f32, f32),
+    ) -> Result<Vec<[f32; N]>> {
+        let n: u64 = self.get(what)?;
+        if n != expected as u64 {
+            return Err(Error::InvalidFile {
+                reason: format!(
+                    "{what} holds {n} elements but the parameters read so far need {expected}"
+                ),
+            });
+        }
+        let bounds: [(f32, f32); N] = std::array::from_fn(&bound);
+        let mut bad = None;
+        let out = self.records_with(what, expected, |first, chunk: &[[f32; N]]| {
+            if bad.is_none() && !all_in_range(chunk, &bounds) {
+                bad = first_out_of_range(chunk, first, what, &bounds).err();
+            }
+        })?;
+        if self.out_of_range.is_none() {
+            self.out_of_range = bad;
+        }
+        Ok(out)
+    }
+
+    /// Reads `expected` records (see [`Decoder::records_with`]).
     fn records<T: Scalar, const N: usize>(
         &mut self,
         what: &'static str,
         expected: usize,
+    ) -> Result<Vec<[T; N]>> {
+        self.records_with(what, expected, |_, _| {})
+    }
+
+    /// Reads `expected` records: bytes go from the reader into a chunk of records (no per-scalar
+    /// decoding), are hashed there, shown to `chunk(index of its first record, records)` and
+    /// appended to the vector, which grows as data arrive (so a file that declares more than it
+    /// holds allocates at most about twice what it did hold). The bytes are reordered in place
+    /// (before `chunk` sees them) only on a big-endian target.
+    fn records_with<T: Scalar, const N: usize>(
+        &mut self,
+        what: &'static str,
+        expected: usize,
+        mut chunk_seen: impl FnMut(usize, &[[T; N]]),
     ) -> Result<Vec<[T; N]>> {
         let record = N * T::BYTES;
         let bytes = expected
@@ -426,13 +473,14 @@ impl<'a> Decoder<'a> {
             let raw: &mut [u8] = bytemuck::cast_slice_mut(chunk.as_flattened_mut());
             read_exact(self.r, raw, what)?;
             self.sum.update(raw);
+            if cfg!(target_endian = "big") {
+                for v in chunk.iter_mut().flatten() {
+                    *v = v.le_to_native();
+                }
+            }
+            chunk_seen(out.len(), chunk);
             out.extend_from_slice(chunk);
             left -= k;
-        }
-        if cfg!(target_endian = "big") {
-            for v in out.iter_mut().flatten() {
-                *v = v.le_to_native();
-            }
         }
         Ok(out)
     }
@@ -442,6 +490,7 @@ impl<'a> Decoder<'a> {
     /// # Errors
     /// [`Error::InvalidFile`] if payload bytes are left over, [`Error::Truncated`] if the checksum is
     /// missing, [`Error::ChecksumMismatch`].
+    /// Then reports the first value [`Decoder::array_in_range`] found out of range, if any.
     pub(crate) fn finish(self) -> Result<()> {
         if self.remaining != 0 {
             return Err(Error::InvalidFile {
@@ -458,7 +507,10 @@ impl<'a> Decoder<'a> {
         if stored != computed {
             return Err(Error::ChecksumMismatch { stored, computed });
         }
-        Ok(())
+        match self.out_of_range {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
     }
 }
 
@@ -487,19 +539,38 @@ pub(crate) fn check_range<const N: usize>(
     bound: impl Fn(usize) -> (f32, f32),
 ) -> Result<()> {
     let bounds: [(f32, f32); N] = std::array::from_fn(&bound);
-    let inside = |item: &[f32; N]| {
-        item.iter()
-            .zip(&bounds)
-            .fold(true, |ok, (&v, &(lo, hi))| ok & (v >= lo) & (v <= hi))
-    };
-    if items.iter().fold(true, |ok, item| ok & inside(item)) {
+    if all_in_range(items, &bounds) {
         return Ok(());
     }
+    first_out_of_range(items, 0, what, &bounds)
+}
+
+/// Whether every component c of every item is in [bounds[c].0, bounds[c].1] (NaN never is); no
+/// early exit, so the loop vectorises.
+#[inline]
+fn all_in_range<const N: usize>(items: &[[f32; N]], bounds: &[(f32, f32); N]) -> bool {
+    let inside = |item: &[f32; N]| {
+        item.iter()
+            .zip(bounds)
+            .fold(true, |ok, (&v, &(lo, hi))| ok & (v >= lo) & (v <= hi))
+    };
+    items.iter().fold(true, |ok, item| ok & inside(item))
+}
+
+/// The [`Error::InvalidFile`] naming the first value out of range (items numbered from `first`).
+#[cold]
+fn first_out_of_range<const N: usize>(
+    items: &[[f32; N]],
+    first: usize,
+    what: &str,
+    bounds: &[(f32, f32); N],
+) -> Result<()> {
     for (k, item) in items.iter().enumerate() {
-        for (c, (&v, &(lo, hi))) in item.iter().zip(&bounds).enumerate() {
+        for (c, (&v, &(lo, hi))) in item.iter().zip(bounds).enumerate() {
             if !(v >= lo && v <= hi) {
                 return Err(invalid(format!(
-                    "{what}[{k}][{c}] = {v} is outside [{lo}, {hi}] (or not finite)"
+                    "{what}[{}][{c}] = {v} is outside [{lo}, {hi}] (or not finite)",
+                    first + k
                 )));
             }
         }

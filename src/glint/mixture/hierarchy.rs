@@ -34,15 +34,18 @@ pub(super) struct LobePyramid {
 
 impl LobePyramid {
     pub fn build(nx: usize, ny: usize, lobes: &[[f32; 5]]) -> LobePyramid {
+        use rayon::prelude::*;
         let sizes = level_sizes(nx, ny);
         let mut levels: Vec<Vec<[f32; 5]>> = Vec::new();
         for l in 1..sizes.len() {
             let [pw, ph] = sizes[l - 1];
             let [w, h] = sizes[l];
             let prev: &[[f32; 5]] = if l == 1 { lobes } else { &levels[l - 2] };
-            let mut level = Vec::with_capacity(w * h);
-            for y in 0..h {
-                for x in 0..w {
+            // Rows in parallel; each node is the same f64 average in the same order whatever the
+            // thread count.
+            let mut level = vec![[0.0f32; 5]; w * h];
+            level.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+                for (x, out) in row.iter_mut().enumerate() {
                     let mut acc = [0.0f64; 5];
                     let mut n = 0.0;
                     for cy in (2 * y)..(2 * y + 2).min(ph) {
@@ -54,9 +57,9 @@ impl LobePyramid {
                             n += 1.0;
                         }
                     }
-                    level.push(acc.map(|v| (v / n) as f32));
+                    *out = acc.map(|v| (v / n) as f32);
                 }
-            }
+            });
             levels.push(level);
         }
         LobePyramid { sizes, levels }

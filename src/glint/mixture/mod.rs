@@ -30,7 +30,7 @@ use crate::glint::slope_tree::SlopeTree;
 use crate::glint::{Footprint, GlintNdf, NormalMap};
 use crate::ndf::SlopeGaussian;
 use blocks::LobeBlocks;
-use hierarchy::{LobePyramid, lobe_box};
+use hierarchy::LobePyramid;
 
 /// Default seed spacing h = 1 texel: one lobe per texel, at the texel centres (\[Chermain2019\] §5.1.1).
 pub const DEFAULT_SPACING: f32 = 1.0;
@@ -404,17 +404,10 @@ impl BeckmannMixture {
         params: MixtureParams,
         lobes: Vec<[f32; 5]>,
     ) -> Self {
-        use rayon::prelude::*;
         let [nx, ny] = grid;
         let box_k = (-2.0 * (params.slope_tail as f64).ln()).sqrt() as f32;
-        let gaussians: Vec<SlopeGaussian> = lobes
-            .par_iter()
-            .map(|m| SlopeGaussian::from_moments(*m, params.sigma_min))
-            .collect();
-        let leaf: Vec<[f32; 4]> = gaussians.par_iter().map(|g| lobe_box(g, box_k)).collect();
-        let tree = SlopeTree::build(nx, ny, &leaf);
-        let pad = SlopeGaussian::from_moments([0.0; 5], params.sigma_min);
-        let blocks = LobeBlocks::build(nx, ny, &gaussians, &pad);
+        // Blocks and tree in one streaming pass (no whole-grid temporaries), then the mip chain.
+        let (blocks, tree) = store::derive_blocks_and_tree(nx, ny, &lobes, params.sigma_min, box_k);
         let pyramid = LobePyramid::build(nx, ny, &lobes);
         BeckmannMixture {
             width,

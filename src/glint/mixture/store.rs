@@ -1,15 +1,86 @@
 //! Saving and loading a built [`BeckmannMixture`] (format: docs/format.md, kind 2).
 //!
-//! Stored: the map size, the build parameters and the lobes' moments (20 bytes per lobe). The slope
-//! boxes, their hierarchy and the moment mip chain are rebuilt on load by the same code as the build
-//! (O(lobes), parallel): this keeps files at 20 bytes per lobe and every query of a loaded mixture
-//! bit-identical to the built one.
+//! Stored: the map size, the build parameters and the lobes' moments (20 bytes per lobe). The lobe
+//! blocks, the slope boxes' hierarchy and the moment mip chain are rebuilt on load by the same code
+//! as the build ([`derive_blocks_and_tree`], O(lobes), parallel): this keeps files at 20 bytes per
+//! lobe and every query of a loaded mixture bit-identical to the built one.
 
+use super::blocks::{LobeBlocks, SIDE};
+use super::hierarchy::lobe_box;
 use super::{BeckmannMixture, MaskingMode, MixtureParams, PatchOptions};
 use crate::Result;
 use crate::glint::MAX_SLOPE;
+use crate::glint::slope_tree::{SlopeTree, level_sizes, parent_row};
 use crate::glint::store::{self, Decoder, Kind};
+use crate::ndf::SlopeGaussian;
+use rayon::prelude::*;
 use std::io::{Read, Write};
+
+/// The lobe blocks (blocks.rs) and the slope-box quadtree (src/glint/slope_tree.rs) of the lobes
+/// `moments` (row major over `nx × ny`), each lobe the [`SlopeGaussian::from_moments`] of its moments
+/// (floor `sigma_min`) and its box [`lobe_box`] of half-width `box_k` standard deviations.
+///
+/// Equal, bit for bit, to `LobeBlocks::build` over all the lobes' Gaussians and `SlopeTree::build`
+/// over all their boxes, but computed in parallel bands of 4 lobe rows (one block row, two rows of
+/// the tree's level 1) whose Gaussians and boxes live only in a per-thread scratch: each lobe's
+/// Gaussian is computed once, and neither the Gaussians (32 bytes per lobe) nor the boxes (16) are
+/// ever held for the whole grid. Loading a mixture is bounded by the memory it fills (docs/results.md,
+/// "Format version 2 and the faster loaders"), so leaving out those 48 bytes per lobe of temporaries
+/// is most of the gain.
+pub(super) fn derive_blocks_and_tree(
+    nx: usize,
+    ny: usize,
+    moments: &[[f32; 5]],
+    sigma_min: f32,
+    box_k: f32,
+) -> (LobeBlocks, SlopeTree) {
+    let gaussian = |m: &[f32; 5]| SlopeGaussian::from_moments(*m, sigma_min);
+    let pad = SlopeGaussian::from_moments([0.0; 5], sigma_min);
+    let sizes = level_sizes(nx, ny);
+    if sizes.len() < 2 {
+        // A single lobe: nothing to stream.
+        let g: Vec<SlopeGaussian> = moments.iter().map(gaussian).collect();
+        let leaf: Vec<[f32; 4]> = g.iter().map(|g| lobe_box(g, box_k)).collect();
+        return (
+            LobeBlocks::build(nx, ny, &g, &pad),
+            SlopeTree::build(nx, ny, &leaf),
+        );
+    }
+    let (bnx, bny) = (nx.div_ceil(SIDE), ny.div_ceil(SIDE));
+    let [w1, h1] = sizes[1];
+    // The final storage, written band by band in place (rayon fills it in parallel, so the pages
+    // are touched by both threads).
+    let proto = LobeBlocks::build(1, 1, &[pad], &pad).blocks[0].clone();
+    let mut blocks = Vec::with_capacity(bnx * bny);
+    blocks.par_extend(rayon::iter::repeat_n(proto, bnx * bny));
+    let mut level1 = vec![[0.0f32; 4]; w1 * h1];
+    let bands = blocks
+        .par_chunks_mut(bnx)
+        .zip(level1.par_chunks_mut(2 * w1))
+        .enumerate();
+    bands.for_each_init(
+        || (Vec::new(), Vec::new()),
+        |(g, leaf): &mut (Vec<SlopeGaussian>, Vec<[f32; 4]>), (b, (out_blocks, out_level1))| {
+            let y0 = b * SIDE;
+            let rows = SIDE.min(ny - y0);
+            let band = &moments[y0 * nx..(y0 + rows) * nx];
+            g.clear();
+            g.extend(band.iter().map(gaussian));
+            leaf.clear();
+            leaf.extend(g.iter().map(|g| lobe_box(g, box_k)));
+            // Rows 2b and 2b + 1 of level 1 are the parents of lobe rows 4b .. 4b + 4, i.e. rows 0
+            // and 1 of the level above this band; lanes of rows ≥ ny are padding in both.
+            for (y, out) in out_level1.chunks_mut(w1).enumerate() {
+                parent_row(nx, rows, y, |k| leaf[k], out);
+            }
+            out_blocks.clone_from_slice(&LobeBlocks::build(nx, rows, g, &pad).blocks);
+        },
+    );
+    (
+        LobeBlocks { bnx, blocks },
+        SlopeTree::from_level1(nx, ny, level1),
+    )
+}
 
 /// Bound on stored mean slopes: 2 · [`MAX_SLOPE`]. Built moments average slopes of at most
 /// `MAX_SLOPE` (interpolated slopes may exceed it by rounding only), so every built file passes with
@@ -45,9 +116,11 @@ impl BeckmannMixture {
     /// Reads a mixture written by [`BeckmannMixture::save`]. Its patches answer `d`, `lambda`,
     /// `projected_area`, `sample_visible` and `pdf_visible` bit-identically to the saved mixture's.
     ///
-    /// Cost: one pass over the file plus the O(lobes) hierarchy and mip chain (parallel); no moment
-    /// integration. Memory is allocated only as data arrive (in 64 KiB steps), whatever the header
-    /// claims.
+    /// Cost: one pass over the file (read, checksum and range check together) plus the O(lobes) lobe
+    /// blocks, quadtree and mip chain (parallel, derived in bands of 4 lobe rows); no moment integration.
+    /// On a 2-core machine the time is mostly the page faults of the model's fresh 64 bytes per lobe
+    /// (docs/results.md, "Format version 2 and the faster loaders"). Memory is allocated only as data
+    /// arrive (in 64 KiB steps), whatever the header claims.
     ///
     /// # Errors
     /// [`crate::Error::BadMagic`], [`crate::Error::UnsupportedVersion`],
@@ -91,14 +164,140 @@ impl BeckmannMixture {
         crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))
             .map_err(refused)?;
         let ([nx, ny], _) = super::lobe_grid(width, height, &params).map_err(refused)?;
-        let lobes = d.array::<f32, 5>("lobes", nx * ny)?;
-        d.finish()?;
         let m2 = MEAN_BOUND * MEAN_BOUND;
-        store::check_range(&lobes, "lobes", |c| match c {
+        let lobes = d.array_in_range::<5>("lobes", nx * ny, |c| match c {
             0 | 1 => (-MEAN_BOUND, MEAN_BOUND),
             2 | 3 => (0.0, m2),
             _ => (-m2, m2),
         })?;
+        d.finish()?;
         BeckmannMixture::from_parts(width, height, params, lobes).map_err(refused)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::glint::mixture::hierarchy::LobePyramid;
+
+    /// Moments of every kind a file can hold: ordinary lobes, means of ±0 (the box unions take
+    /// min/max of ±0, whose result depends on the order), degenerate and clamped covariances.
+    fn moments(n: usize, seed: u64) -> Vec<[f32; 5]> {
+        let mut s = seed;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((s >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        (0..n)
+            .map(|k| {
+                let (mx, my) = match k % 5 {
+                    0 => (0.0, -0.0),
+                    1 => (-0.0, 0.0),
+                    _ => (next(), next()),
+                };
+                let (sx, sy, r) = (0.3 * next().abs(), 0.3 * next().abs(), next());
+                match k % 7 {
+                    3 => [mx, my, 0.0, 0.0, 0.0],
+                    _ => [
+                        mx,
+                        my,
+                        mx * mx + sx * sx,
+                        my * my + sy * sy,
+                        mx * my + r * sx * sy,
+                    ],
+                }
+            })
+            .collect()
+    }
+
+    /// The blocks and the tree derived band by band equal, bit for bit, those of the whole-grid
+    /// derivation (every Gaussian and box held, then `LobeBlocks::build`, and a quadtree built here
+    /// by the straightforward loop), on grids with odd sizes and partial bands; the parallel mip
+    /// chain equals the straightforward f64 average.
+    #[test]
+    fn derived_parts_match_the_whole_grid_derivation() {
+        let (sigma_min, box_k) = (0.01, 5.26);
+        for (nx, ny) in [
+            (1, 1),
+            (1, 7),
+            (9, 1),
+            (5, 3),
+            (13, 6),
+            (16, 16),
+            (17, 11),
+            (40, 9),
+        ] {
+            let m = moments(nx * ny, (nx * 31 + ny) as u64);
+            let (blocks, tree) = derive_blocks_and_tree(nx, ny, &m, sigma_min, box_k);
+            let g: Vec<SlopeGaussian> = m
+                .iter()
+                .map(|m| SlopeGaussian::from_moments(*m, sigma_min))
+                .collect();
+            let pad = SlopeGaussian::from_moments([0.0; 5], sigma_min);
+            let want = LobeBlocks::build(nx, ny, &g, &pad);
+            assert_eq!(blocks.bnx, want.bnx);
+            assert_eq!(
+                format!("{:?}", blocks.blocks),
+                format!("{:?}", want.blocks),
+                "{nx}×{ny} blocks"
+            );
+            // The quadtree by the straightforward loop over whole levels.
+            let mut level: Vec<[f32; 4]> = g.iter().map(|g| lobe_box(g, box_k)).collect();
+            let sizes = level_sizes(nx, ny);
+            assert_eq!(tree.sizes, sizes);
+            for l in 1..sizes.len() {
+                let ([pw, ph], [w, h]) = (sizes[l - 1], sizes[l]);
+                let mut up = Vec::new();
+                for y in 0..h {
+                    for x in 0..w {
+                        let mut b = [f32::INFINITY, f32::INFINITY, -f32::INFINITY, -f32::INFINITY];
+                        for cy in [2 * y, 2 * y + 1].into_iter().filter(|&c| c < ph) {
+                            for cx in [2 * x, 2 * x + 1].into_iter().filter(|&c| c < pw) {
+                                let c = level[cy * pw + cx];
+                                b = [
+                                    b[0].min(c[0]),
+                                    b[1].min(c[1]),
+                                    b[2].max(c[2]),
+                                    b[3].max(c[3]),
+                                ];
+                            }
+                        }
+                        up.push(b);
+                    }
+                }
+                let bits =
+                    |v: &[[f32; 4]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&tree.boxes[l - 1]), bits(&up), "{nx}×{ny} level {l}");
+                level = up;
+            }
+            // The mip chain: each node the f64 mean of its (up to) 2 × 2 children.
+            let pyramid = LobePyramid::build(nx, ny, &m);
+            let mut prev = m.clone();
+            for l in 1..sizes.len() {
+                let ([pw, ph], [w, h]) = (sizes[l - 1], sizes[l]);
+                let mut up = Vec::new();
+                for y in 0..h {
+                    for x in 0..w {
+                        let mut acc = [0.0f64; 5];
+                        let mut n = 0.0;
+                        for cy in (2 * y)..(2 * y + 2).min(ph) {
+                            for cx in (2 * x)..(2 * x + 2).min(pw) {
+                                for k in 0..5 {
+                                    acc[k] += prev[cy * pw + cx][k] as f64;
+                                }
+                                n += 1.0;
+                            }
+                        }
+                        up.push(acc.map(|v| (v / n) as f32));
+                    }
+                }
+                let bits =
+                    |v: &[[f32; 5]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&pyramid.levels[l - 1]), bits(&up), "{nx}×{ny} mip {l}");
+                prev = up;
+            }
+        }
     }
 }

@@ -29,7 +29,6 @@ use crate::error::{Error, Result, positive};
 use crate::glint::slope_tree::SlopeTree;
 use crate::glint::{Footprint, GlintNdf, GlintScratch, MAX_TRUNCATION_SIGMAS, NormalMap};
 use glam::{Mat2, Vec2};
-use rayon::prelude::*;
 
 /// σ_h / h = 1/√(8 ln 2) (see [`PositionNormalMap::SIGMA_H_PER_SPACING`]).
 pub(crate) const SIGMA_H_PER_SPACING: f64 = 0.424_660_900_144_009_5;
@@ -234,11 +233,11 @@ impl PositionNormalMap {
     ) -> Self {
         let spacing = 1.0 / params.sampling_rate as f64;
         let sigma_h = SIGMA_H_PER_SPACING * spacing;
-        let leaf: Vec<[f32; 4]> = elements
-            .par_iter()
-            .map(|e| build::slope_box(e, sigma_h, &params))
-            .collect();
-        let tree = SlopeTree::build(grid[0], grid[1], &leaf);
+        // The element boxes are computed on the fly, once each, into level 1 of the tree (no
+        // 16-byte-per-element level 0 is held).
+        let tree = SlopeTree::build_with(grid[0], grid[1], |k| {
+            build::slope_box(&elements[k], sigma_h, &params)
+        });
         PositionNormalMap {
             width,
             height,

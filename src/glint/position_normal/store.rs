@@ -57,19 +57,19 @@ impl PositionNormalMap {
         crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))
             .map_err(refused)?;
         let [nx, ny] = super::element_grid(width, height, &params).map_err(refused)?;
-        let elements = d.array::<f32, 6>("elements", nx * ny)?;
-        d.finish()?;
         // Built elements: interpolated slopes (≤ MAX_SLOPE up to rounding) and central differences of
         // them over 1/rate texels (≤ 2 · MAX_SLOPE · rate); a factor 2 to spare on both.
         let s = 2.0 * MAX_SLOPE;
         let j = 4.0 * MAX_SLOPE * params.sampling_rate as f32;
-        store::check_range(
-            &elements,
-            "elements",
-            |c| {
-                if c < 2 { (-s, s) } else { (-j, j) }
-            },
-        )?;
+        let elements =
+            d.array_in_range::<6>(
+                "elements",
+                nx * ny,
+                |c| {
+                    if c < 2 { (-s, s) } else { (-j, j) }
+                },
+            )?;
+        d.finish()?;
         PositionNormalMap::from_parts(width, height, params, elements).map_err(refused)
     }
 }
