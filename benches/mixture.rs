@@ -54,6 +54,7 @@ fn params() -> MixtureParams {
         patch: PatchOptions {
             masking: MaskingMode::Exact,
             lod_lobes: f32::INFINITY,
+            lod_tolerance: 0.0,
         },
         ..MixtureParams::default()
     }
@@ -184,6 +185,7 @@ fn queries(c: &mut Criterion) {
             let options = PatchOptions {
                 masking: MaskingMode::Approximate,
                 lod_lobes: f32::INFINITY,
+                lod_tolerance: 0.0,
             };
             let patch = mix.patch_with(&footprint(area), options);
             g.bench_with_input(BenchmarkId::from_parameter(area), &w, |b, w| {

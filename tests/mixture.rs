@@ -50,6 +50,7 @@ fn exact_params() -> MixtureParams {
         patch: PatchOptions {
             masking: MaskingMode::Exact,
             lod_lobes: f32::INFINITY,
+            lod_tolerance: 0.0,
         },
         ..MixtureParams::default()
     }
@@ -408,6 +409,7 @@ fn white_furnace_exact_and_approximate() {
                 let options = PatchOptions {
                     masking,
                     lod_lobes: f32::INFINITY,
+                    lod_tolerance: 0.0,
                 };
                 let patch = mix.patch_with(&footprint(area, Vec2::new(0.37, 0.61)), options);
                 for theta in thetas {
@@ -610,6 +612,7 @@ fn bad_input() {
                     PatchOptions {
                         masking,
                         lod_lobes: lod,
+                        lod_tolerance: 0.0,
                     },
                 );
                 for &w in &dirs {
@@ -704,6 +707,7 @@ fn accuracy_table() {
                 PatchOptions {
                     masking: MaskingMode::Approximate,
                     lod_lobes: 0.0,
+                    lod_tolerance: 0.0,
                 },
             );
             let (d, c, k, noise) = tv_both_truths(&exact, &t);
@@ -787,6 +791,7 @@ fn lod_table() {
                 PatchOptions {
                     masking: MaskingMode::Approximate,
                     lod_lobes: 0.0,
+                    lod_tolerance: 0.0,
                 },
             );
             let tv = tv_distance(&exact, &reference, 1);
@@ -848,6 +853,7 @@ fn build_2048() {
             PatchOptions {
                 masking: MaskingMode::Exact,
                 lod_lobes: f32::INFINITY,
+                lod_tolerance: 0.0,
             },
         );
         let t_patch = t.elapsed();
@@ -880,6 +886,7 @@ fn build_2048() {
             PatchOptions {
                 masking: MaskingMode::Approximate,
                 lod_lobes: f32::INFINITY,
+                lod_tolerance: 0.0,
             },
         );
         let t = std::time::Instant::now();
@@ -1023,4 +1030,57 @@ proptest::proptest! {
             "{name} θ {theta}: V_P {v} vs f64 sum {reference}"
         );
     }
+}
+
+/// TV between a patch's D_P and another's grid values, ½ ∫ |P22_a − P22_b| ds on `b`'s slope grid
+/// (every lobe of `b` to ±8 σ, step half the narrowest σ) by the trapezoid rule, with the
+/// quadrature's own error estimate (the same sum at twice the step).
+fn tv_to_grid(a: &MixturePatch, b: &GridValues) -> (f64, f64) {
+    integrate_grid(b, &|s, p| {
+        let (m, mz) = normal_of(s);
+        0.5 * (a.d(m) as f64 * mz.powi(4) - p).abs()
+    })
+}
+
+/// The level of detail respects its tolerance: on the four procedural maps (64²) at a 256-texel
+/// footprint, the TV between the level-of-detail patch and the full mixture (same footprint) is at
+/// most the patch's bound Σ W_n e(n) (src/glint/mixture/levels.rs), which is at most the tolerance,
+/// plus three times the quadrature's error estimate. The bound covers the merged lobes, not the
+/// node weights (each node's weight is the moment-matched Gaussian of its lobes' weights, and the
+/// weight is spread evenly over its lobes; docs/mixture.md): the test checks that this
+/// approximation stays inside the bound's slack on these maps. At least three cases must pick a
+/// level ≥ 1 (otherwise the test would check nothing).
+#[test]
+fn level_of_detail_respects_its_tolerance() {
+    let centre = Vec2::new(0.43, 0.57);
+    let mut merged = 0;
+    for (name, map) in procedural_maps() {
+        let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
+        let fp = footprint(256.0, centre);
+        let full = mix.patch(&fp);
+        assert_eq!(full.level(), 0);
+        let gv = grid_values(&full);
+        for tol in [0.02f32, 0.3] {
+            let p = mix.patch_with(
+                &fp,
+                PatchOptions {
+                    lod_tolerance: tol,
+                    ..exact_params().patch
+                },
+            );
+            let (tv, q) = tv_to_grid(&p, &gv);
+            let bound = p.lod_error() as f64;
+            println!(
+                "{name} tol {tol}: level {} bound {bound:.4} TV {tv:.4} (±{q:.1e})",
+                p.level()
+            );
+            assert!(bound <= tol as f64, "{name}: bound {bound} > tolerance {tol}");
+            assert!(
+                tv <= bound + 3.0 * q,
+                "{name} tol {tol}: TV {tv} > bound {bound} + 3 × {q}"
+            );
+            merged += (p.level() > 0) as usize;
+        }
+    }
+    assert!(merged >= 3, "only {merged} cases used a level ≥ 1");
 }
