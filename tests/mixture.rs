@@ -626,7 +626,12 @@ fn bad_input() {
     ];
     for fp in &fps {
         for masking in [MaskingMode::Exact, MaskingMode::Approximate] {
-            for (lod, tol) in [(0.0, 0.0), (f32::INFINITY, 0.0), (f32::INFINITY, 1.0), (4.0, 0.1)] {
+            for (lod, tol) in [
+                (0.0, 0.0),
+                (f32::INFINITY, 0.0),
+                (f32::INFINITY, 1.0),
+                (4.0, 0.1),
+            ] {
                 let p = mix.patch_with(
                     fp,
                     PatchOptions {
@@ -1094,7 +1099,10 @@ fn level_of_detail_respects_its_tolerance() {
                 "{name} tol {tol}: level {} bound {bound:.4} TV {tv:.4} (±{q:.1e})",
                 p.level()
             );
-            assert!(bound <= tol as f64, "{name}: bound {bound} > tolerance {tol}");
+            assert!(
+                bound <= tol as f64,
+                "{name}: bound {bound} > tolerance {tol}"
+            );
             assert!(
                 tv <= bound + 3.0 * q,
                 "{name} tol {tol}: TV {tv} > bound {bound} + 3 × {q}"

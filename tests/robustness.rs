@@ -257,7 +257,11 @@ proptest! {
 fn quick_mixture_params(masking: MaskingMode, lod_lobes: f32) -> MixtureParams {
     MixtureParams {
         samples: 16,
-        patch: PatchOptions { masking, lod_lobes, ..PatchOptions::default() },
+        patch: PatchOptions {
+            masking,
+            lod_lobes,
+            ..PatchOptions::default()
+        },
         ..MixtureParams::default()
     }
 }

@@ -107,13 +107,21 @@ fn det(c: &[f64; 3]) -> f64 {
 /// ∫ N(x; μ_i, Σ_i) N(x; μ_j, Σ_j) / N(x; μ, Σ) dx in closed form (a Gaussian integral of the
 /// precision A = P_i + P_j − P, P = Σ⁻¹), or `None` when A is not positive definite (the integral
 /// diverges).
-fn chi2_term(i: &([f64; 2], [f64; 3]), j: &([f64; 2], [f64; 3]), g: &([f64; 2], [f64; 3])) -> Option<f64> {
+fn chi2_term(
+    i: &([f64; 2], [f64; 3]),
+    j: &([f64; 2], [f64; 3]),
+    g: &([f64; 2], [f64; 3]),
+) -> Option<f64> {
     let inv = |c: &[f64; 3]| {
         let d = det(c);
         [c[2] / d, -c[1] / d, c[0] / d]
     };
     let (pi, pj, p) = (inv(&i.1), inv(&j.1), inv(&g.1));
-    let a = [pi[0] + pj[0] - p[0], pi[1] + pj[1] - p[1], pi[2] + pj[2] - p[2]];
+    let a = [
+        pi[0] + pj[0] - p[0],
+        pi[1] + pj[1] - p[1],
+        pi[2] + pj[2] - p[2],
+    ];
     let det_a = det(&a);
     if !(a[0] > 0.0 && det_a > 0.0) {
         return None;
@@ -280,9 +288,19 @@ mod tests {
             (0.1, 0.05, true),
         ] {
             let c = if mixed {
-                [lobe(-d, 0.0, s), lobe(d, 0.0, 1.5 * s), lobe(0.0, d, s), lobe(0.0, -d, 0.7 * s)]
+                [
+                    lobe(-d, 0.0, s),
+                    lobe(d, 0.0, 1.5 * s),
+                    lobe(0.0, d, s),
+                    lobe(0.0, -d, 0.7 * s),
+                ]
             } else {
-                [lobe(-d, 0.0, s), lobe(d, 0.0, s), lobe(-d, 0.0, s), lobe(d, 0.0, s)]
+                [
+                    lobe(-d, 0.0, s),
+                    lobe(d, 0.0, s),
+                    lobe(-d, 0.0, s),
+                    lobe(d, 0.0, s),
+                ]
             };
             let (m, bound) = merge([&c[0], &c[1], &c[2], &c[3]]);
             let g = SlopeGaussian::from_moments(m, 0.01);

@@ -6,10 +6,12 @@
 //!   under each seed kernel k_i (eq. 5-6) and stores them (5 `f32` per lobe), with an implicit
 //!   quadtree of slope boxes (§5), a mip chain of the moments (§4.2.2), and the lobes again as
 //!   structure-of-arrays blocks of 4 × 4 with their P22 and masking coefficients precomputed in `f32`
-//!   (blocks.rs), which the per-direction queries evaluate 16 lanes at a time.
+//!   (blocks.rs), which the per-direction queries evaluate 16 lanes at a time; and levels of detail
+//!   l ≥ 1 of merged lobes stored the same way, with a per-node merge-error bound (levels.rs).
 //! - [`BeckmannMixture::patch`] turns a [`Footprint`] into a [`MixturePatch`], an [`Ndf`](crate::ndf::Ndf) whose
 //!   D_P(h) = Σ W_i D_i(h) (eq. 9) and whose masking terms are exact (eq. 10-17) or approximate
-//!   (§4.2.2), so that `MicrofacetBrdf::new(patch, fresnel)` is the P-BRDF of eq. 7.
+//!   (§4.2.2), so that `MicrofacetBrdf::new(patch, fresnel)` is the P-BRDF of eq. 7; on the
+//!   coarsest level of detail whose error bound meets [`PatchOptions::lod_tolerance`].
 //!
 //! The model, the hierarchy layout, the deviations from the paper and the defaults with their
 //! measurements are in docs/mixture.md.
@@ -302,7 +304,11 @@ pub struct MixtureMemory {
 impl MixtureMemory {
     /// Total bytes (lobes, hierarchy, mip chain, blocks and levels of detail).
     pub fn total(&self) -> usize {
-        self.lobe_bytes + self.hierarchy_bytes + self.mip_bytes + self.block_bytes + self.level_bytes
+        self.lobe_bytes
+            + self.hierarchy_bytes
+            + self.mip_bytes
+            + self.block_bytes
+            + self.level_bytes
     }
 }
 
@@ -317,7 +323,8 @@ impl MixtureMemory {
 /// Stored per lobe: the 5 moments as `f32` (20 bytes, what files hold); the lobe blocks derived from
 /// them (32 bytes: mean, Cholesky factor and its scaled inverse in `f32`, structure-of-arrays tiles of
 /// 4 × 4 lobes that `d`, the exact masking and the samplers evaluate 16 lanes at a time); the quadtree
-/// of slope boxes (~5.3 bytes per lobe) and the moment mip chain (~6.7 bytes per lobe), see
+/// of slope boxes (~5.3 bytes per lobe), the moment mip chain (~6.7 bytes per lobe) and the levels of
+/// detail (~20 bytes per lobe for a full chain: merged lobes, blocks, quadtree, merge error), see
 /// [`BeckmannMixture::memory`] and docs/mixture.md ("Lobe blocks").
 ///
 /// # Reference

@@ -4,7 +4,9 @@
 //! Per-footprint work (done once in [`MixturePatch::new`]): the effective Gaussian k_i ∗ k_P in lobe
 //! units, the rectangle of lobes within `weight_sigmas` of it, their normalised weights W_i (stored
 //! densely per "slot" of the rectangle, with a cdf for sampling), the patch mean slope and the
-//! filtered lobe of the moment mip chain. An axis of the rectangle at least one period long is
+//! filtered lobe of the moment mip chain. All of it at one level of detail (levels.rs): the coarsest
+//! whose weighted merge-error bound meets the tolerance, moved coarser by the cost cap; the
+//! "lobes" below are that level's nodes (the lobes themselves at level 0). An axis of the rectangle at least one period long is
 //! folded onto the lobe grid (a lobe's slot then carries the sum of its periodic images' weights),
 //! so a patch never holds more slots than the map has lobes.
 
@@ -782,12 +784,7 @@ impl<'a> MixturePatch<'a> {
         for r in &g.rects[..g.n_rects] {
             for by in r.by0..r.by0 + r.bh {
                 for bx in r.bx0..r.bx0 + r.bw {
-                    f(
-                        self.lv.blocks.block(bx, by),
-                        r.weights(bw, bx, by),
-                        bx,
-                        by,
-                    );
+                    f(self.lv.blocks.block(bx, by), r.weights(bw, bx, by), bx, by);
                 }
             }
         }
