@@ -1160,14 +1160,14 @@ fn level_d_equals_the_brute_force_sum() {
     }
 }
 
-/// Both samplers of a level-2 patch (white-noise map, 256-texel footprint) against their pdfs, by
+/// Both samplers of a level-2 patch (white-noise map, 1024-texel footprint) against their pdfs, by
 /// the chi-square harness (as `chi_square_of_both_samplers` at level 0), and the white furnace of
 /// level ≥ 1 patches on the procedural maps (as `white_furnace_exact_and_approximate`): the merged
 /// lobes go through the same D, masking and sampling code, with the same guarantees.
 #[test]
 fn chi_square_and_furnace_at_a_merged_level() {
     let mix = BeckmannMixture::build(&noise(N, 4), exact_params()).unwrap();
-    let patch = merged_patch(&mix, 256.0, MaskingMode::Exact);
+    let patch = merged_patch(&mix, 1024.0, MaskingMode::Exact);
     assert_eq!(patch.level(), 2);
     let cfg = |name: &str| Chi2 {
         res_z: 100,
@@ -1201,6 +1201,46 @@ fn chi_square_and_furnace_at_a_merged_level() {
                     e.is_finite() && e <= 1.0 + 4.0 * err + 1e-5,
                     "{name} level {} {masking:?} θo={theta}: albedo {e} ± {err}",
                     patch.level()
+                );
+            }
+        }
+    }
+}
+
+/// The tolerance check of `level_of_detail_respects_its_tolerance` on the 512² procedural maps
+/// (where nodes merge at more footprints), with its table for docs/results.md: per map, footprint
+/// and tolerance, the level, the bound Σ W_n e(n) and the measured TV to the full mixture.
+///
+/// `cargo test --release --test mixture -- --ignored lod_check --nocapture`
+#[test]
+#[ignore]
+fn lod_check() {
+    let n = 512;
+    println!("| map | texels | tolerance | level | bound | TV to the full mixture |");
+    println!("|---|---|---|---|---|---|");
+    for (name, map) in support::procedural_maps(n) {
+        let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
+        for area in [64.0f32, 256.0, 1024.0] {
+            let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
+            let full = mix.patch(&fp);
+            let gv = grid_values(&full);
+            for tol in [0.03f32, 0.1, 0.3] {
+                let p = mix.patch_with(
+                    &fp,
+                    PatchOptions {
+                        lod_tolerance: tol,
+                        ..exact_params().patch
+                    },
+                );
+                let (tv, q) = tv_to_grid(&p, &gv);
+                let bound = p.lod_error() as f64;
+                println!(
+                    "| {name} | {area} | {tol} | {} | {bound:.4} | {tv:.4} ± {q:.0e} |",
+                    p.level()
+                );
+                assert!(
+                    tv <= bound + 3.0 * q,
+                    "{name} {area} {tol}: TV {tv} > {bound}"
                 );
             }
         }

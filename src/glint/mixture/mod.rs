@@ -93,9 +93,13 @@ pub const DEFAULT_LOD_LOBES: f32 = 16384.0;
 /// of merged lobes and the full mixture that a patch may spend (e(n) the merge error of node n,
 /// src/glint/mixture/levels.rs). 0 keeps the full mixture.
 ///
-/// Chosen from the footprint sweep of docs/results.md ("Levels of detail chosen by error"): see
-/// docs/mixture.md for the chart and the reasons.
-pub const DEFAULT_LOD_TOLERANCE: f32 = 0.1;
+/// Since |TV(lod, R) − TV(full, R)| ≤ TV(lod, full) for any reference R, the tolerance bounds the
+/// increase of the TV to any (binned) ground truth, up to the node-weight approximation
+/// (docs/mixture.md). 0.01 is issue 15's budget for that increase; the footprint sweep of
+/// docs/results.md ("Levels of detail chosen by error") measured +0.013 at 0.1 on the scratched map
+/// (within that tolerance, over the 0.01 budget) for 5× cheaper `d`. The bound is conservative: at
+/// 0.01 the tolerance alone merged nothing in that sweep, and smooth maps merge only under the cost cap.
+pub const DEFAULT_LOD_TOLERANCE: f32 = 0.01;
 
 /// How the build integrates each lobe's five slope moments (\[Chermain2019\] eq. 6).
 ///
@@ -160,7 +164,7 @@ pub struct PatchOptions {
     pub lod_lobes: f32,
     /// Error tolerance of the level of detail ([`DEFAULT_LOD_TOLERANCE`]): a patch uses the
     /// coarsest level of merged lobes whose weighted merge-error bound Σ W_n e(n) is at most this
-    /// (and whose nodes are no wider than the footprint's smaller standard deviation); 0 keeps the
+    /// (and whose nodes are no wider than half the footprint's smaller standard deviation); 0 keeps the
     /// full mixture (level 0), unless the cost cap moves it. Not stored in saved files.
     pub lod_tolerance: f32,
 }

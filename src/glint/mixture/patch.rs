@@ -220,7 +220,7 @@ fn clamped_covariance(vx: f64, vy: f64, c: f64, s2: f64) -> f64 {
 ///   Σ W_i ⟨wo,m⟩⁺ D_i / V_P(wo) = `pdf_visible` (exact V_P in both masking modes).
 /// - Level of detail: the patch is made of the nodes of one level l of merged lobes
 ///   (src/glint/mixture/levels.rs; l = 0 is the lobes themselves): the coarsest level whose nodes
-///   are no wider than the footprint's smaller standard deviation and whose bound Σ W_n e(n) on the
+///   are no wider than half the footprint's smaller standard deviation and whose bound Σ W_n e(n) on the
 ///   TV to the full mixture is at most `lod_tolerance`, then moved coarser if the footprint still
 ///   covers more than `lod_lobes` nodes (the filtered lobe alone if no level is coarse enough).
 ///   D_P, both masking modes, both samplers and their pdfs all use that one level.
@@ -462,9 +462,10 @@ impl<'a> MixturePatch<'a> {
     /// first whose Σ W_n e(n) meets the tolerance (the finest is taken regardless); `None` for the
     /// filtered lobe alone.
     ///
-    /// - coarsest: the largest l with 2^l ≤ σ_min(Σ_P) (a node no wider than the footprint's
-    ///   smaller standard deviation, so that its lobes' weights vary little across it; measured in
-    ///   docs/results.md) among the built levels; 0 when the tolerance is 0;
+    /// - coarsest: the largest l with 2^l ≤ σ_min(Σ_P)/2 (a node no wider than half the
+    ///   footprint's smaller standard deviation, so that its lobes' weights vary little across it:
+    ///   with nodes as wide as σ the weight approximation alone cost 0.02 in TV on scratched at 64
+    ///   texels, docs/results.md) among the built levels; 0 when the tolerance is 0;
     /// - finest: the smallest l whose node count (area / 4^l) is within the cost cap `lod_lobes`;
     ///   if that exceeds the built levels, the filtered lobe.
     fn level_range(
@@ -485,7 +486,7 @@ impl<'a> MixturePatch<'a> {
         let mut coarsest = 0;
         if options.lod_tolerance > 0.0 {
             let s = fp.min_variance().sqrt();
-            while coarsest < top && (2u64 << coarsest) as f64 <= s {
+            while coarsest < top && (2u64 << coarsest) as f64 <= 0.5 * s {
                 coarsest += 1;
             }
         }
@@ -521,8 +522,9 @@ impl<'a> MixturePatch<'a> {
             }
         }
         let total: f64 = w.iter().sum();
-        // total ≥ the nearest lobe's weight ≥ exp(−½ · 2 · 0.5²/σ_k²) ≈ 0.06 (|d| ≤ ½ per axis,
-        // Σ_eff ≥ σ_k² I), so the division is safe.
+        // total ≥ the nearest node's weight ≥ exp(−½ · 2 · 0.5²/v) with v the smallest variance of
+        // Σ_eff: σ_k² ≈ 0.18 at level 0 (≈ 0.06), (σ_k² + (4^l − 1)/12)/4^l > 1/12 at level l (> 0.04)
+        // (|d| ≤ ½ per axis), so the division is safe.
         let inv = if total > 0.0 { 1.0 / total } else { 0.0 };
         let mut acc = 0.0;
         // Σ W μ and Σ W (Σ + μ μᵀ) with the lobes' covariances as D uses them.
