@@ -230,8 +230,9 @@ fn clamped_covariance(vx: f64, vy: f64, c: f64, s2: f64) -> f64 {
 #[derive(Clone, Debug)]
 pub struct MixturePatch<'a> {
     mixture: &'a BeckmannMixture,
-    /// The level of detail the patch reads (its lobes, blocks, quadtree).
-    lv: LevelRef<'a>,
+    /// The level of detail the patch reads (its lobes, blocks, quadtree): see [`MixturePatch::lv`].
+    /// (An index, not a [`LevelRef`], to keep the patch small inside `GlintPatch`.)
+    level: usize,
     masking: MaskingMode,
     /// The Beckmann lobe of the filtered moments (§4.2.2).
     filtered: SlopeGaussian,
@@ -450,7 +451,7 @@ impl<'a> MixturePatch<'a> {
         };
         MixturePatch {
             mixture,
-            lv,
+            level: lv.level,
             masking: options.masking,
             filtered,
             gathered,
@@ -631,7 +632,13 @@ impl<'a> MixturePatch<'a> {
     /// The level of detail l the patch reads: its lobes are the merged lobes of 2^l × 2^l blocks of
     /// the mixture's lobes (0: the lobes themselves; also 0 under the filtered lobe).
     pub fn level(&self) -> usize {
-        self.lv.level
+        self.level
+    }
+
+    /// The level the patch reads.
+    #[inline]
+    fn lv(&self) -> LevelRef<'a> {
+        self.mixture.level_ref(self.level)
     }
 
     /// The level of detail's error bound Σ W_n e(n): an upper bound of the TV between this patch's
@@ -669,8 +676,9 @@ impl<'a> MixturePatch<'a> {
     #[inline]
     fn slot_lobe(&self, g: &Gathered, s: usize) -> SlopeGaussian {
         let lx = g.axes[0].len;
-        let k = g.axes[1].lobe_of_slot(s / lx) * self.lv.grid[0] + g.axes[0].lobe_of_slot(s % lx);
-        self.lv.lobe_at(k)
+        let lv = self.lv();
+        let k = g.axes[1].lobe_of_slot(s / lx) * lv.grid[0] + g.axes[0].lobe_of_slot(s % lx);
+        lv.lobe_at(k)
     }
 
     /// D_P(m) and the number of lobes whose D_i was evaluated: 16 per lobe block whose box (and
@@ -710,7 +718,7 @@ impl<'a> MixturePatch<'a> {
     /// down to the lobe blocks (level 2) restricted to each lobe rectangle of the footprint, then
     /// the 16 lanes of each block reached at once ([`blocks::p22_lanes`]).
     fn sum_p22(&self, g: &Gathered, s: Vec2) -> (f64, usize) {
-        let (mix, lv) = (self.mixture, &self.lv);
+        let (mix, lv) = (self.mixture, self.lv());
         let k2 = mix.box_k * mix.box_k;
         let bw = &g.bufs.block_weights;
         let mut acc = [0.0f64; LANES];
@@ -731,7 +739,7 @@ impl<'a> MixturePatch<'a> {
     /// The scalar walk (former path): Σ W_i P22_i(s) over the lobes whose slope box contains s, by
     /// a depth-first walk of the quadtree to its leaves, each lobe rebuilt from its moments.
     fn sum_p22_scalar(&self, g: &Gathered, s: Vec2) -> (f64, usize) {
-        let (mix, lv) = (self.mixture, &self.lv);
+        let (mix, lv) = (self.mixture, self.lv());
         let tree = lv.tree;
         let [nx, _] = lv.grid;
         let lx = g.axes[0].len;
@@ -783,10 +791,11 @@ impl<'a> MixturePatch<'a> {
         mut f: impl FnMut(&blocks::LobeBlock, &[f32; LANES], usize, usize),
     ) {
         let bw = &g.bufs.block_weights;
+        let blocks = self.lv().blocks;
         for r in &g.rects[..g.n_rects] {
             for by in r.by0..r.by0 + r.bh {
                 for bx in r.bx0..r.bx0 + r.bw {
-                    f(self.lv.blocks.block(bx, by), r.weights(bw, bx, by), bx, by);
+                    f(blocks.block(bx, by), r.weights(bw, bx, by), bx, by);
                 }
             }
         }
@@ -1050,7 +1059,7 @@ impl MixturePatch<'_> {
             u.x.clamp(0.0, 1.0)
         } as f64;
         let target = ux * total;
-        let nx = self.lv.grid[0];
+        let nx = self.lv().grid[0];
         let lobe = |bx: usize, by: usize, lane: usize| {
             (by * SIDE + lane / SIDE) * nx + bx * SIDE + lane % SIDE
         };
@@ -1092,7 +1101,7 @@ impl MixturePatch<'_> {
             return self.sample_normal(u);
         }
         let r = r.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-        self.lv.lobe_at(k).sample_visible(wo, Vec2::new(r, u.y))
+        self.lv().lobe_at(k).sample_visible(wo, Vec2::new(r, u.y))
     }
 
     /// The scalar visible sampler (the patch's `sample_visible`):
