@@ -54,6 +54,7 @@ fn params() -> MixtureParams {
         patch: PatchOptions {
             masking: MaskingMode::Exact,
             lod_lobes: f32::INFINITY,
+            lod_tolerance: 0.0,
         },
         ..MixtureParams::default()
     }
@@ -184,6 +185,7 @@ fn queries(c: &mut Criterion) {
             let options = PatchOptions {
                 masking: MaskingMode::Approximate,
                 lod_lobes: f32::INFINITY,
+                lod_tolerance: 0.0,
             };
             let patch = mix.patch_with(&footprint(area), options);
             g.bench_with_input(BenchmarkId::from_parameter(area), &w, |b, w| {
@@ -238,5 +240,46 @@ fn build_method(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, build, queries, build_method);
+/// The levels of detail (issue 15 item 2): `d` and `patch()` of the full mixture (`full`: tolerance 0,
+/// no cap) against the default level of detail (`lod`: [`brdf::glint::DEFAULT_LOD_TOLERANCE`] and
+/// the default cost cap), alternating per footprint, 256 to 65 536 texels; the same 32 normals
+/// (drawn from the full patch) for both.
+///
+/// `cargo bench --bench mixture -- mixture_lod --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+fn lod(c: &mut Criterion) {
+    let full = PatchOptions {
+        masking: MaskingMode::Exact,
+        lod_lobes: f32::INFINITY,
+        lod_tolerance: 0.0,
+    };
+    let lod = PatchOptions::default();
+    for (name, map) in maps() {
+        let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
+        let mut g = c.benchmark_group(format!("mixture_lod_d/{name}"));
+        g.throughput(Throughput::Elements(BATCH as u64));
+        for area in [256.0f32, 1024.0, 4096.0, 16384.0, 65536.0] {
+            let f = footprint(area);
+            let m = normals(&mix.patch_with(&f, full), 7);
+            for (label, o) in [("full", full), ("lod", lod)] {
+                let patch = mix.patch_with(&f, o);
+                g.bench_with_input(BenchmarkId::new(label, area), &m, |b, m| {
+                    b.iter(|| m.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
+                });
+            }
+        }
+        g.finish();
+        let mut g = c.benchmark_group(format!("mixture_lod_patch/{name}"));
+        for area in [256.0f32, 4096.0, 65536.0] {
+            let f = footprint(area);
+            for (label, o) in [("full", full), ("lod", lod)] {
+                g.bench_with_input(BenchmarkId::new(label, area), &f, |b, f| {
+                    b.iter(|| mix.patch_with(black_box(f), o).lobe_count())
+                });
+            }
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, build, queries, build_method, lod);
 criterion_main!(benches);

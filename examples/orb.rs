@@ -76,7 +76,12 @@ mod tests {
     fn variants(m: &BeckmannMixture) -> [MixtureVariant<'_>; 3] {
         let v = |masking, lod_lobes| MixtureVariant {
             mixture: m,
-            options: PatchOptions { masking, lod_lobes },
+            // Tolerance 0: the full mixture (or the filtered lobe), not a level of detail.
+            options: PatchOptions {
+                masking,
+                lod_lobes,
+                lod_tolerance: 0.0,
+            },
         };
         [
             v(MaskingMode::Exact, f32::INFINITY),

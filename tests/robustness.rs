@@ -257,7 +257,11 @@ proptest! {
 fn quick_mixture_params(masking: MaskingMode, lod_lobes: f32) -> MixtureParams {
     MixtureParams {
         samples: 16,
-        patch: PatchOptions { masking, lod_lobes },
+        patch: PatchOptions {
+            masking,
+            lod_lobes,
+            ..PatchOptions::default()
+        },
         ..MixtureParams::default()
     }
 }
@@ -391,7 +395,7 @@ proptest! {
         wo in grazing_dir_from(1.75e-3), // θo ≤ 89.9°
     ) {
         let mixture = BeckmannMixture::build(&map, quick_mixture_params(MaskingMode::Exact, f32::INFINITY)).unwrap();
-        let approximate = PatchOptions { masking: MaskingMode::Approximate, lod_lobes: f32::INFINITY };
+        let approximate = PatchOptions { masking: MaskingMode::Approximate, lod_lobes: f32::INFINITY, ..PatchOptions::default() };
         let bin_map = BinMap::build(&map, small_bins()).unwrap();
         let pn = PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap();
         let (mix, mix_approx, bins, smoothed, pnp) = (

@@ -128,6 +128,7 @@ fn mixture_round_trip_is_exact() {
             patch: PatchOptions {
                 masking,
                 lod_lobes: lod,
+                ..PatchOptions::default()
             },
             ..MixtureParams::default()
         };

@@ -102,7 +102,12 @@ pub type Builder = fn(&NormalMap, &Settings) -> Res<Vec<Box<dyn Method>>>;
 /// and the single filtered Beckmann lobe (the cheapest model).
 fn mixture_methods(map: &NormalMap, settings: &Settings) -> Res<Vec<Box<dyn Method>>> {
     let mix = Arc::new(BeckmannMixture::build(map, MixtureParams::default())?);
-    let opts = |masking, lod_lobes| PatchOptions { masking, lod_lobes };
+    // Tolerance 0: these rows are the full mixture (or the filtered lobe), not a level of detail.
+    let opts = |masking, lod_lobes| PatchOptions {
+        masking,
+        lod_lobes,
+        lod_tolerance: 0.0,
+    };
     let inf = f32::INFINITY;
     let m = |options, label, mip_only| -> Box<dyn Method> {
         Box::new(Mixture {

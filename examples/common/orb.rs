@@ -798,6 +798,7 @@ pub fn render_all(opts: &OrbOptions, map: &NormalMap) -> Res<(References, f64, V
         options: PatchOptions {
             masking: MaskingMode::Approximate,
             lod_lobes: 0.0,
+            ..PatchOptions::default()
         },
     };
     // The two other glint methods at their defaults, through the same `MicrofacetBrdf` (for the

@@ -33,6 +33,7 @@ fuzz_target!(|input: Input| {
                 MaskingMode::Exact
             },
             lod_lobes: input.lod_lobes,
+            ..PatchOptions::default()
         },
         ..MixtureParams::default()
     };

@@ -4,12 +4,15 @@
 //! Per-footprint work (done once in [`MixturePatch::new`]): the effective Gaussian k_i ∗ k_P in lobe
 //! units, the rectangle of lobes within `weight_sigmas` of it, their normalised weights W_i (stored
 //! densely per "slot" of the rectangle, with a cdf for sampling), the patch mean slope and the
-//! filtered lobe of the moment mip chain. An axis of the rectangle at least one period long is
+//! filtered lobe of the moment mip chain. All of it at one level of detail (levels.rs): the coarsest
+//! whose weighted merge-error bound meets the tolerance, moved coarser by the cost cap; the
+//! "lobes" below are that level's nodes (the lobes themselves at level 0). An axis of the rectangle at least one period long is
 //! folded onto the lobe grid (a lobe's slot then carries the sum of its periodic images' weights),
 //! so a patch never holds more slots than the map has lobes.
 
 use super::blocks::{self, LANES, SIDE};
 use super::hierarchy::lobe_box;
+use super::levels::LevelRef;
 use super::{BeckmannMixture, MaskingMode, PatchOptions, build::kernel_sigma};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
@@ -167,6 +170,9 @@ struct Gathered<'a> {
     n_rects: usize,
     /// Σ W_i μ_i: the patch mean slope.
     mean_slope: Vec2,
+    /// Σ W_n e(n): the bound of the TV between this level's patch and the full mixture's
+    /// (0 at level 0).
+    lod_error: f64,
     /// The patch's slope covariance Σ_P = Σ W_i (Σ_i + μ_i μ_iᵀ) − μ_P μ_Pᵀ, [xx, xy, yy] (f64), with
     /// each lobe's covariance as its D uses it (floored, correlation clamped): the second moment that
     /// the approximate masking's Scarf bound needs.
@@ -212,13 +218,21 @@ fn clamped_covariance(vx: f64, vy: f64, c: f64, s2: f64) -> f64 {
 /// - Samplers: `sample_normal` draws a lobe ∝ W_i then its slope Gaussian (exactly D_P cos θ);
 ///   `sample_visible` draws a lobe ∝ W_i V_i(wo) then that lobe's visible normal, density
 ///   Σ W_i ⟨wo,m⟩⁺ D_i / V_P(wo) = `pdf_visible` (exact V_P in both masking modes).
-/// - Level of detail: a footprint of more than `lod_lobes` lobes is the filtered lobe alone.
+/// - Level of detail: the patch is made of the nodes of one level l of merged lobes
+///   (src/glint/mixture/levels.rs; l = 0 is the lobes themselves): the coarsest level whose nodes
+///   are no wider than half the footprint's smaller standard deviation and whose bound Σ W_n e(n) on the
+///   TV to the full mixture is at most `lod_tolerance`, then moved coarser if the footprint still
+///   covers more than `lod_lobes` nodes (the filtered lobe alone if no level is coarse enough).
+///   D_P, both masking modes, both samplers and their pdfs all use that one level.
 ///
 /// # Reference
 /// \[Chermain2019\] eq. 7-17, §4.2.2, §5.
 #[derive(Clone, Debug)]
 pub struct MixturePatch<'a> {
     mixture: &'a BeckmannMixture,
+    /// The level of detail the patch reads (its lobes, blocks, quadtree): see [`MixturePatch::lv`].
+    /// (An index, not a [`LevelRef`], to keep the patch small inside `GlintPatch`.)
+    level: usize,
     masking: MaskingMode,
     /// The Beckmann lobe of the filtered moments (§4.2.2).
     filtered: SlopeGaussian,
@@ -238,30 +252,61 @@ struct Effective {
     inv: [f64; 3],
 }
 
-impl Effective {
-    fn new(mix: &BeckmannMixture, footprint: &Footprint) -> (Effective, f64) {
+/// The footprint's Gaussian k_P in level-0 lobe units: centre and covariance [xx, xy, yy].
+struct FootprintLobes {
+    c: [f64; 2],
+    cov: [f64; 3],
+}
+
+impl FootprintLobes {
+    fn new(mix: &BeckmannMixture, footprint: &Footprint) -> FootprintLobes {
         let (c, s) = footprint.gaussian_texels(mix.width, mix.height);
         let [hx, hy] = mix.spacing;
-        let c = [c.x as f64 / hx, c.y as f64 / hy];
-        let (sxx, sxy, syy) = (
-            s.x_axis.x as f64 / (hx * hx),
-            s.x_axis.y as f64 / (hx * hy),
-            s.y_axis.y as f64 / (hy * hy),
-        );
-        let det_p = (sxx * syy - sxy * sxy).max(0.0);
-        let area = 12.0 * det_p.sqrt();
-        let k2 = kernel_sigma(1.0).powi(2);
-        let (a, b, d) = (sxx + k2, sxy, syy + k2);
+        FootprintLobes {
+            c: [c.x as f64 / hx, c.y as f64 / hy],
+            cov: [
+                s.x_axis.x as f64 / (hx * hx),
+                s.x_axis.y as f64 / (hx * hy),
+                s.y_axis.y as f64 / (hy * hy),
+            ],
+        }
+    }
+
+    /// The footprint's area in lobe cells (12 √det Σ_P: a uniform square of side a has σ² = a²/12).
+    fn area(&self) -> f64 {
+        let [sxx, sxy, syy] = self.cov;
+        12.0 * (sxx * syy - sxy * sxy).max(0.0).sqrt()
+    }
+
+    /// The smaller eigenvalue of Σ_P (lobe units²).
+    fn min_variance(&self) -> f64 {
+        let [a, b, d] = self.cov;
+        let m = 0.5 * (a + d);
+        let r = (0.25 * (a - d) * (a - d) + b * b).sqrt();
+        (m - r).max(0.0)
+    }
+}
+
+impl Effective {
+    /// The effective Gaussian of the nodes of level l, in that level's units (a node spans 2^l
+    /// lobes): centre c / 2^l and covariance (Σ_P + (σ_k² + (4^l − 1)/12) I) / 4^l. The added
+    /// (4^l − 1)/12 is the variance of the 2^l lobe positions a node spans along each axis, so a
+    /// node's weight is the moment-matched Gaussian of the sum of its lobes' weights (exact at
+    /// l = 0, where the formula is the level-0 effective Gaussian k_i ∗ k_P).
+    fn at_level(fp: &FootprintLobes, l: usize) -> Effective {
+        let n2 = (1u64 << (2 * l)) as f64;
+        let k2 = kernel_sigma(1.0).powi(2) + (n2 - 1.0) / 12.0;
+        let scale = 1.0 / (1u64 << l) as f64;
+        let c = [fp.c[0] * scale, fp.c[1] * scale];
+        let [sxx, sxy, syy] = fp.cov;
+        let (a, b, d) = ((sxx + k2) / n2, sxy / n2, (syy + k2) / n2);
         let det = a * d - b * b;
         let inv = [d / det, -b / det, a / det];
-        (
-            Effective {
-                c,
-                cov: [a, b, d],
-                inv,
-            },
-            area,
-        )
+        Effective {
+            c,
+            cov: [a, b, d],
+            inv,
+        }
     }
 
     /// The weights of lobes (i0, j), (i0 + 1, j), … along a row, by the exact recurrence of a
@@ -383,17 +428,30 @@ impl<'a> MixturePatch<'a> {
             Some(s) => (Some(&mut s.mixture.slots), Some(&mut s.mixture.lobes)),
             None => (None, None),
         };
-        let (eff, area) = Effective::new(mixture, footprint);
+        let fp = FootprintLobes::new(mixture, footprint);
+        let area = fp.area();
         let lod = 0.5 * area.max(1e-300).log2();
-        let filtered_m = mixture.pyramid.filtered(&mixture.lobes, eff.c, lod);
+        let filtered_m = mixture.pyramid.filtered(&mixture.lobes, fp.c, lod);
         let filtered = SlopeGaussian::from_moments(filtered_m, mixture.params.sigma_min);
-        let gathered = if area > options.lod_lobes as f64 {
-            None
-        } else {
-            Some(Self::gather(mixture, &eff, Lent::new(slots)))
+        let (lv, gathered) = match Self::level_range(mixture, &fp, area, &options) {
+            None => (mixture.level_ref(0), None),
+            Some((finest, coarsest)) => {
+                let mut bufs = Lent::new(slots);
+                let mut l = coarsest;
+                loop {
+                    let lv = mixture.level_ref(l);
+                    let g = Self::gather(mixture, lv, &Effective::at_level(&fp, l), bufs);
+                    if l == finest || g.lod_error <= options.lod_tolerance as f64 {
+                        break (lv, Some(g));
+                    }
+                    bufs = g.bufs;
+                    l -= 1;
+                }
+            }
         };
         MixturePatch {
             mixture,
+            level: lv.level,
             masking: options.masking,
             filtered,
             gathered,
@@ -401,16 +459,52 @@ impl<'a> MixturePatch<'a> {
         }
     }
 
+    /// The levels a patch may use, (finest, coarsest), searched from the coarsest down to the
+    /// first whose Σ W_n e(n) meets the tolerance (the finest is taken regardless); `None` for the
+    /// filtered lobe alone.
+    ///
+    /// - coarsest: the largest l with 2^l ≤ σ_min(Σ_P)/2 (a node no wider than half the
+    ///   footprint's smaller standard deviation, so that its lobes' weights vary little across it:
+    ///   with nodes as wide as σ the weight approximation alone cost 0.02 in TV on scratched at 64
+    ///   texels, docs/results.md) among the built levels; 0 when the tolerance is 0;
+    /// - finest: the smallest l whose node count (area / 4^l) is within the cost cap `lod_lobes`;
+    ///   if that exceeds the built levels, the filtered lobe.
+    fn level_range(
+        mix: &BeckmannMixture,
+        fp: &FootprintLobes,
+        area: f64,
+        options: &PatchOptions,
+    ) -> Option<(usize, usize)> {
+        let top = mix.level_count() - 1;
+        let cap = options.lod_lobes as f64;
+        let mut finest = 0;
+        while area / (1u64 << (2 * finest)) as f64 > cap {
+            finest += 1;
+            if finest > top {
+                return None;
+            }
+        }
+        let mut coarsest = 0;
+        if options.lod_tolerance > 0.0 {
+            let s = fp.min_variance().sqrt();
+            while coarsest < top && (2u64 << coarsest) as f64 <= 0.5 * s {
+                coarsest += 1;
+            }
+        }
+        Some((finest, coarsest.max(finest)))
+    }
+
     fn gather<'b>(
         mix: &BeckmannMixture,
+        lv: LevelRef<'_>,
         eff: &Effective,
         mut bufs: Lent<'b, SlotBuffers>,
     ) -> Gathered<'b> {
         let t = mix.params.weight_sigmas as f64;
         let half = [t * eff.cov[0].sqrt(), t * eff.cov[2].sqrt()];
         let axes = [
-            AxisSlots::new(eff.c[0], half[0], mix.grid[0]),
-            AxisSlots::new(eff.c[1], half[1], mix.grid[1]),
+            AxisSlots::new(eff.c[0], half[0], lv.grid[0]),
+            AxisSlots::new(eff.c[1], half[1], lv.grid[1]),
         ];
         let (lx, ly) = (axes[0].len, axes[1].len);
         // Raw weights are summed into the cdf buffer, then normalised and accumulated in place.
@@ -429,21 +523,24 @@ impl<'a> MixturePatch<'a> {
             }
         }
         let total: f64 = w.iter().sum();
-        // total ≥ the nearest lobe's weight ≥ exp(−½ · 2 · 0.5²/σ_k²) ≈ 0.06 (|d| ≤ ½ per axis,
-        // Σ_eff ≥ σ_k² I), so the division is safe.
+        // total ≥ the nearest node's weight ≥ exp(−½ · 2 · 0.5²/v) with v the smallest variance of
+        // Σ_eff: σ_k² ≈ 0.18 at level 0 (≈ 0.06), (σ_k² + (4^l − 1)/12)/4^l > 1/12 at level l (> 0.04)
+        // (|d| ≤ ½ per axis), so the division is safe.
         let inv = if total > 0.0 { 1.0 / total } else { 0.0 };
         let mut acc = 0.0;
         // Σ W μ and Σ W (Σ + μ μᵀ) with the lobes' covariances as D uses them.
         let mut m1 = [0.0f64; 2];
         let mut m2 = [0.0f64; 3];
+        let mut lod_error = 0.0f64;
         let s2 = sigma_floor_squared(mix.params.sigma_min);
         weights.extend(w.iter_mut().enumerate().map(|(s, wi)| {
             let wn = *wi * inv;
             acc += wn;
             *wi = acc;
-            let k = axes[1].lobe_of_slot(s / lx) * mix.grid[0] + axes[0].lobe_of_slot(s % lx);
-            let (mu, cov) = lobe_mean_cov(&mix.lobes[k], s2).unwrap_or_else(|| {
-                let lobe = mix.lobe_at(k);
+            let k = axes[1].lobe_of_slot(s / lx) * lv.grid[0] + axes[0].lobe_of_slot(s % lx);
+            lod_error += wn * lv.error_at(k) as f64;
+            let (mu, cov) = lobe_mean_cov(&lv.moments[k], s2).unwrap_or_else(|| {
+                let lobe = lv.lobe_at(k);
                 let (mu, c) = (lobe.mean(), lobe.covariance());
                 let c = [c.x_axis.x, c.x_axis.y, c.y_axis.y].map(f64::from);
                 ([mu.x as f64, mu.y as f64], c)
@@ -468,6 +565,7 @@ impl<'a> MixturePatch<'a> {
             rects,
             n_rects,
             mean_slope: Vec2::new(m1[0] as f32, m1[1] as f32),
+            lod_error,
             slope_cov,
         }
     }
@@ -531,6 +629,25 @@ impl<'a> MixturePatch<'a> {
         self.gathered.is_none()
     }
 
+    /// The level of detail l the patch reads: its lobes are the merged lobes of 2^l × 2^l blocks of
+    /// the mixture's lobes (0: the lobes themselves; also 0 under the filtered lobe).
+    pub fn level(&self) -> usize {
+        self.level
+    }
+
+    /// The level the patch reads.
+    #[inline]
+    fn lv(&self) -> LevelRef<'a> {
+        self.mixture.level_ref(self.level)
+    }
+
+    /// The level of detail's error bound Σ W_n e(n): an upper bound of the TV between this patch's
+    /// D_P and the full mixture's with the same node weights (0 at level 0; 1 under the filtered
+    /// lobe, which has no bound). See src/glint/mixture/levels.rs.
+    pub fn lod_error(&self) -> f32 {
+        self.gathered.as_ref().map_or(1.0, |g| g.lod_error as f32)
+    }
+
     /// The Beckmann lobe of the footprint's filtered moments (\[Chermain2019\] §4.2.2): trilinear lookup
     /// in the moment mip chain at level log₂(√(footprint area in lobes)).
     pub fn filtered_lobe(&self) -> &SlopeGaussian {
@@ -559,9 +676,9 @@ impl<'a> MixturePatch<'a> {
     #[inline]
     fn slot_lobe(&self, g: &Gathered, s: usize) -> SlopeGaussian {
         let lx = g.axes[0].len;
-        let k =
-            g.axes[1].lobe_of_slot(s / lx) * self.mixture.grid[0] + g.axes[0].lobe_of_slot(s % lx);
-        self.mixture.lobe_at(k)
+        let lv = self.lv();
+        let k = g.axes[1].lobe_of_slot(s / lx) * lv.grid[0] + g.axes[0].lobe_of_slot(s % lx);
+        lv.lobe_at(k)
     }
 
     /// D_P(m) and the number of lobes whose D_i was evaluated: 16 per lobe block whose box (and
@@ -601,16 +718,16 @@ impl<'a> MixturePatch<'a> {
     /// down to the lobe blocks (level 2) restricted to each lobe rectangle of the footprint, then
     /// the 16 lanes of each block reached at once ([`blocks::p22_lanes`]).
     fn sum_p22(&self, g: &Gathered, s: Vec2) -> (f64, usize) {
-        let mix = self.mixture;
+        let (mix, lv) = (self.mixture, self.lv());
         let k2 = mix.box_k * mix.box_k;
         let bw = &g.bufs.block_weights;
         let mut acc = [0.0f64; LANES];
         let mut blocks_seen = 0usize;
         for r in &g.rects[..g.n_rects] {
-            blocks::for_each_block(&mix.tree, r.x, r.y, s, |bx, by| {
+            blocks::for_each_block(lv.tree, r.x, r.y, s, |bx, by| {
                 blocks_seen += 1;
                 let w = r.weights(bw, bx, by);
-                blocks::p22_lanes::<true>(mix.blocks.block(bx, by), w, s, k2, &mut acc);
+                blocks::p22_lanes::<true>(lv.blocks.block(bx, by), w, s, k2, &mut acc);
             });
         }
         (
@@ -622,9 +739,9 @@ impl<'a> MixturePatch<'a> {
     /// The scalar walk (former path): Σ W_i P22_i(s) over the lobes whose slope box contains s, by
     /// a depth-first walk of the quadtree to its leaves, each lobe rebuilt from its moments.
     fn sum_p22_scalar(&self, g: &Gathered, s: Vec2) -> (f64, usize) {
-        let mix = self.mixture;
-        let tree = &mix.tree;
-        let [nx, _] = mix.grid;
+        let (mix, lv) = (self.mixture, self.lv());
+        let tree = lv.tree;
+        let [nx, _] = lv.grid;
         let lx = g.axes[0].len;
         let (xs, nxs) = g.axes[0].segments();
         let (ys, nys) = g.axes[1].segments();
@@ -635,12 +752,12 @@ impl<'a> MixturePatch<'a> {
             for &(y_lo, y_hi, y_off) in &ys[..nys] {
                 tree.for_each_leaf((x_lo, x_hi), (y_lo, y_hi), s, |x, y| {
                     let k = y * nx + x;
-                    let p22 = match leaf.p22_in_box(&mix.lobes[k], s) {
+                    let p22 = match leaf.p22_in_box(&lv.moments[k], s) {
                         Leaf::Outside => return,
                         Leaf::Inside(p) => p,
                         // Non-finite moments: the lobe's documented fallback.
                         Leaf::Degenerate => {
-                            let lobe = mix.lobe_at(k);
+                            let lobe = lv.lobe_at(k);
                             if !contains(&lobe_box(&lobe, mix.box_k), s) {
                                 return;
                             }
@@ -674,15 +791,11 @@ impl<'a> MixturePatch<'a> {
         mut f: impl FnMut(&blocks::LobeBlock, &[f32; LANES], usize, usize),
     ) {
         let bw = &g.bufs.block_weights;
+        let blocks = self.lv().blocks;
         for r in &g.rects[..g.n_rects] {
             for by in r.by0..r.by0 + r.bh {
                 for bx in r.bx0..r.bx0 + r.bw {
-                    f(
-                        self.mixture.blocks.block(bx, by),
-                        r.weights(bw, bx, by),
-                        bx,
-                        by,
-                    );
+                    f(blocks.block(bx, by), r.weights(bw, bx, by), bx, by);
                 }
             }
         }
@@ -942,7 +1055,7 @@ impl MixturePatch<'_> {
             u.x.clamp(0.0, 1.0)
         } as f64;
         let target = ux * total;
-        let nx = self.mixture.grid[0];
+        let nx = self.lv().grid[0];
         let lobe = |bx: usize, by: usize, lane: usize| {
             (by * SIDE + lane / SIDE) * nx + bx * SIDE + lane % SIDE
         };
@@ -983,9 +1096,7 @@ impl MixturePatch<'_> {
             return self.sample_normal(u);
         }
         let r = r.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-        self.mixture
-            .lobe_at(k)
-            .sample_visible(wo, Vec2::new(r, u.y))
+        self.lv().lobe_at(k).sample_visible(wo, Vec2::new(r, u.y))
     }
 
     /// The scalar visible sampler (the patch's `sample_visible` before the lobe blocks; kept for the

@@ -156,7 +156,12 @@ impl BeckmannMixture {
             kernel_sigmas,
             weight_sigmas,
             slope_tail,
-            patch: PatchOptions { masking, lod_lobes },
+            // The level-of-detail tolerance is not stored (the format is unchanged): the default.
+            patch: PatchOptions {
+                masking,
+                lod_lobes,
+                ..PatchOptions::default()
+            },
             ..MixtureParams::default()
         };
         let refused = |e: crate::Error| store::invalid(format!("stored mixture refused: {e}"));
