@@ -136,10 +136,23 @@ fn smoothed(c: &mut Criterion) {
     let mut g = c.benchmark_group("binmap_smoothed_d_2048_256texels");
     g.throughput(Throughput::Elements(1024));
     let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), 256.0, SIZE, SIZE);
-    for alpha in [0.01f32, 0.02, 0.05] {
+    for alpha in [0.01f32, 0.02, 0.05, 0.1] {
         let patch = bm.patch_smoothed(&fp, alpha);
         let hs: Vec<Vec3> = (0..1024).map(|k| patch.sample_normal(r2(k))).collect();
         g.bench_with_input(BenchmarkId::from_parameter(alpha), &hs, |b, hs| {
+            b.iter(|| hs.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
+        });
+    }
+    g.finish();
+    // The grazing example's setting (α = 0.1) against the footprint: patches with exact masking
+    // terms (≤ 4096 texels) against the larger ones, which sum over a window of bins.
+    let mut g = c.benchmark_group("binmap_smoothed_d_2048_alpha0.1");
+    g.throughput(Throughput::Elements(1024));
+    for area in [64.0f32, 1024.0, 4096.0, 16384.0] {
+        let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, SIZE, SIZE);
+        let patch = bm.patch_smoothed(&fp, 0.1);
+        let hs: Vec<Vec3> = (0..1024).map(|k| patch.sample_normal(r2(k))).collect();
+        g.bench_with_input(BenchmarkId::from_parameter(area), &hs, |b, hs| {
             b.iter(|| hs.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
         });
     }

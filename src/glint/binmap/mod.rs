@@ -3,7 +3,8 @@
 //! parallelogram footprint with constant filtering in texture and half-vector space.
 //!
 //! - [`BinMap::build`] splits every texel into s × s sub-texels ([`BinMapParams::subdivisions`]),
-//!   assigns every sub-texel the bin of the interpolated normal at its centre (the bin map 𝓑; s = 1:
+//!   assigns every sub-texel the bin of the interpolated normal at a point inside it (n-rooks
+//!   pattern per texel; the bin map 𝓑; s = 1:
 //!   the texel-centre normal, as in the talk), counting-sorts the sub-texels by bin into one array
 //!   (the inverse bin map 𝓑⁻¹), builds one kd-tree per list longer than the leaf size L, packed into
 //!   one `u32` array, and a lookup bin → list ([`BinLookup`]: dense offsets or a hash table of the
@@ -54,10 +55,12 @@ pub const DEFAULT_LEAF_SIZE: usize = 16;
 pub const DEFAULT_MASKING_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
 
 /// Default sub-texel resolution s: each texel is binned as s × s sub-texels of the interpolated
-/// surface. 2 was chosen with [`DEFAULT_BINS_PER_AXIS`] from accuracy against memory on the
-/// procedural maps (docs/results.md, "The bin map, finished"): with 255² bins, at ≥ 256 texels, the
-/// TV distance to the ground truth is 1.6-3.8× below the talk's map (s = 1, 127²) for 2.8× its
-/// memory (29.2 B/texel at 2048²); s = 3 would reach 2.3-4.4× but costs 62.9 B/texel.
+/// surface (normals at n-rooks points, see [`BinMap::build`]). 2 was chosen with
+/// [`DEFAULT_BINS_PER_AXIS`] from accuracy against memory on the procedural maps (docs/results.md,
+/// "The bin map, finished" and "Memory, grazing cost and load"): with 255² bins, at ≥ 256 texels,
+/// the TV distance to the ground truth is 2.1-4.2× below the talk's map (s = 1, 127²) on bumpy,
+/// brushed and scratched for 2.8× its memory (29.2 B/texel at 2048²); s = 3 costs 62.9 B/texel,
+/// over the 42 B/texel budget whatever the integer widths (docs/binmap.md).
 pub const DEFAULT_SUBDIVISIONS: usize = 2;
 
 /// Largest accepted sub-texel resolution s (s² sub-texels per texel).
@@ -92,8 +95,9 @@ pub struct BinMapParams {
     /// filtered-moment Beckmann lobe, see [`BinMapPatch`]).
     pub sigma_min: f32,
     /// Sub-texel resolution s, 1 ≤ s ≤ [`MAX_SUBDIVISIONS`]: every texel is split into s × s
-    /// sub-texels, each a flat facet carrying the interpolated surface's normal at its centre
-    /// ([`NormalMap::normal_at_texel`]); the bin map, the inverse map and the forest work on the
+    /// sub-texels, each a flat facet carrying the interpolated surface's normal
+    /// ([`NormalMap::normal_at_texel`]) at one point inside it, the s² points of a texel in an
+    /// n-rooks pattern (s² distinct coordinates per axis; see [`BinMap::build`]); the bin map, the inverse map and the forest work on the
     /// (s·width) × (s·height) sub-texel grid. s = 1 is the talk's one-normal-per-texel map. Memory
     /// of 𝓑, 𝓑⁻¹ and the forest grows as s².
     pub subdivisions: usize,
@@ -348,14 +352,36 @@ fn check_params(params: &BinMapParams) -> Result<HemisphereBins> {
     Ok(bins)
 }
 
+/// The point, in texel units, whose interpolated normal sub-texel (I, J) of an s × s subdivision
+/// carries: with (a, b) = (I mod s, J mod s) its place in texel (⌊I/s⌋, ⌊J/s⌋),
+///
+/// x = ⌊I/s⌋ + (a + (s − 1 − b + ½)/s)/s,  y = ⌊J/s⌋ + (b + (a + ½)/s)/s.
+///
+/// Each point lies inside its own sub-texel, and the s² points of a texel fall in s² distinct
+/// strata of width 1/s² along x and along y (an n-rooks, "rotated grid" pattern; for s = 2 the
+/// points (⅜, ⅛), (⅞, ⅜), (⅛, ⅝), (⅝, ⅞)). The uniform grid of sub-texel centres has only s distinct
+/// coordinates per axis, so a map whose normals vary along one axis (brushed, scratched) was sampled
+/// s times per texel across it instead of s²: at s = 2, 255² bins, this pattern halves the TV distance
+/// to the ground truth on the brushed map at 256 texels (0.123 → 0.063) for a 1.16× loss on the
+/// isotropic bumpy map (docs/results.md, "Memory, grazing cost and load"). s = 1: the texel centre.
+fn subtexel_point(i: usize, j: usize, s: usize) -> Vec2 {
+    let (a, b) = (i % s, j % s);
+    let sf = s as f32;
+    Vec2::new(
+        (i / s) as f32 + (a as f32 + ((s - 1 - b) as f32 + 0.5) / sf) / sf,
+        (j / s) as f32 + (b as f32 + (a as f32 + 0.5) / sf) / sf,
+    )
+}
+
 impl BinMap {
     /// Builds the bin map, the inverse bin map, its forest and lookup from a normal map.
     ///
     /// The map is split into s × s sub-texels (s = `subdivisions`); sub-texel (I, J) of the
     /// (s·width) × (s·height) grid covers [I/s, (I + 1)/s) × [J/s, (J + 1)/s) in texel units and is a
-    /// flat facet with the interpolated surface's normal at its centre,
-    /// [`NormalMap::normal_at_texel`]((I + ½)/s, (J + ½)/s) (for s = 1 the texel-centre normal: the
-    /// talk's piecewise-constant map). 𝓑(k) = the bin of sub-texel k's normal; 𝓑⁻¹ by counting sort
+    /// flat facet with the interpolated surface's normal [`NormalMap::normal_at_texel`] at one point
+    /// inside it, placed in an n-rooks pattern per texel (x = ⌊I/s⌋ + (a + (s − 1 − b + ½)/s)/s,
+    /// y = ⌊J/s⌋ + (b + (a + ½)/s)/s with (a, b) = (I mod s, J mod s); for s = 1 the texel-centre
+    /// normal: the talk's piecewise-constant map). 𝓑(k) = the bin of sub-texel k's normal; 𝓑⁻¹ by counting sort
     /// (sub-texels in row-major order within a bin before the trees reorder them); one kd-tree per
     /// list longer than `leaf_size`. Cost O(s² · texels · log), the normals in parallel.
     ///
@@ -381,9 +407,8 @@ impl BinMap {
         // guards it.
         let pole = bins.bin_of(glam::Vec3::Z).unwrap_or(0);
         let mut bin_map = BinIndex::new(nb, texels);
-        let sf = s as f32;
         bin_map.fill(grid_w, |i, j| {
-            let p = Vec2::new((i as f32 + 0.5) / sf, (j as f32 + 0.5) / sf);
+            let p = subtexel_point(i, j, s);
             let n = if s == 1 {
                 // Exactly the stored texel normal (no interpolation round-off).
                 slope_to_normal(map.slopes()[j * width + i])
@@ -604,6 +629,34 @@ impl GlintNdf for BinMap {
 mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
+
+    /// The sub-texel points: each inside its own sub-texel, and per texel s² distinct strata of width
+    /// 1/s² on each axis (exact small rationals: compared after scaling by s² and flooring).
+    #[test]
+    fn subtexel_points_are_n_rooks_inside_their_subtexels() {
+        for s in 1..=MAX_SUBDIVISIONS {
+            for (ti, tj) in [(0usize, 0usize), (3, 5)] {
+                let (mut xs, mut ys) = (vec![false; s * s], vec![false; s * s]);
+                for b in 0..s {
+                    for a in 0..s {
+                        let (i, j) = (ti * s + a, tj * s + b);
+                        let p = subtexel_point(i, j, s);
+                        let (x, y) = (p.x as f64 * s as f64, p.y as f64 * s as f64);
+                        assert!(x > i as f64 && x < (i + 1) as f64, "s={s} ({i},{j}) x {x}");
+                        assert!(y > j as f64 && y < (j + 1) as f64, "s={s} ({i},{j}) y {y}");
+                        let sx = ((p.x as f64 - ti as f64) * (s * s) as f64).floor() as usize;
+                        let sy = ((p.y as f64 - tj as f64) * (s * s) as f64).floor() as usize;
+                        assert!(!xs[sx] && !ys[sy], "s={s}: stratum repeated");
+                        xs[sx] = true;
+                        ys[sy] = true;
+                    }
+                }
+            }
+        }
+        assert_eq!(subtexel_point(0, 0, 2), Vec2::new(0.375, 0.125));
+        assert_eq!(subtexel_point(1, 1, 2), Vec2::new(0.625, 0.875));
+        assert_eq!(subtexel_point(4, 2, 1), Vec2::new(4.5, 2.5));
+    }
 
     /// The tabulated facets against directions drawn uniformly in random bins: every draw lies within
     /// the radius of its bin's centre, and the mean of the draws matches the tabulated mean direction
