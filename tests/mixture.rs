@@ -231,12 +231,7 @@ fn hierarchy_d_equals_the_brute_force_sum() {
             let patch = mix.patch(&footprint(area, Vec2::new(0.37, 0.61)));
             let lobes: Vec<_> = patch.weighted_lobes().collect();
             for k in 0..200 {
-                let u = Vec2::new(rng.random(), rng.random());
-                let m = if k % 2 == 0 {
-                    patch.sample_normal(u)
-                } else {
-                    support::dir(rng.random_range(0.0..40.0), rng.random_range(0.0..360.0))
-                };
+                let m = probe_normal(&patch, &mut rng, k);
                 let brute: f64 = lobes.iter().map(|(w, g)| *w as f64 * g.d(m) as f64).sum();
                 let (d, touched) = patch.d_with_stats(m);
                 // A lobe outside its 5.26σ box contributes ≤ e^{−13.8} ≈ 1e-6 of its peak (times the
@@ -500,26 +495,43 @@ fn chi_square_of_both_samplers() {
     }
     let mix = BeckmannMixture::build(&noise(N, 4), exact_params()).unwrap();
     let patch = mix.patch(&footprint(16.0, Vec2::new(0.3, 0.3)));
+    chi2_patch_samplers(&patch, "mixture", &[30.0, 75.0]);
+}
+
+/// Chi-square (10⁶ draws, 100 × 200 cells) of a patch's normal sampler and of its visible sampler
+/// at each θo (φo = 20°).
+fn chi2_patch_samplers(patch: &MixturePatch, label: &str, thetas: &[f64]) {
     let cfg = |name: &str| Chi2 {
         res_z: 100,
         res_phi: 200,
         samples: 1_000_000,
         ..Chi2::new(name, 3)
     };
-    cfg("mixture normals")
+    cfg(&format!("{label} normals"))
         .run(
             |_, u| Some(patch.sample_normal(u)),
             |m| patch.pdf_normal(m) as f64,
         )
         .unwrap();
-    for theta in [30.0, 75.0] {
+    for &theta in thetas {
         let wo = support::dir(theta, 20.0);
-        cfg(&format!("mixture visible {theta}"))
+        cfg(&format!("{label} visible {theta}"))
             .run(
                 |_, u| Some(patch.sample_visible(wo, u)),
                 |m| patch.pdf_visible(wo, m) as f64,
             )
             .unwrap();
+    }
+}
+
+/// A direction to probe D at: draw k (even) from the patch's normal sampler, odd k uniform in
+/// θ ∈ [0°, 40°).
+fn probe_normal(patch: &MixturePatch, rng: &mut impl RngExt, k: usize) -> Vec3 {
+    let u = Vec2::new(rng.random(), rng.random());
+    if k.is_multiple_of(2) {
+        patch.sample_normal(u)
+    } else {
+        support::dir(rng.random_range(0.0..40.0), rng.random_range(0.0..360.0))
     }
 }
 
@@ -1084,6 +1096,25 @@ fn tv_to_grid(a: &MixturePatch, b: &GridValues) -> (f64, f64) {
     })
 }
 
+/// The patch at tolerance `tol` against the full mixture's grid values `full`: (its level, its
+/// bound Σ W_n e(n), the TV between the two, the quadrature's error estimate of that TV).
+fn lod_against_full(
+    mix: &BeckmannMixture,
+    fp: &Footprint,
+    tol: f32,
+    full: &GridValues,
+) -> (usize, f64, f64, f64) {
+    let p = mix.patch_with(
+        fp,
+        PatchOptions {
+            lod_tolerance: tol,
+            ..exact_params().patch
+        },
+    );
+    let (tv, q) = tv_to_grid(&p, full);
+    (p.level(), p.lod_error() as f64, tv, q)
+}
+
 /// The level of detail respects its tolerance: on the four procedural maps (64²) at a 256-texel
 /// footprint, the TV between the level-of-detail patch and the full mixture (same footprint) is at
 /// most the patch's bound Σ W_n e(n) (src/glint/mixture/levels.rs), which is at most the tolerance,
@@ -1103,19 +1134,8 @@ fn level_of_detail_respects_its_tolerance() {
         assert_eq!(full.level(), 0);
         let gv = grid_values(&full);
         for tol in [0.02f32, 0.3] {
-            let p = mix.patch_with(
-                &fp,
-                PatchOptions {
-                    lod_tolerance: tol,
-                    ..exact_params().patch
-                },
-            );
-            let (tv, q) = tv_to_grid(&p, &gv);
-            let bound = p.lod_error() as f64;
-            println!(
-                "{name} tol {tol}: level {} bound {bound:.4} TV {tv:.4} (±{q:.1e})",
-                p.level()
-            );
+            let (level, bound, tv, q) = lod_against_full(&mix, &fp, tol, &gv);
+            println!("{name} tol {tol}: level {level} bound {bound:.4} TV {tv:.4} (±{q:.1e})");
             assert!(
                 bound <= tol as f64,
                 "{name}: bound {bound} > tolerance {tol}"
@@ -1124,7 +1144,7 @@ fn level_of_detail_respects_its_tolerance() {
                 tv <= bound + 3.0 * q,
                 "{name} tol {tol}: TV {tv} > bound {bound} + 3 × {q}"
             );
-            merged += (p.level() > 0) as usize;
+            merged += (level > 0) as usize;
         }
     }
     assert!(merged >= 3, "only {merged} cases used a level ≥ 1");
@@ -1159,12 +1179,7 @@ fn level_d_equals_the_brute_force_sum() {
                 .map(|(w, g)| *w as f64 * g.d(g.mean_normal()) as f64)
                 .sum();
             for k in 0..200 {
-                let u = Vec2::new(rng.random(), rng.random());
-                let m = if k % 2 == 0 {
-                    patch.sample_normal(u)
-                } else {
-                    support::dir(rng.random_range(0.0..40.0), rng.random_range(0.0..360.0))
-                };
+                let m = probe_normal(&patch, &mut rng, k);
                 let brute: f64 = lobes.iter().map(|(w, g)| *w as f64 * g.d(m) as f64).sum();
                 let d = patch.d(m) as f64;
                 assert!(
@@ -1196,25 +1211,7 @@ fn chi_square_and_furnace_at_a_merged_level() {
         },
     );
     assert_eq!(patch.level(), 1);
-    let cfg = |name: &str| Chi2 {
-        res_z: 100,
-        res_phi: 200,
-        samples: 1_000_000,
-        ..Chi2::new(name, 3)
-    };
-    cfg("level-1 normals")
-        .run(
-            |_, u| Some(patch.sample_normal(u)),
-            |m| patch.pdf_normal(m) as f64,
-        )
-        .unwrap();
-    let wo = support::dir(60.0, 20.0);
-    cfg("level-1 visible 60")
-        .run(
-            |_, u| Some(patch.sample_visible(wo, u)),
-            |m| patch.pdf_visible(wo, m) as f64,
-        )
-        .unwrap();
+    chi2_patch_samplers(&patch, "level-1", &[60.0]);
     for (name, map) in procedural_maps() {
         let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
         for masking in [MaskingMode::Exact, MaskingMode::Approximate] {
@@ -1252,19 +1249,8 @@ fn lod_check() {
             let full = mix.patch(&fp);
             let gv = grid_values(&full);
             for tol in [0.03f32, 0.1, 0.3] {
-                let p = mix.patch_with(
-                    &fp,
-                    PatchOptions {
-                        lod_tolerance: tol,
-                        ..exact_params().patch
-                    },
-                );
-                let (tv, q) = tv_to_grid(&p, &gv);
-                let bound = p.lod_error() as f64;
-                println!(
-                    "| {name} | {area} | {tol} | {} | {bound:.4} | {tv:.4} ± {q:.0e} |",
-                    p.level()
-                );
+                let (level, bound, tv, q) = lod_against_full(&mix, &fp, tol, &gv);
+                println!("| {name} | {area} | {tol} | {level} | {bound:.4} | {tv:.4} ± {q:.0e} |");
                 assert!(
                     tv <= bound + 3.0 * q,
                     "{name} {area} {tol}: TV {tv} > {bound}"

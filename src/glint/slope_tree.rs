@@ -186,6 +186,34 @@ impl SlopeTree {
     }
 }
 
+/// The quadtree's levels 1, 2, … by the straightforward loop over whole levels (each node the
+/// union of its up to 2 × 2 children, in [`union`]'s order): the reference of the tests of
+/// `build_with` here and of the mixture loader's banded derivation.
+#[cfg(test)]
+pub(crate) fn reference_levels(nx: usize, ny: usize, leaf: Vec<[f32; 4]>) -> Vec<Vec<[f32; 4]>> {
+    let sizes = level_sizes(nx, ny);
+    let mut out = Vec::new();
+    let mut level = leaf;
+    for l in 1..sizes.len() {
+        let ([pw, ph], [w, h]) = (sizes[l - 1], sizes[l]);
+        let mut up = Vec::with_capacity(w * h);
+        for y in 0..h {
+            for x in 0..w {
+                let mut b = [f32::INFINITY, f32::INFINITY, -f32::INFINITY, -f32::INFINITY];
+                for cy in [2 * y, 2 * y + 1].into_iter().filter(|&c| c < ph) {
+                    for cx in [2 * x, 2 * x + 1].into_iter().filter(|&c| c < pw) {
+                        b = union(b, level[cy * pw + cx]);
+                    }
+                }
+                up.push(b);
+            }
+        }
+        out.push(up.clone());
+        level = up;
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -207,25 +235,10 @@ mod tests {
             let sizes = level_sizes(nx, ny);
             assert_eq!(tree.sizes, sizes);
             assert_eq!(tree.boxes.len(), sizes.len() - 1);
-            let mut level = leaf.clone();
-            for l in 1..sizes.len() {
-                let ([pw, ph], [w, h]) = (sizes[l - 1], sizes[l]);
-                let mut up = Vec::new();
-                for y in 0..h {
-                    for x in 0..w {
-                        let mut b = [f32::INFINITY, f32::INFINITY, -f32::INFINITY, -f32::INFINITY];
-                        for cy in [2 * y, 2 * y + 1].into_iter().filter(|&c| c < ph) {
-                            for cx in [2 * x, 2 * x + 1].into_iter().filter(|&c| c < pw) {
-                                b = union(b, level[cy * pw + cx]);
-                            }
-                        }
-                        up.push(b);
-                    }
-                }
-                let bits =
-                    |v: &[[f32; 4]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
-                assert_eq!(bits(&tree.boxes[l - 1]), bits(&up), "{nx}×{ny} level {l}");
-                level = up;
+            let want = reference_levels(nx, ny, leaf);
+            let bits = |v: &[[f32; 4]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+            for (l, up) in want.iter().enumerate() {
+                assert_eq!(bits(&tree.boxes[l]), bits(up), "{nx}×{ny} level {}", l + 1);
             }
         }
     }

@@ -434,13 +434,10 @@ impl<'a> BinMapPatch<'a> {
 
     /// The smoothed D(h) = Σ_j mass_j D_j(h) over the given (mass_j, D_j) lobes within r.
     fn smoothed_d_lobes(lobes: &[(f32, SlopeGaussian)], h: Vec3, sigma: f64) -> f64 {
-        let Some(s) = crate::frame::normal_to_slope(h) else {
+        let Some(k) = SmoothingKernel::at(h, sigma) else {
             return 0.0;
         };
-        let (sx, sy) = (s.x as f64, s.y as f64);
-        let r = (-2.0 * SMOOTH_TAIL.ln()).sqrt() * sigma;
-        let inv2s2 = 0.5 / (sigma * sigma);
-        let norm = inv2s2 / std::f64::consts::PI; // 1/(2πσ²)
+        let (sx, sy, r, inv2s2, norm) = (k.sx, k.sy, k.r, k.inv2s2, k.norm);
         let mut sum = 0.0;
         for (mass, lobe) in lobes {
             let c = lobe.mean();
@@ -455,13 +452,10 @@ impl<'a> BinMapPatch<'a> {
 
     /// The smoothed D(h) over the window of bins around h, each bin's mass through the forest.
     fn smoothed_d_window(&self, h: Vec3, sigma: f64) -> f64 {
-        let Some(s) = crate::frame::normal_to_slope(h) else {
+        let Some(k) = SmoothingKernel::at(h, sigma) else {
             return 0.0;
         };
-        let (sx, sy) = (s.x as f64, s.y as f64);
-        let r = (-2.0 * SMOOTH_TAIL.ln()).sqrt() * sigma;
-        let inv2s2 = 0.5 / (sigma * sigma);
-        let norm = inv2s2 / std::f64::consts::PI; // 1/(2πσ²)
+        let (sx, sy, r, inv2s2, norm) = (k.sx, k.sy, k.r, k.inv2s2, k.norm);
         let cos4 = (h.z as f64).powi(4);
         let mut sum = 0.0;
         self.for_bins_near(h, r, |bin| {
@@ -1131,6 +1125,31 @@ fn pdf_visible_lobes(e: &ExactMasking<'_>, wo: Vec3, total: f64, m: Vec3) -> f32
         .map(|(mass, lobe)| *mass as f64 * lobe.d(m) as f64)
         .sum();
     finite_or_zero(c as f64 * d / total)
+}
+
+/// The smoothing Gaussian of the smoothed D at half-vector h: h's slope (sx, sy), the cut-off radius
+/// r (where the kernel falls to `SMOOTH_TAIL`), 1/(2σ²) and the normaliser 1/(2πσ²).
+struct SmoothingKernel {
+    sx: f64,
+    sy: f64,
+    r: f64,
+    inv2s2: f64,
+    norm: f64,
+}
+
+impl SmoothingKernel {
+    /// None for h at or below the horizon (no slope).
+    fn at(h: Vec3, sigma: f64) -> Option<Self> {
+        let s = crate::frame::normal_to_slope(h)?;
+        let inv2s2 = 0.5 / (sigma * sigma);
+        Some(SmoothingKernel {
+            sx: s.x as f64,
+            sy: s.y as f64,
+            r: (-2.0 * SMOOTH_TAIL.ln()).sqrt() * sigma,
+            inv2s2,
+            norm: inv2s2 / std::f64::consts::PI,
+        })
+    }
 }
 
 #[cfg(test)]

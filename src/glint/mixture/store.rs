@@ -184,6 +184,7 @@ impl BeckmannMixture {
 mod tests {
     use super::*;
     use crate::glint::mixture::hierarchy::LobePyramid;
+    use crate::glint::slope_tree::reference_levels;
 
     /// Moments of every kind a file can hold: ordinary lobes, means of ±0 (the box unions take
     /// min/max of ±0, whose result depends on the order), degenerate and clamped covariances.
@@ -249,33 +250,12 @@ mod tests {
                 "{nx}×{ny} blocks"
             );
             // The quadtree by the straightforward loop over whole levels.
-            let mut level: Vec<[f32; 4]> = g.iter().map(|g| lobe_box(g, box_k)).collect();
+            let leaf: Vec<[f32; 4]> = g.iter().map(|g| lobe_box(g, box_k)).collect();
             let sizes = level_sizes(nx, ny);
             assert_eq!(tree.sizes, sizes);
-            for l in 1..sizes.len() {
-                let ([pw, ph], [w, h]) = (sizes[l - 1], sizes[l]);
-                let mut up = Vec::new();
-                for y in 0..h {
-                    for x in 0..w {
-                        let mut b = [f32::INFINITY, f32::INFINITY, -f32::INFINITY, -f32::INFINITY];
-                        for cy in [2 * y, 2 * y + 1].into_iter().filter(|&c| c < ph) {
-                            for cx in [2 * x, 2 * x + 1].into_iter().filter(|&c| c < pw) {
-                                let c = level[cy * pw + cx];
-                                b = [
-                                    b[0].min(c[0]),
-                                    b[1].min(c[1]),
-                                    b[2].max(c[2]),
-                                    b[3].max(c[3]),
-                                ];
-                            }
-                        }
-                        up.push(b);
-                    }
-                }
-                let bits =
-                    |v: &[[f32; 4]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
-                assert_eq!(bits(&tree.boxes[l - 1]), bits(&up), "{nx}×{ny} level {l}");
-                level = up;
+            let bits = |v: &[[f32; 4]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+            for (l, up) in reference_levels(nx, ny, leaf).iter().enumerate() {
+                assert_eq!(bits(&tree.boxes[l]), bits(up), "{nx}×{ny} level {}", l + 1);
             }
             // The mip chain: each node the f64 mean of its (up to) 2 × 2 children.
             let pyramid = LobePyramid::build(nx, ny, &m);
