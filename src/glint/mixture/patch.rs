@@ -437,16 +437,33 @@ impl<'a> MixturePatch<'a> {
             None => (mixture.level_ref(0), None),
             Some((finest, coarsest)) => {
                 let mut bufs = Lent::new(slots);
-                let mut l = coarsest;
-                loop {
-                    let lv = mixture.level_ref(l);
-                    let g = Self::gather(mixture, lv, &Effective::at_level(&fp, l), bufs);
-                    if l == finest || g.lod_error <= options.lod_tolerance as f64 {
-                        break (lv, Some(g));
+                // From the finest allowed level up while the next level's Σ W_n e(n) meets the
+                // tolerance (an error-only pass: weights, no moments, no block layout), then one
+                // gather at the level chosen. The bound grows with the level (a node's e(n) includes
+                // the mean of its children's; up to the per-level weight approximation), so this
+                // stops where a coarse-to-fine search would; a footprint that merges nothing pays one
+                // error pass at level finest + 1 (a quarter of the nodes) instead of a gather per
+                // level.
+                let mut l = finest;
+                while l < coarsest {
+                    let next = mixture.level_ref(l + 1);
+                    let eff = Effective::at_level(&fp, l + 1);
+                    let e = Self::lod_error_of(mixture, next, &eff, &mut bufs);
+                    if e > options.lod_tolerance as f64 {
+                        break;
                     }
-                    bufs = g.bufs;
-                    l -= 1;
+                    l += 1;
                 }
+                let lv = mixture.level_ref(l);
+                (
+                    lv,
+                    Some(Self::gather(
+                        mixture,
+                        lv,
+                        &Effective::at_level(&fp, l),
+                        bufs,
+                    )),
+                )
             }
         };
         MixturePatch {
@@ -494,25 +511,23 @@ impl<'a> MixturePatch<'a> {
         Some((finest, coarsest.max(finest)))
     }
 
-    fn gather<'b>(
-        mix: &BeckmannMixture,
+    /// The footprint's raw kernel weights of the level's nodes, summed per slot into `w`
+    /// (resized to the slot grid), and the slot axes (±`weight_sigmas` σ of Σ_eff per axis).
+    fn slot_weights(
+        weight_sigmas: f32,
         lv: LevelRef<'_>,
         eff: &Effective,
-        mut bufs: Lent<'b, SlotBuffers>,
-    ) -> Gathered<'b> {
-        let t = mix.params.weight_sigmas as f64;
+        w: &mut Vec<f64>,
+    ) -> [AxisSlots; 2] {
+        let t = weight_sigmas as f64;
         let half = [t * eff.cov[0].sqrt(), t * eff.cov[2].sqrt()];
         let axes = [
             AxisSlots::new(eff.c[0], half[0], lv.grid[0]),
             AxisSlots::new(eff.c[1], half[1], lv.grid[1]),
         ];
         let (lx, ly) = (axes[0].len, axes[1].len);
-        // Raw weights are summed into the cdf buffer, then normalised and accumulated in place.
-        let SlotBuffers { weights, cdf, .. } = &mut *bufs;
-        weights.clear();
-        cdf.clear();
-        cdf.resize(lx * ly, 0.0);
-        let w = cdf;
+        w.clear();
+        w.resize(lx * ly, 0.0);
         let (i0, i1) = axes[0].unwrapped_range(eff.c[0], half[0]);
         let (j0, j1) = axes[1].unwrapped_range(eff.c[1], half[1]);
         for j in j0..=j1 {
@@ -522,6 +537,41 @@ impl<'a> MixturePatch<'a> {
                 row[axes[0].slot_of_unwrapped(i)] += wi;
             }
         }
+        axes
+    }
+
+    /// Σ W_n e(n) of the level over the footprint (what [`Self::gather`] reports as `lod_error`),
+    /// from the weights alone: the error-only pass of the level-of-detail search.
+    fn lod_error_of(
+        mix: &BeckmannMixture,
+        lv: LevelRef<'_>,
+        eff: &Effective,
+        bufs: &mut Lent<'_, SlotBuffers>,
+    ) -> f64 {
+        let w = &mut bufs.cdf;
+        let axes = Self::slot_weights(mix.params.weight_sigmas, lv, eff, w);
+        let lx = axes[0].len;
+        let (mut total, mut err) = (0.0f64, 0.0f64);
+        for (s, &wi) in w.iter().enumerate() {
+            let k = axes[1].lobe_of_slot(s / lx) * lv.grid[0] + axes[0].lobe_of_slot(s % lx);
+            total += wi;
+            err += wi * lv.error_at(k) as f64;
+        }
+        if total > 0.0 { err / total } else { 0.0 }
+    }
+
+    fn gather<'b>(
+        mix: &BeckmannMixture,
+        lv: LevelRef<'_>,
+        eff: &Effective,
+        mut bufs: Lent<'b, SlotBuffers>,
+    ) -> Gathered<'b> {
+        // Raw weights are summed into the cdf buffer, then normalised and accumulated in place.
+        let SlotBuffers { weights, cdf, .. } = &mut *bufs;
+        weights.clear();
+        let axes = Self::slot_weights(mix.params.weight_sigmas, lv, eff, cdf);
+        let lx = axes[0].len;
+        let w = cdf;
         let total: f64 = w.iter().sum();
         // total ≥ the nearest node's weight ≥ exp(−½ · 2 · 0.5²/v) with v the smallest variance of
         // Σ_eff: σ_k² ≈ 0.18 at level 0 (≈ 0.06), (σ_k² + (4^l − 1)/12)/4^l > 1/12 at level l (> 0.04)
