@@ -476,8 +476,8 @@ impl<'a> MixturePatch<'a> {
         }
     }
 
-    /// The levels a patch may use, (finest, coarsest), searched from the coarsest down to the
-    /// first whose Σ W_n e(n) meets the tolerance (the finest is taken regardless); `None` for the
+    /// The levels a patch may use, (finest, coarsest), searched from the finest up while the next
+    /// level's Σ W_n e(n) meets the tolerance (the finest is taken regardless); `None` for the
     /// filtered lobe alone.
     ///
     /// - coarsest: the largest l with 2^l ≤ σ_min(Σ_P)/2 (a node no wider than half the
