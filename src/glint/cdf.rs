@@ -24,9 +24,36 @@ pub(crate) fn invert_cdf(cdf: &[f64], u: f32) -> (usize, f32) {
     (s, (r as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0))
 }
 
+/// [`invert_cdf`] without the table: picks k ∝ v_k from the weights in order, given their sum
+/// `total` (computed beforehand in the same order), stopping at the first k whose running sum passes
+/// u · total, and returns u rescaled to [0, 1) inside v_k. For samplers whose weights depend on the
+/// direction (W_i V_i(wo)), so that no table is stored. If rounding leaves u · total beyond the last
+/// running sum, the last positive weight is taken. NaN u → ½; u clamped to [0, 1]; no positive
+/// weight → (0, ½).
+pub(crate) fn pick_streaming(
+    u: f32,
+    total: f64,
+    weights: impl IntoIterator<Item = f64>,
+) -> (usize, f32) {
+    let u = if u.is_nan() { 0.5 } else { u.clamp(0.0, 1.0) } as f64;
+    let target = u * total;
+    let mut acc = 0.0;
+    let mut chosen = (0, 0.5f32);
+    for (k, v) in weights.into_iter().enumerate() {
+        if v > 0.0 {
+            chosen = (k, ((target - acc) / v) as f32);
+            if acc + v > target {
+                break;
+            }
+        }
+        acc += v;
+    }
+    (chosen.0, chosen.1.clamp(0.0, 1.0 - f32::EPSILON / 2.0))
+}
+
 #[cfg(test)]
 mod tests {
-    use super::invert_cdf;
+    use super::{invert_cdf, pick_streaming};
 
     #[test]
     fn picks_the_slot_and_rescales() {
@@ -38,5 +65,18 @@ mod tests {
         assert!((r - 1.0 / 3.0).abs() < 1e-6);
         assert_eq!(invert_cdf(&cdf, f32::NAN).0, 2);
         assert_eq!(invert_cdf(&[], 0.3), (0, 0.5));
+    }
+
+    #[test]
+    fn streaming_pick_agrees_with_the_table() {
+        let v = [1.0, 0.0, 3.0, 2.0];
+        let cdf = [1.0, 1.0, 4.0, 6.0];
+        for u in [0.0f32, 0.1, 0.2, 0.5, 0.66, 0.9, 1.0] {
+            let (a, ra) = invert_cdf(&cdf, u);
+            let (b, rb) = pick_streaming(u, 6.0, v);
+            assert_eq!(a, b, "{u}");
+            assert!((ra - rb).abs() < 1e-6, "{u}: {ra} {rb}");
+        }
+        assert_eq!(pick_streaming(0.3, 0.0, [0.0, 0.0]), (0, 0.5));
     }
 }

@@ -140,16 +140,31 @@ impl SlopeTree {
     /// Calls `leaf(x, y)` for every level-0 element (x, y) in the half-open rectangle
     /// [x.0, x.1) × [y.0, y.1) all of whose ancestors' boxes contain the slope `s`, depth first. The
     /// caller tests the element's own box (level 0 is not stored).
-    ///
-    /// The stack holds at most 3 pending siblings per level plus one, and a grid of at most 2³²
-    /// elements per side has at most 33 levels: 128 entries always suffice.
     #[inline]
     pub fn for_each_leaf(
         &self,
         x: (usize, usize),
         y: (usize, usize),
         s: Vec2,
-        mut leaf: impl FnMut(usize, usize),
+        leaf: impl FnMut(usize, usize),
+    ) {
+        self.for_each_node(0, x, y, s, leaf);
+    }
+
+    /// Calls `f(nx, ny)` for every node of level `stop` (≤ [`SlopeTree::top`]) that meets the
+    /// level-0 rectangle [x.0, x.1) × [y.0, y.1) and whose boxes — its ancestors' and, for
+    /// `stop` ≥ 1, its own — all contain the slope `s`, depth first.
+    ///
+    /// The stack holds at most 3 pending siblings per level plus one, and a grid of at most 2³²
+    /// elements per side has at most 33 levels: 128 entries always suffice.
+    #[inline]
+    pub fn for_each_node(
+        &self,
+        stop: usize,
+        x: (usize, usize),
+        y: (usize, usize),
+        s: Vec2,
+        mut f: impl FnMut(usize, usize),
     ) {
         let mut stack = [(0u8, 0u32, 0u32); 128];
         let mut len = 1;
@@ -163,11 +178,11 @@ impl SlopeTree {
             if bx1 <= x.0 || bx0 >= x.1 || by1 <= y.0 || by0 >= y.1 {
                 continue;
             }
-            if l == 0 {
-                leaf(nx, ny);
+            if l > 0 && !contains(self.node_box(l, nx, ny), s) {
                 continue;
             }
-            if !contains(self.node_box(l, nx, ny), s) {
+            if l == stop {
+                f(nx, ny);
                 continue;
             }
             let [cw, ch] = self.sizes[l - 1];

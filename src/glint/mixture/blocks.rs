@@ -14,7 +14,7 @@
 //! error that vectorises (std's `exp` is a library call per lane); V_P's ramp term G(−t) is
 //! [`ramp_neg_lanes`], one fitted exponent and one such exponential (no `erfc` call).
 
-use crate::glint::slope_tree::{SlopeTree, contains};
+use crate::glint::slope_tree::SlopeTree;
 use crate::ndf::SlopeGaussian;
 use glam::{Vec2, Vec3};
 
@@ -362,9 +362,8 @@ fn exp2_lanes_wide(x: f64) -> f32 {
 
 /// Calls `f(bx, by)` for every block that meets the lobe rectangle [x.0, x.1) × [y.0, y.1) and
 /// whose quadtree ancestors' boxes (down to the block's own, level 2) all contain the slope `s`,
-/// depth first. Grids of at most 2 × 2 lobes (no level-2 node) have one block, always called.
-///
-/// The stack holds at most 3 pending siblings per level plus one; ≤ 33 levels: 128 entries suffice.
+/// depth first ([`SlopeTree::for_each_node`] at level 2). Grids of at most 2 × 2 lobes (no level-2
+/// node) have one block, always called.
 #[inline]
 pub(super) fn for_each_block(
     tree: &SlopeTree,
@@ -373,38 +372,11 @@ pub(super) fn for_each_block(
     s: Vec2,
     mut f: impl FnMut(usize, usize),
 ) {
-    let top = tree.top();
-    if top < LEVEL {
+    if tree.top() < LEVEL {
         f(0, 0);
         return;
     }
-    let mut stack = [(0u8, 0u32, 0u32); 128];
-    let mut len = 1;
-    stack[0] = (top as u8, 0, 0);
-    while len > 0 {
-        len -= 1;
-        let (l, nx, ny) = stack[len];
-        let (l, nx, ny) = (l as usize, nx as usize, ny as usize);
-        let (bx0, by0) = (nx << l, ny << l);
-        let (bx1, by1) = ((nx + 1) << l, (ny + 1) << l);
-        if bx1 <= x.0 || bx0 >= x.1 || by1 <= y.0 || by0 >= y.1 {
-            continue;
-        }
-        if !contains(tree.node_box(l, nx, ny), s) {
-            continue;
-        }
-        if l == LEVEL {
-            f(nx, ny);
-            continue;
-        }
-        let [cw, ch] = tree.sizes[l - 1];
-        for cy in (2 * ny)..(2 * ny + 2).min(ch) {
-            for cx in (2 * nx)..(2 * nx + 2).min(cw) {
-                stack[len] = ((l - 1) as u8, cx as u32, cy as u32);
-                len += 1;
-            }
-        }
-    }
+    tree.for_each_node(LEVEL, x, y, s, f);
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@ use super::{BeckmannMixture, MaskingMode, PatchOptions, build::kernel_sigma};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
-use crate::glint::cdf::invert_cdf;
+use crate::glint::cdf::{invert_cdf, pick_streaming};
 use crate::glint::scratch::{Lent, Loan};
 use crate::glint::slope_tree::contains;
 use crate::math::{finite_f32, finite_or_zero};
@@ -1163,27 +1163,15 @@ impl MixturePatch<'_> {
         if !(total > 0.0 && total.is_finite()) {
             return self.sample_normal(u);
         }
-        let ux = if u.x.is_nan() {
-            0.5
-        } else {
-            u.x.clamp(0.0, 1.0)
-        } as f64;
-        let target = ux * total;
-        let mut acc = 0.0;
-        let mut chosen = (0, 0.5f32);
         let lobes = self.slot_lobes(g);
-        for (s, lobe) in lobes.iter().enumerate() {
-            let v = g.bufs.weights[s] as f64 * lobe.visible_area(wo) as f64;
-            if v > 0.0 {
-                chosen = (s, ((target - acc) / v) as f32);
-                if acc + v > target {
-                    break;
-                }
-            }
-            acc += v;
-        }
-        let (s, r) = chosen;
-        let r = r.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        let (s, r) = pick_streaming(
+            u.x,
+            total,
+            lobes
+                .iter()
+                .enumerate()
+                .map(|(s, lobe)| g.bufs.weights[s] as f64 * lobe.visible_area(wo) as f64),
+        );
         lobes[s].sample_visible(wo, Vec2::new(r, u.y))
     }
 }

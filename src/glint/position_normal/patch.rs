@@ -12,7 +12,7 @@ use super::{PositionNormalMap, SIGMA_H_PER_SPACING};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
-use crate::glint::cdf::invert_cdf;
+use crate::glint::cdf::{invert_cdf, pick_streaming};
 use crate::glint::scratch::Loan;
 use crate::glint::slope_tree::contains;
 use crate::math::finite_or_zero;
@@ -554,26 +554,14 @@ impl Ndf for PositionNormalPatch<'_> {
         if !(total > 0.0 && total.is_finite()) {
             return self.sample_normal(u);
         }
-        let ux = if u.x.is_nan() {
-            0.5
-        } else {
-            u.x.clamp(0.0, 1.0)
-        } as f64;
-        let target = ux * total;
-        let mut acc = 0.0;
-        let mut chosen = (0, 0.5f32);
-        for (k, lobe) in s.lobes.iter().enumerate() {
-            let v = s.weights[k] * lobe.visible_area(wo) as f64;
-            if v > 0.0 {
-                chosen = (k, ((target - acc) / v) as f32);
-                if acc + v > target {
-                    break;
-                }
-            }
-            acc += v;
-        }
-        let (k, r) = chosen;
-        let r = r.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        let (k, r) = pick_streaming(
+            u.x,
+            total,
+            s.lobes
+                .iter()
+                .enumerate()
+                .map(|(k, lobe)| s.weights[k] * lobe.visible_area(wo) as f64),
+        );
         s.lobes[k].sample_visible(wo, Vec2::new(r, u.y))
     }
 
