@@ -1,7 +1,8 @@
 //! Cost of the Beckmann mixture of \[Chermain2019\]: the build, and per footprint size the patch
 //! construction, D_P, the exact and approximate Λ_P and the visible sampler, each per-direction query
-//! timed by the lobe blocks (`blocks`) and by the scalar path (`scalar`, one lobe at a time rebuilt
-//! from its moments) in the same run. The blocks paths are the patch's `d`, exact `lambda` and
+//! timed by the lobe blocks (`blocks`: the copy of the block loops the CPU selects at run time, AVX2
+//! where it has it; `blocks_baseline`: the same patch forced onto the baseline copy, SSE2 on x86-64)
+//! and by the scalar path (`scalar`, one lobe at a time rebuilt from its moments) in the same run. The blocks paths are the patch's `d`, exact `lambda` and
 //! `sample_visible` (`lambda_blocks` / `sample_visible_blocks` are the same code, callable by name);
 //! `d_scalar`, `lambda_scalar` and `sample_visible_scalar` are the former paths, all `#[doc(hidden)]`.
 //!
@@ -18,7 +19,7 @@
 
 use brdf::glint::{
     BeckmannMixture, BrushedParams, FlakesParams, Footprint, GlintNdf, MaskingMode, MixtureParams,
-    NormalMap, PatchOptions, ScratchedParams, brushed, bumpy, flakes, scratched,
+    MixturePatch, NormalMap, PatchOptions, ScratchedParams, brushed, bumpy, flakes, scratched,
 };
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
@@ -96,6 +97,15 @@ fn views(seed: u64) -> Vec<(Vec3, Vec2)> {
         .collect()
 }
 
+/// A copy of `patch` forced onto the baseline copy of the block loops (`blocks_baseline`; `blocks`
+/// is what the patch runs: AVX2 where the CPU has it). Bit-identical results
+/// (tests/mixture_dispatch.rs).
+fn baseline<'a>(patch: &MixturePatch<'a>) -> MixturePatch<'a> {
+    let mut base = patch.clone();
+    base.force_baseline_simd(true);
+    base
+}
+
 fn build(c: &mut Criterion) {
     let map = bumpy(256, 256, 0.25, 4.0, 1).unwrap();
     let mut g = c.benchmark_group("mixture_build_256");
@@ -124,9 +134,13 @@ fn queries(c: &mut Criterion) {
         g.throughput(Throughput::Elements(BATCH as u64));
         for area in AREAS {
             let patch = mix.patch(&footprint(area));
+            let base = baseline(&patch);
             let m = normals(&patch, 7);
             g.bench_with_input(BenchmarkId::new("blocks", area), &m, |b, m| {
                 b.iter(|| m.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
+            });
+            g.bench_with_input(BenchmarkId::new("blocks_baseline", area), &m, |b, m| {
+                b.iter(|| m.iter().map(|&h| base.d(black_box(h))).sum::<f32>())
             });
             g.bench_with_input(BenchmarkId::new("scalar", area), &m, |b, m| {
                 b.iter(|| m.iter().map(|&h| patch.d_scalar(black_box(h))).sum::<f32>())
@@ -140,10 +154,18 @@ fn queries(c: &mut Criterion) {
         for area in AREAS {
             let patch = mix.patch(&footprint(area));
             let _ = patch.lambda_scalar(Vec3::Z); // build the scalar path's lazy lobes before timing
+            let base = baseline(&patch);
             g.bench_with_input(BenchmarkId::new("blocks", area), &w, |b, w| {
                 b.iter(|| {
                     w.iter()
                         .map(|&(v, _)| patch.lambda_blocks(black_box(v)))
+                        .sum::<f32>()
+                })
+            });
+            g.bench_with_input(BenchmarkId::new("blocks_baseline", area), &w, |b, w| {
+                b.iter(|| {
+                    w.iter()
+                        .map(|&(v, _)| base.lambda_blocks(black_box(v)))
                         .sum::<f32>()
                 })
             });
@@ -162,10 +184,18 @@ fn queries(c: &mut Criterion) {
         for area in AREAS {
             let patch = mix.patch(&footprint(area));
             let _ = patch.lambda_scalar(Vec3::Z);
+            let base = baseline(&patch);
             g.bench_with_input(BenchmarkId::new("blocks", area), &w, |b, w| {
                 b.iter(|| {
                     w.iter()
                         .map(|&(v, u)| patch.sample_visible_blocks(black_box(v), u).z)
+                        .sum::<f32>()
+                })
+            });
+            g.bench_with_input(BenchmarkId::new("blocks_baseline", area), &w, |b, w| {
+                b.iter(|| {
+                    w.iter()
+                        .map(|&(v, u)| base.sample_visible_blocks(black_box(v), u).z)
                         .sum::<f32>()
                 })
             });

@@ -157,7 +157,10 @@ impl SlopeTree {
     ///
     /// The stack holds at most 3 pending siblings per level plus one, and a grid of at most 2³²
     /// elements per side has at most 33 levels: 128 entries always suffice.
-    #[inline]
+    ///
+    /// `#[inline(always)]`: the mixture's lobe-block passes are compiled once more with AVX2
+    /// (src/glint/mixture/blocks.rs, `dispatch`), and only code inlined into them gets that copy.
+    #[inline(always)]
     pub fn for_each_node(
         &self,
         stop: usize,

@@ -241,6 +241,9 @@ pub struct MixturePatch<'a> {
     /// The gathered lobes as [`SlopeGaussian`]s (per slot), built on the first call that loops over
     /// all of them (exact masking, visible sampling): 32 bytes per slot.
     lobes: Loan<'a, Vec<SlopeGaussian>>,
+    /// The compiled copy of the block loops the patch runs ([`blocks::Simd::detected`] unless a
+    /// bench or test forces the baseline).
+    simd: blocks::Simd,
 }
 
 /// The effective Gaussian k_i ∗ k_P in lobe units: centre and inverse covariance.
@@ -473,6 +476,7 @@ impl<'a> MixturePatch<'a> {
             filtered,
             gathered,
             lobes: Loan::new(lobes),
+            simd: blocks::Simd::detected(),
         }
     }
 
@@ -740,6 +744,25 @@ impl<'a> MixturePatch<'a> {
         self.d_by(m, Self::sum_p22)
     }
 
+    /// Forces the patch's per-query block loops (`d`, exact `lambda` / `visible_area`,
+    /// `sample_visible`, `pdf_visible`, `pdf_normal`) onto the baseline copy (`true`) or back to the
+    /// copy the CPU supports (`false`: AVX2 where detected; docs/mixture.md "Runtime dispatch").
+    /// Results are bit-identical either way: for the benches' and tests' comparisons.
+    #[doc(hidden)]
+    pub fn force_baseline_simd(&mut self, baseline: bool) {
+        self.simd = if baseline {
+            blocks::Simd::BASELINE
+        } else {
+            blocks::Simd::detected()
+        };
+    }
+
+    /// The copy of the block loops the patch runs: `"avx2"` or `"baseline"`.
+    #[doc(hidden)]
+    pub fn simd_path(&self) -> &'static str {
+        self.simd.name()
+    }
+
     /// D_P(m) by the former scalar path (one lobe at a time, each rebuilt from its moments in `f64`):
     /// kept as the reference of the benches and tests. Equal to [`Ndf::d`] to ~1e-6 relative.
     #[doc(hidden)]
@@ -768,22 +791,8 @@ impl<'a> MixturePatch<'a> {
     /// down to the lobe blocks (level 2) restricted to each lobe rectangle of the footprint, then
     /// the 16 lanes of each block reached at once ([`blocks::p22_lanes`]).
     fn sum_p22(&self, g: &Gathered, s: Vec2) -> (f64, usize) {
-        let (mix, lv) = (self.mixture, self.lv());
-        let k2 = mix.box_k * mix.box_k;
-        let bw = &g.bufs.block_weights;
-        let mut acc = [0.0f64; LANES];
-        let mut blocks_seen = 0usize;
-        for r in &g.rects[..g.n_rects] {
-            blocks::for_each_block(lv.tree, r.x, r.y, s, |bx, by| {
-                blocks_seen += 1;
-                let w = r.weights(bw, bx, by);
-                blocks::p22_lanes::<true>(lv.blocks.block(bx, by), w, s, k2, &mut acc);
-            });
-        }
-        (
-            acc.iter().sum::<f64>() * blocks::p22_scale(),
-            blocks_seen * LANES,
-        )
+        let (sum, blocks_seen) = blocks::dispatch(self.simd, SumP22 { patch: self, g, s });
+        (sum * blocks::p22_scale(), blocks_seen * LANES)
     }
 
     /// The scalar walk (former path): Σ W_i P22_i(s) over the lobes whose slope box contains s, by
@@ -834,7 +843,7 @@ impl<'a> MixturePatch<'a> {
     }
 
     /// Calls `f(block, lane weights, bx, by)` for every lobe block of the patch.
-    #[inline]
+    #[inline(always)]
     fn for_each_patch_block(
         &self,
         g: &Gathered,
@@ -883,11 +892,7 @@ impl<'a> MixturePatch<'a> {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
         }
-        let mut acc = [0.0f64; LANES];
-        self.for_each_patch_block(g, |b, wts, _, _| {
-            blocks::visible_lanes(b, wts, w, &mut acc);
-        });
-        acc.iter().sum()
+        blocks::dispatch(self.simd, VisibleSum { patch: self, g, w })
     }
 
     /// V_P(w) by the former scalar path (one [`SlopeGaussian`] per slot, `f64`): the reference of
@@ -1077,12 +1082,9 @@ impl MixturePatch<'_> {
         if !s.is_finite() {
             return 0.0;
         }
-        let mut acc = [0.0f64; LANES];
-        self.for_each_patch_block(g, |b, wts, _, _| {
-            blocks::p22_lanes::<false>(b, wts, s, 0.0, &mut acc);
-        });
+        let sum = blocks::dispatch(self.simd, UntruncatedSum { patch: self, g, s });
         let c = 1.0 + s.length_squared() as f64;
-        acc.iter().sum::<f64>() * blocks::p22_scale() * c * c
+        sum * blocks::p22_scale() * c * c
     }
 
     /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
@@ -1105,43 +1107,15 @@ impl MixturePatch<'_> {
             u.x.clamp(0.0, 1.0)
         } as f64;
         let target = ux * total;
-        let nx = self.lv().grid[0];
-        let lobe = |bx: usize, by: usize, lane: usize| {
-            (by * SIDE + lane / SIDE) * nx + bx * SIDE + lane % SIDE
-        };
-        let mut acc = 0.0f64;
-        // (lobe index, rescaled u.x); the last lobe with V > 0 if rounding leaves the target unmet.
-        let mut chosen = (usize::MAX, 0.5f32);
-        let mut done = false;
-        self.for_each_patch_block(g, |b, wts, bx, by| {
-            if done {
-                return;
-            }
-            let mut v = [0.0f64; LANES];
-            blocks::visible_lanes(b, wts, wo, &mut v);
-            let sum: f64 = v.iter().sum();
-            if sum.is_nan() || sum <= 0.0 {
-                return;
-            }
-            if acc + sum <= target {
-                if let Some(last) = (0..LANES).rev().find(|&i| v[i] > 0.0) {
-                    chosen = (lobe(bx, by, last), 1.0);
-                }
-                acc += sum;
-                return;
-            }
-            for (lane, &vi) in v.iter().enumerate() {
-                if vi > 0.0 {
-                    chosen = (lobe(bx, by, lane), ((target - acc) / vi) as f32);
-                    if acc + vi > target {
-                        done = true;
-                        return;
-                    }
-                }
-                acc += vi;
-            }
-        });
-        let (k, r) = chosen;
+        let (k, r) = blocks::dispatch(
+            self.simd,
+            VisiblePick {
+                patch: self,
+                g,
+                wo,
+                target,
+            },
+        );
         if k == usize::MAX {
             return self.sample_normal(u);
         }
@@ -1173,6 +1147,151 @@ impl MixturePatch<'_> {
                 .map(|(s, lobe)| g.bufs.weights[s] as f64 * lobe.visible_area(wo) as f64),
         );
         lobes[s].sample_visible(wo, Vec2::new(r, u.y))
+    }
+}
+
+/// The per-query block passes, each compiled once per instruction set ([`blocks::dispatch`]).
+///
+/// [`MixturePatch::sum_p22`]'s loop: Σ over the blocks reached by the walk of Σ_lanes W P22 (slope
+/// box applied), without the 1/(2π) factor, and the number of blocks reached.
+struct SumP22<'p, 'a, 'g> {
+    patch: &'p MixturePatch<'a>,
+    g: &'g Gathered<'g>,
+    s: Vec2,
+}
+
+impl blocks::BlockPass for SumP22<'_, '_, '_> {
+    type Out = (f64, usize);
+    #[inline(always)]
+    fn run<I: blocks::Isa>(self) -> (f64, usize) {
+        let (mix, lv, g, s) = (self.patch.mixture, self.patch.lv(), self.g, self.s);
+        let k2 = mix.box_k * mix.box_k;
+        let bw = &g.bufs.block_weights;
+        let mut acc = [0.0f64; LANES];
+        let mut blocks_seen = 0usize;
+        for r in &g.rects[..g.n_rects] {
+            blocks::for_each_block(
+                lv.tree,
+                r.x,
+                r.y,
+                s,
+                #[inline(always)]
+                |bx, by| {
+                    blocks_seen += 1;
+                    let w = r.weights(bw, bx, by);
+                    blocks::p22_lanes::<true>(lv.blocks.block(bx, by), w, s, k2, &mut acc);
+                },
+            );
+        }
+        (acc.iter().sum::<f64>(), blocks_seen)
+    }
+}
+
+/// [`MixturePatch::untruncated_d`]'s loop: Σ W P22 over every lane of every block of the patch (no
+/// box), without the 1/(2π) factor.
+struct UntruncatedSum<'p, 'a, 'g> {
+    patch: &'p MixturePatch<'a>,
+    g: &'g Gathered<'g>,
+    s: Vec2,
+}
+
+impl blocks::BlockPass for UntruncatedSum<'_, '_, '_> {
+    type Out = f64;
+    #[inline(always)]
+    fn run<I: blocks::Isa>(self) -> f64 {
+        let mut acc = [0.0f64; LANES];
+        self.patch.for_each_patch_block(
+            self.g,
+            #[inline(always)]
+            |b, wts, _, _| {
+                blocks::p22_lanes::<false>(b, wts, self.s, 0.0, &mut acc);
+            },
+        );
+        acc.iter().sum()
+    }
+}
+
+/// [`MixturePatch::exact_visible_area_blocks`]'s loop: Σ W V over every block of the patch, for a
+/// valid direction (w_z > 0, finite).
+struct VisibleSum<'p, 'a, 'g> {
+    patch: &'p MixturePatch<'a>,
+    g: &'g Gathered<'g>,
+    w: Vec3,
+}
+
+impl blocks::BlockPass for VisibleSum<'_, '_, '_> {
+    type Out = f64;
+    #[inline(always)]
+    fn run<I: blocks::Isa>(self) -> f64 {
+        let mut acc = [0.0f64; LANES];
+        self.patch.for_each_patch_block(
+            self.g,
+            #[inline(always)]
+            |b, wts, _, _| {
+                blocks::visible_lanes(b, wts, self.w, &mut acc);
+            },
+        );
+        acc.iter().sum()
+    }
+}
+
+/// [`MixturePatch::sample_visible_blocks`]'s second pass: the lobe whose cumulative W V (blocks in
+/// the patch's order, lanes in block order) first exceeds `target`, and u.x rescaled into it;
+/// (`usize::MAX`, ½) if no lobe has V > 0, the last lobe with V > 0 if rounding leaves the target
+/// unmet.
+struct VisiblePick<'p, 'a, 'g> {
+    patch: &'p MixturePatch<'a>,
+    g: &'g Gathered<'g>,
+    wo: Vec3,
+    target: f64,
+}
+
+impl blocks::BlockPass for VisiblePick<'_, '_, '_> {
+    type Out = (usize, f32);
+    #[inline(always)]
+    fn run<I: blocks::Isa>(self) -> (usize, f32) {
+        let (wo, target) = (self.wo, self.target);
+        let nx = self.patch.lv().grid[0];
+        let lobe = |bx: usize, by: usize, lane: usize| {
+            (by * SIDE + lane / SIDE) * nx + bx * SIDE + lane % SIDE
+        };
+        let mut acc = 0.0f64;
+        // (lobe index, rescaled u.x); the last lobe with V > 0 if rounding leaves the target unmet.
+        let mut chosen = (usize::MAX, 0.5f32);
+        let mut done = false;
+        self.patch.for_each_patch_block(
+            self.g,
+            #[inline(always)]
+            |b, wts, bx, by| {
+                if done {
+                    return;
+                }
+                let mut v = [0.0f64; LANES];
+                blocks::visible_lanes(b, wts, wo, &mut v);
+                let sum: f64 = v.iter().sum();
+                if sum.is_nan() || sum <= 0.0 {
+                    return;
+                }
+                if acc + sum <= target {
+                    if let Some(last) = (0..LANES).rev().find(|&i| v[i] > 0.0) {
+                        chosen = (lobe(bx, by, last), 1.0);
+                    }
+                    acc += sum;
+                    return;
+                }
+                for (lane, &vi) in v.iter().enumerate() {
+                    if vi > 0.0 {
+                        chosen = (lobe(bx, by, lane), ((target - acc) / vi) as f32);
+                        if acc + vi > target {
+                            done = true;
+                            return;
+                        }
+                    }
+                    acc += vi;
+                }
+            },
+        );
+        chosen
     }
 }
 
