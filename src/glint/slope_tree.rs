@@ -10,10 +10,11 @@
 use glam::Vec2;
 use rayon::prelude::*;
 
-/// Whether a slope lies in a box (NaN slopes never do).
+/// Whether a slope lies in a box (NaN slopes never do). The four comparisons are combined with `&`
+/// (not `&&`): one branch for the caller instead of up to four, whose outcomes a walk cannot predict.
 #[inline]
 pub(crate) fn contains(b: &[f32; 4], s: Vec2) -> bool {
-    s.x >= b[0] && s.y >= b[1] && s.x <= b[2] && s.y <= b[3]
+    (s.x >= b[0]) & (s.y >= b[1]) & (s.x <= b[2]) & (s.y <= b[3])
 }
 
 fn union(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
@@ -155,8 +156,18 @@ impl SlopeTree {
     /// level-0 rectangle [x.0, x.1) × [y.0, y.1) and whose boxes — its ancestors' and, for
     /// `stop` ≥ 1, its own — all contain the slope `s`, depth first.
     ///
-    /// The stack holds at most 3 pending siblings per level plus one, and a grid of at most 2³²
-    /// elements per side has at most 33 levels: 128 entries always suffice.
+    /// The walk starts below the root, at the finest level l ≥ max(`stop`, 1) on which the
+    /// rectangle spans at most 2 × 2 nodes (pushed in increasing Morton code, so popped in the
+    /// order the walk from the root reaches them), so a small footprint skips the levels above it.
+    /// Same nodes, same order as the walk from the root: a node's box is the union of its
+    /// children's ([`parent_row`]), so an ancestor's box contains the slope whenever a descendant's
+    /// does, and the skipped ancestors' tests could only have passed (`for_each_node_from_root`
+    /// in the tests checks the sequences match).
+    ///
+    /// The stack holds at most 3 pending siblings per level plus the start nodes, and a grid of at
+    /// most 2³² elements per side has at most 33 levels: 128 entries always suffice. Entries pack
+    /// (level, x, y) into a `u64` (6 + 29 + 29 bits; node coordinates < 2²⁹ on every level, i.e.
+    /// grids under 2²⁹ elements per side) so that the stack is 1 KiB of plain zeros to set up.
     ///
     /// `#[inline(always)]`: the mixture's lobe-block passes are compiled once more with AVX2
     /// (src/glint/mixture/blocks.rs, `dispatch`), and only code inlined into them gets that copy.
@@ -169,13 +180,55 @@ impl SlopeTree {
         s: Vec2,
         mut f: impl FnMut(usize, usize),
     ) {
-        let mut stack = [(0u8, 0u32, 0u32); 128];
-        let mut len = 1;
-        stack[0] = (self.top() as u8, 0, 0);
+        const BITS: u32 = 29;
+        const MASK: u64 = (1 << BITS) - 1;
+        debug_assert!(self.sizes[0][0] < 1 << BITS && self.sizes[0][1] < 1 << BITS);
+        let pack = |l: usize, nx: usize, ny: usize| {
+            ((l as u64) << (2 * BITS)) | ((nx as u64) << BITS) | ny as u64
+        };
+        if x.0 >= x.1 || y.0 >= y.1 {
+            return;
+        }
+        let top = self.top();
+        let mut stack = [0u64; 128];
+        let mut len = 0;
+        // The start level: the finest on which the rectangle spans at most 2 nodes per axis, never
+        // below `stop` or level 1 (whose test is the one the stored boxes give for level 0).
+        let wide =
+            |l: usize| ((x.1 - 1) >> l) - (x.0 >> l) > 1 || ((y.1 - 1) >> l) - (y.0 >> l) > 1;
+        let mut l0 = stop.max(1).min(top);
+        while l0 < top && wide(l0) {
+            l0 += 1;
+        }
+        let [w0, h0] = self.sizes[l0];
+        let (xa, xb) = (x.0 >> l0, ((x.1 - 1) >> l0).min(w0.saturating_sub(1)));
+        let (ya, yb) = (y.0 >> l0, ((y.1 - 1) >> l0).min(h0.saturating_sub(1)));
+        // At most 2 × 2 neighbours, pushed in increasing Morton code (bits interleaved, y's above
+        // x's): the axis whose two coordinates differ at the higher bit is the major one, y on a tie
+        // (the xor of two consecutive integers is 2^(k+1) − 1, k their highest differing bit).
+        if (ya ^ yb) >= (xa ^ xb) {
+            for ny in ya..=yb {
+                for nx in xa..=xb {
+                    stack[len] = pack(l0, nx, ny);
+                    len += 1;
+                }
+            }
+        } else {
+            for nx in xa..=xb {
+                for ny in ya..=yb {
+                    stack[len] = pack(l0, nx, ny);
+                    len += 1;
+                }
+            }
+        }
         while len > 0 {
             len -= 1;
-            let (l, nx, ny) = stack[len];
-            let (l, nx, ny) = (l as usize, nx as usize, ny as usize);
+            let e = stack[len];
+            let (l, nx, ny) = (
+                (e >> (2 * BITS)) as usize,
+                ((e >> BITS) & MASK) as usize,
+                (e & MASK) as usize,
+            );
             let (bx0, by0) = (nx << l, ny << l);
             let (bx1, by1) = ((nx + 1) << l, (ny + 1) << l);
             if bx1 <= x.0 || bx0 >= x.1 || by1 <= y.0 || by0 >= y.1 {
@@ -191,7 +244,7 @@ impl SlopeTree {
             let [cw, ch] = self.sizes[l - 1];
             for cy in (2 * ny)..(2 * ny + 2).min(ch) {
                 for cx in (2 * nx)..(2 * nx + 2).min(cw) {
-                    stack[len] = ((l - 1) as u8, cx as u32, cy as u32);
+                    stack[len] = pack(l - 1, cx, cy);
                     len += 1;
                 }
             }
@@ -235,6 +288,96 @@ pub(crate) fn reference_levels(nx: usize, ny: usize, leaf: Vec<[f32; 4]>) -> Vec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The walk as it was before it started below the root: from the root, every level's box
+    /// tested. The reference of `walk_matches_the_walk_from_the_root`.
+    fn for_each_node_from_root(
+        tree: &SlopeTree,
+        stop: usize,
+        x: (usize, usize),
+        y: (usize, usize),
+        s: Vec2,
+        mut f: impl FnMut(usize, usize),
+    ) {
+        let mut stack = vec![(tree.top(), 0usize, 0usize)];
+        while let Some((l, nx, ny)) = stack.pop() {
+            let (bx0, by0) = (nx << l, ny << l);
+            let (bx1, by1) = ((nx + 1) << l, (ny + 1) << l);
+            if bx1 <= x.0 || bx0 >= x.1 || by1 <= y.0 || by0 >= y.1 {
+                continue;
+            }
+            if l > 0 && !contains(tree.node_box(l, nx, ny), s) {
+                continue;
+            }
+            if l == stop {
+                f(nx, ny);
+                continue;
+            }
+            let [cw, ch] = tree.sizes[l - 1];
+            for cy in (2 * ny)..(2 * ny + 2).min(ch) {
+                for cx in (2 * nx)..(2 * nx + 2).min(cw) {
+                    stack.push((l - 1, cx, cy));
+                }
+            }
+        }
+    }
+
+    /// [`SlopeTree::for_each_node`] (started at the finest level where the rectangle spans 2 × 2
+    /// nodes) calls `f` for the same nodes in the same order as the walk from the root, for every
+    /// stop level, on grids of odd sizes, random boxes (some NaN, some ±0), rectangles from one
+    /// element to the whole grid and slopes inside and outside the boxes. The sequences, not just
+    /// the sets: the mixture sums its blocks in this order, so its D_P bits depend on it.
+    #[test]
+    fn walk_matches_the_walk_from_the_root() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(11);
+        let mut calls = 0usize;
+        for (nx, ny) in [
+            (1, 1),
+            (2, 3),
+            (7, 5),
+            (16, 16),
+            (33, 10),
+            (64, 64),
+            (100, 37),
+        ] {
+            let leaf: Vec<[f32; 4]> = (0..nx * ny)
+                .map(|k| {
+                    let (cx, cy): (f32, f32) =
+                        (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                    let (hx, hy): (f32, f32) =
+                        (rng.random_range(0.0..0.3), rng.random_range(0.0..0.3));
+                    if k % 97 == 5 {
+                        [f32::NAN, cy - hy, cx + hx, cy + hy]
+                    } else if k % 89 == 3 {
+                        [-0.0, -0.0, 0.0, 0.0]
+                    } else {
+                        [cx - hx, cy - hy, cx + hx, cy + hy]
+                    }
+                })
+                .collect();
+            let tree = SlopeTree::build(nx, ny, &leaf);
+            for _ in 0..300 {
+                let (x0, y0) = (rng.random_range(0..nx), rng.random_range(0..ny));
+                let x1 = rng.random_range(x0 + 1..=nx);
+                let y1 = rng.random_range(y0 + 1..=ny);
+                let s = Vec2::new(rng.random_range(-1.2..1.2), rng.random_range(-1.2..1.2));
+                for stop in 0..=tree.top() {
+                    let (mut got, mut want) = (Vec::new(), Vec::new());
+                    tree.for_each_node(stop, (x0, x1), (y0, y1), s, |a, b| got.push((a, b)));
+                    for_each_node_from_root(&tree, stop, (x0, x1), (y0, y1), s, |a, b| {
+                        want.push((a, b))
+                    });
+                    assert_eq!(
+                        got, want,
+                        "{nx}×{ny} stop {stop} x {x0}..{x1} y {y0}..{y1} {s:?}"
+                    );
+                    calls += want.len();
+                }
+            }
+        }
+        assert!(calls > 10_000, "{calls}");
+    }
 
     /// `build_with` (boxes computed on the fly, level 1 by rows in parallel) equals, bit for bit,
     /// the quadtree built by the straightforward loop over whole levels, including the order of the
