@@ -145,7 +145,9 @@ struct BlockRect {
 
 impl BlockRect {
     /// The lane weights of block (bx, by) (absolute block coordinates, inside the rectangle).
-    #[inline]
+    /// `#[inline(always)]`: called inside the block passes, whose AVX2 copy inlines only what is
+    /// forced (blocks.rs, `dispatch`).
+    #[inline(always)]
     fn weights<'w>(&self, bw: &'w [f32], bx: usize, by: usize) -> &'w [f32; LANES] {
         let o = self.offset + ((by - self.by0) * self.bw + (bx - self.bx0)) * LANES;
         bw[o..o + LANES].try_into().expect("16 lanes")
