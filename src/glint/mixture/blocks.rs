@@ -84,7 +84,7 @@ impl LobeBlock {
     }
 
     /// The eight lane arrays, read only (same order as [`LobeBlock::lanes_mut`]).
-    #[cfg(test)]
+    #[inline]
     pub(super) fn lanes(&self) -> [&[f32; LANES]; 8] {
         [
             &self.mx, &self.my, &self.j11, &self.j21, &self.j22, &self.l11, &self.l21, &self.l22,

@@ -558,8 +558,52 @@ impl CompactLevel {
     /// J₂₁ finite, the decoded lobe valid with its mean within `mean_bound`) whose box lies in its
     /// block's frame. Returns the first offence.
     pub fn check(&self, box_k: f32, mean_bound: f32) -> std::result::Result<(), String> {
+        let bad = (0..self.blocks.len())
+            .into_par_iter()
+            .map_init(LobeBlock::zeroed, |blk, b| {
+                (!self.block_ok(b, blk, box_k, mean_bound))
+                    .then(|| self.block_fault(b, box_k, mean_bound))
+            })
+            .find_map_first(|fault| fault.flatten());
+        bad.map_or(Ok(()), Err)
+    }
+
+    /// Whether every lane of block `b` passes [`CompactLevel::check`], by the block decoder and
+    /// branch-free lane tests (the loader's fast path). J in binary16's normal range and a mean
+    /// within `MAX_SLOPE` make the decoded lobe valid (L, L⁻¹ and the normalisation are then normal
+    /// `f32` numbers: |J| ∈ [2⁻¹⁴, 65504] gives L₁₁, L₂₂ ∈ [1.3·10⁻⁵, 1.4·10⁴]).
+    fn block_ok(&self, b: usize, blk: &mut LobeBlock, box_k: f32, mean_bound: f32) -> bool {
         let [w, h] = self.grid;
-        let bad = (0..self.blocks.len()).into_par_iter().find_map_first(|b| {
+        let (bx, by) = (b % self.bnx, b / self.bnx);
+        let frame = self.frame(bx, by);
+        decode_block(&self.blocks[b], frame, blk);
+        let [mx, my, j11, j21, j22, l11, l21, l22] = blk.lanes();
+        let (lo, hi) = (f16::MIN_POSITIVE.to_f32(), f16::MAX.to_f32());
+        let mut ok = true;
+        for i in 0..LANES {
+            let (x, y) = (bx * SIDE + i % SIDE, by * SIDE + i / SIDE);
+            let real = (x < w) & (y < h);
+            let j_ok = (j11[i] >= lo)
+                & (j11[i] <= hi)
+                & (j22[i] >= lo)
+                & (j22[i] <= hi)
+                & j21[i].is_finite();
+            let m_ok = (mx[i].abs() <= mean_bound) & (my[i].abs() <= mean_bound);
+            let hx = box_k * l11[i].abs();
+            let hy = box_k * (l21[i] * l21[i] + l22[i] * l22[i]).sqrt();
+            let b_ok = (mx[i] - hx >= frame[0])
+                & (my[i] - hy >= frame[1])
+                & (mx[i] + hx <= frame[2])
+                & (my[i] + hy <= frame[3]);
+            ok &= j_ok & (!real | (m_ok & b_ok));
+        }
+        ok
+    }
+
+    /// The first offence in block `b` (see [`CompactLevel::check`]), lane by lane.
+    fn block_fault(&self, b: usize, box_k: f32, mean_bound: f32) -> Option<String> {
+        let [w, h] = self.grid;
+        {
             let (bx, by) = (b % self.bnx, b / self.bnx);
             let frame = self.frame(bx, by);
             for lane in 0..LANES {
@@ -585,8 +629,7 @@ impl CompactLevel {
                 }
             }
             None
-        });
-        bad.map_or(Ok(()), Err)
+        }
     }
 }
 
