@@ -253,7 +253,7 @@ fn encode_j(g: &SlopeGaussian) -> [u16; 3] {
 
 /// The code whose decoded mean is nearest to `mu` (ties to the lower code).
 fn encode_mean(mu: f32, lo: f32, step: f32) -> u16 {
-    if !(step > 0.0) {
+    if step.is_nan() || step <= 0.0 {
         return 0;
     }
     let t = ((mu - lo) / step).round().clamp(0.0, QMAX) as i64;
@@ -799,13 +799,9 @@ mod tests {
     fn decode_error_bounds() {
         let box_k = 5.26f32;
         let (mut worst_mu, mut worst_j) = (0.0f64, 0.0f64);
-        for chunk in test_lobes(7).chunks(LANES) {
+        for (c, chunk) in test_lobes(7).chunks(LANES).enumerate() {
             let lobes: [SlopeGaussian; LANES] = std::array::from_fn(|i| chunk[i]);
-            let real = if chunk.as_ptr() as usize % 3 == 0 {
-                0x7fff
-            } else {
-                0xffff
-            };
+            let real = if c.is_multiple_of(3) { 0x7fff } else { 0xffff };
             let (words, frame, tv) = encode_block(&lobes, real, box_k);
             let (sx, sy) = steps(&frame);
             let mut blk = LobeBlock::zeroed();

@@ -293,7 +293,9 @@ impl MixtureParams {
                 reason: "must be in [1, 64] (MAX_SUPERSAMPLING)",
             });
         }
-        if self.storage == LobeStorage::Compact && !(self.sigma_min >= MIN_COMPACT_SIGMA) {
+        if self.storage == LobeStorage::Compact
+            && (self.sigma_min.is_nan() || self.sigma_min < MIN_COMPACT_SIGMA)
+        {
             return Err(Error::InvalidParameter {
                 name: "sigma_min",
                 value: self.sigma_min as f64,
