@@ -281,7 +281,7 @@ fn lod(c: &mut Criterion) {
     }
 }
 
-/// Compact storage (issue 16 item 5): `d`, exact-masking `lambda` and `sample_visible` of full
+/// Compact storage (issue 16 item 5): `patch()`, `d`, exact-masking `lambda` and `sample_visible` of full
 /// (`full`) against compact storage (`compact`: every block decoded on each visit), alternating
 /// per footprint, 256 and 4096 texels, the level of detail off (the full mixture); the same 32
 /// normals (drawn from the full patch) and views for both.
@@ -301,6 +301,16 @@ fn storage(c: &mut Criterion) {
         .unwrap();
         let w = views(3);
         let areas = [256.0f32, 4096.0];
+        let mut g = c.benchmark_group(format!("mixture_storage_patch/{name}"));
+        for area in areas {
+            let f = footprint(area);
+            for (label, mix) in [("full", &full), ("compact", &compact)] {
+                g.bench_with_input(BenchmarkId::new(label, area), &f, |b, f| {
+                    b.iter(|| mix.patch(black_box(f)).lobe_count())
+                });
+            }
+        }
+        g.finish();
         let mut g = c.benchmark_group(format!("mixture_storage_d/{name}"));
         g.throughput(Throughput::Elements(BATCH as u64));
         for area in areas {

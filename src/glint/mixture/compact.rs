@@ -647,6 +647,18 @@ impl<'a> LevelRef<'a> {
         }
     }
 
+    /// Node k's mean and covariance [xx, xy, yy] in `f64` (Σ = L Lᵀ of the decoded lane) under
+    /// compact storage; `None` in full storage (which has the moments).
+    #[inline]
+    pub fn mean_cov(&self, k: usize) -> Option<([f64; 2], [f64; 3])> {
+        let d = self.compact?.lane(k);
+        let [l11, l21, l22] = d.l.map(f64::from);
+        Some((
+            [d.mean.x as f64, d.mean.y as f64],
+            [l11 * l11, l11 * l21, l21 * l21 + l22 * l22],
+        ))
+    }
+
     /// Calls `leaf(x, y)` for every lobe in the rectangle [x.0, x.1) × [y.0, y.1) whose ancestors'
     /// boxes contain `s` (the scalar walk): down to the leaves in full storage; in compact storage,
     /// whose quadtree stops at level 2, every lobe of each level-2 node reached.

@@ -589,14 +589,17 @@ impl<'a> MixturePatch<'a> {
             *wi = acc;
             let k = axes[1].lobe_of_slot(s / lx) * lv.grid[0] + axes[0].lobe_of_slot(s % lx);
             lod_error += wn * lv.error_at(k) as f64;
-            // No stored moments (compact storage): the lobe itself.
+            // No stored moments (compact storage): the decoded lobe's mean and L Lᵀ.
             let m = lv.moments.get(k);
-            let (mu, cov) = m.and_then(|m| lobe_mean_cov(m, s2)).unwrap_or_else(|| {
-                let lobe = lv.lobe_at(k);
-                let (mu, c) = (lobe.mean(), lobe.covariance());
-                let c = [c.x_axis.x, c.x_axis.y, c.y_axis.y].map(f64::from);
-                ([mu.x as f64, mu.y as f64], c)
-            });
+            let (mu, cov) = m
+                .and_then(|m| lobe_mean_cov(m, s2))
+                .or_else(|| lv.mean_cov(k))
+                .unwrap_or_else(|| {
+                    let lobe = lv.lobe_at(k);
+                    let (mu, c) = (lobe.mean(), lobe.covariance());
+                    let c = [c.x_axis.x, c.x_axis.y, c.y_axis.y].map(f64::from);
+                    ([mu.x as f64, mu.y as f64], c)
+                });
             m1[0] += wn * mu[0];
             m1[1] += wn * mu[1];
             m2[0] += wn * (cov[0] + mu[0] * mu[0]);
