@@ -378,7 +378,10 @@ impl MixtureMemory {
 /// 4 × 4 lobes that `d`, the exact masking and the samplers evaluate 16 lanes at a time); the quadtree
 /// of slope boxes (~5.3 bytes per lobe), the moment mip chain (~6.7 bytes per lobe) and the levels of
 /// detail (~20 bytes per lobe for a full chain: merged lobes, blocks, quadtree, merge error), see
-/// [`BeckmannMixture::memory`] and docs/mixture.md ("Lobe blocks").
+/// [`BeckmannMixture::memory`] and docs/mixture.md ("Lobe blocks"). Under
+/// [`LobeStorage::Compact`] ([`MixtureParams::storage`]) only compact blocks of every level, their
+/// quadtree from level 2 up and one-byte merge errors: ≤ 16 bytes per lobe, the model defined by the
+/// decoded lobes (docs/mixture.md, "Compact storage").
 ///
 /// # Reference
 /// \[Chermain2019\] §3 (eq. 1-6), §4 (eq. 7-17), §5 (hierarchy).

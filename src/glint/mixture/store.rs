@@ -90,7 +90,9 @@ const MEAN_BOUND: f32 = 2.0 * MAX_SLOPE;
 
 impl BeckmannMixture {
     /// Writes the mixture in the crate's binary format (docs/format.md): map size, parameters and
-    /// moments, exactly (f32 bits), about 20 bytes per lobe. Writes in 64 KiB blocks.
+    /// moments, exactly (f32 bits), about 20 bytes per lobe (model kind 2); under
+    /// [`LobeStorage::Compact`], the compact levels of detail instead (frames, compact blocks and
+    /// merge-error codes, exactly; about 15 bytes per lobe, model kind 5). Writes in 64 KiB blocks.
     ///
     /// # Errors
     /// [`crate::Error::Stream`] if the writer fails.
@@ -127,8 +129,16 @@ impl BeckmannMixture {
         })
     }
 
-    /// Reads a mixture written by [`BeckmannMixture::save`]. Its patches answer `d`, `lambda`,
-    /// `projected_area`, `sample_visible` and `pdf_visible` bit-identically to the saved mixture's.
+    /// Reads a mixture written by [`BeckmannMixture::save`], in either storage (the file's model
+    /// kind). Its patches answer `d`, `lambda`, `projected_area`, `sample_visible` and `pdf_visible`
+    /// bit-identically to the saved mixture's (with the same patch options: the level-of-detail
+    /// tolerance is not stored).
+    ///
+    /// Compact files (kind 5): one read, the level count, frame, block and error counts checked
+    /// against the grid before allocating, then every lane checked (binary16 range, a valid lobe
+    /// with its mean within `MAX_SLOPE`, its slope box inside its block's frame), block-decoded in
+    /// parallel; only the quadtree's levels ≥ 3 are derived. ~23× faster than a build at 2048²
+    /// (docs/results.md, "Compact storage").
     ///
     /// Cost: one pass over the file (read, checksum and range check together) plus the O(lobes) lobe
     /// blocks, quadtree and mip chain (parallel, derived in bands of 4 lobe rows); no moment integration.
@@ -142,7 +152,9 @@ impl BeckmannMixture {
     /// [`crate::Error::ChecksumMismatch`], [`crate::Error::Stream`]; [`crate::Error::InvalidFile`] for
     /// parameters the builder refuses, a map size out of range, a lobe count that does not match the
     /// grid the size and spacing give, or moments that no built mixture holds (non-finite, means
-    /// beyond 2 · `MAX_SLOPE`, second moments beyond its square or negative).
+    /// beyond 2 · `MAX_SLOPE`, second moments beyond its square or negative); for compact files, a
+    /// level count, frame, block or error count that does not match the grid, a frame out of range
+    /// or with lo > hi, or a lane that fails the checks above.
     pub fn load(r: &mut impl Read) -> Result<Self> {
         let (mut d, kind) =
             Decoder::open_any(r, &[Kind::BeckmannMixture, Kind::BeckmannMixtureCompact])?;
