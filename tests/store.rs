@@ -574,6 +574,42 @@ fn inconsistent_compact_contents_are_errors() {
     }
 }
 
+/// Every single-byte change of a small compact file, re-sealed (so the checksum passes): the loader
+/// returns an error or a mixture whose queries are total (finite, non-negative `d` and pdfs, unit
+/// upper-hemisphere samples) — never a panic. A changed mean code or binary16 J that stays valid is a
+/// legitimate different model; everything else must be refused.
+#[test]
+fn resealed_compact_byte_changes_load_to_total_models_or_errors() {
+    let file = small_compact_file();
+    let (mut ok, mut refused) = (0, 0);
+    let fp = Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 9.0, 6, 6);
+    for k in 24..file.len() - 8 {
+        let mut f = file.clone();
+        f[k] ^= 0x5A;
+        let Ok(mix) = load_mixture(&reseal(f)) else {
+            refused += 1;
+            continue;
+        };
+        ok += 1;
+        let p = mix.patch(&fp);
+        for w in dirs() {
+            let d = p.d(w);
+            assert!(d.is_finite() && d >= 0.0, "byte {k}: d({w}) = {d}");
+            let l = p.lambda(w);
+            assert!(l.is_finite() && l >= 0.0, "byte {k}: lambda({w}) = {l}");
+            let m = p.sample_visible(w, Vec2::new(0.3, 0.8));
+            assert!(
+                m.is_finite() && (m.length() - 1.0).abs() < 1e-3 && m.z >= 0.0,
+                "byte {k}: sample {m}"
+            );
+            let q = p.pdf_visible(w, m);
+            assert!(q.is_finite() && q >= 0.0, "byte {k}: pdf {q}");
+        }
+    }
+    println!("{ok} changed files loaded (all total), {refused} refused");
+    assert!(ok > 0 && refused > 0);
+}
+
 /// Offsets in a mixture file (docs/format.md): header 24, width 24, height 32, spacing 40,
 /// sigma_min 44, samples 48, kernel_sigmas 56, weight_sigmas 60, slope_tail 64, masking 68,
 /// lod_lobes 72, lobe count 76, lobes 84.
