@@ -311,5 +311,80 @@ fn lod(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, build, queries, build_method, lod);
+/// Compact storage (issue 16 item 5): `patch()`, `d`, exact-masking `lambda` and `sample_visible` of full
+/// (`full`) against compact storage (`compact`: every block decoded on each visit), alternating
+/// per footprint, 256 and 4096 texels, the level of detail off (the full mixture); the same 32
+/// normals (drawn from the full patch) and views for both.
+///
+/// `cargo bench --bench mixture -- mixture_storage --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+fn storage(c: &mut Criterion) {
+    use brdf::glint::LobeStorage;
+    for (name, map) in maps() {
+        let full = BeckmannMixture::build(&map, params()).unwrap();
+        let compact = BeckmannMixture::build(
+            &map,
+            MixtureParams {
+                storage: LobeStorage::Compact,
+                ..params()
+            },
+        )
+        .unwrap();
+        let w = views(3);
+        let areas = [256.0f32, 4096.0];
+        let mut g = c.benchmark_group(format!("mixture_storage_patch/{name}"));
+        for area in areas {
+            let f = footprint(area);
+            for (label, mix) in [("full", &full), ("compact", &compact)] {
+                g.bench_with_input(BenchmarkId::new(label, area), &f, |b, f| {
+                    b.iter(|| mix.patch(black_box(f)).lobe_count())
+                });
+            }
+        }
+        g.finish();
+        let mut g = c.benchmark_group(format!("mixture_storage_d/{name}"));
+        g.throughput(Throughput::Elements(BATCH as u64));
+        for area in areas {
+            let m = normals(&full.patch(&footprint(area)), 7);
+            for (label, mix) in [("full", &full), ("compact", &compact)] {
+                let patch = mix.patch(&footprint(area));
+                g.bench_with_input(BenchmarkId::new(label, area), &m, |b, m| {
+                    b.iter(|| m.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
+                });
+            }
+        }
+        g.finish();
+        let mut g = c.benchmark_group(format!("mixture_storage_lambda/{name}"));
+        g.throughput(Throughput::Elements(BATCH as u64));
+        for area in areas {
+            for (label, mix) in [("full", &full), ("compact", &compact)] {
+                let patch = mix.patch(&footprint(area));
+                g.bench_with_input(BenchmarkId::new(label, area), &w, |b, w| {
+                    b.iter(|| {
+                        w.iter()
+                            .map(|&(v, _)| patch.lambda(black_box(v)))
+                            .sum::<f32>()
+                    })
+                });
+            }
+        }
+        g.finish();
+        let mut g = c.benchmark_group(format!("mixture_storage_sample_visible/{name}"));
+        g.throughput(Throughput::Elements(BATCH as u64));
+        for area in areas {
+            for (label, mix) in [("full", &full), ("compact", &compact)] {
+                let patch = mix.patch(&footprint(area));
+                g.bench_with_input(BenchmarkId::new(label, area), &w, |b, w| {
+                    b.iter(|| {
+                        w.iter()
+                            .map(|&(v, u)| patch.sample_visible(black_box(v), u).z)
+                            .sum::<f32>()
+                    })
+                });
+            }
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, build, queries, build_method, lod, storage);
 criterion_main!(benches);

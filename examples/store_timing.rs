@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release --example store_timing -- [--size N] [--loads K] [--models LIST]` (default
 //! 2048² bumpy map, 5 loads per build, every model; LIST is a comma-separated subset of `normal`,
-//! `mixture`, `pn`, `binmap`). Builds and loads alternate (build, loads, build, loads) so that a change of
+//! `mixture` (full and compact storage), `compact` (compact only), `pn`, `binmap`). Builds and loads alternate (build, loads, build, loads) so that a change of
 //! machine load hits both; files are saved to and loaded from memory (a `Vec<u8>`), so disk speed is
 //! left out. Prints a Markdown table (docs/results.md, "Saving and loading built maps").
 //!
@@ -12,7 +12,7 @@
 //! model's memory is new) and copying the file into fresh memory. Their ratio to the build is the
 //! most that any loader of this in-memory layout could reach on the machine.
 
-use brdf::glint::{BeckmannMixture, BinMap, BinMapParams, MixtureParams, NormalMap};
+use brdf::glint::{BeckmannMixture, BinMap, BinMapParams, LobeStorage, MixtureParams, NormalMap};
 use brdf::glint::{PositionNormalMap, PositionNormalParams, bumpy};
 use std::time::Instant;
 
@@ -136,6 +136,22 @@ fn main() {
                 2,
                 loads,
                 || BeckmannMixture::build(&map, MixtureParams::default()).unwrap(),
+                |m, f| m.save(f).unwrap(),
+                |f| BeckmannMixture::load(&mut &f[..]).unwrap(),
+                |m| m.memory().total(),
+            )
+        }),
+        // Compact storage (issue 16 item 5), with the `mixture` models or as `compact`.
+        (wanted("mixture") || wanted("compact")).then(|| {
+            let p = MixtureParams {
+                storage: LobeStorage::Compact,
+                ..MixtureParams::default()
+            };
+            measure(
+                "BeckmannMixture, compact",
+                2,
+                loads,
+                || BeckmannMixture::build(&map, p).unwrap(),
                 |m, f| m.save(f).unwrap(),
                 |f| BeckmannMixture::load(&mut &f[..]).unwrap(),
                 |m| m.memory().total(),

@@ -10,7 +10,7 @@
 mod support;
 
 use brdf::glint::{
-    BeckmannMixture, Footprint, MaskingMode, MixtureParams, MixturePatch, PatchOptions,
+    BeckmannMixture, Footprint, LobeStorage, MaskingMode, MixtureParams, MixturePatch, PatchOptions,
 };
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
@@ -106,7 +106,8 @@ fn first_difference(
 /// `d`, `lambda`, `visible_area_exact`, `sample_visible`, `pdf_visible` and `pdf_normal` agree bit
 /// for bit between the AVX2 and the baseline copies of the block loops, on the four procedural maps
 /// at 64², for sub-texel to whole-map (folded, wrapping) footprints, isotropic and anisotropic, with
-/// the level of detail off (exact masking) and at its defaults (merged levels, approximate masking).
+/// the level of detail off (exact masking) and at its defaults (merged levels, approximate masking),
+/// in full and in compact storage (whose blocks are decoded inside the dispatched loops).
 #[test]
 fn avx2_and_baseline_are_bit_identical() {
     let options = [
@@ -120,8 +121,17 @@ fn avx2_and_baseline_are_bit_identical() {
     let mut rng = support::rng(15);
     let mut compared = 0;
     let mut patches = 0;
-    for (name, map) in support::procedural_maps(N) {
-        let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
+    let maps = support::procedural_maps(N);
+    let storages = [LobeStorage::Full, LobeStorage::Compact];
+    for ((name, map), storage) in storages
+        .iter()
+        .flat_map(|&st| maps.iter().map(move |m| (m, st)))
+    {
+        let params = MixtureParams {
+            storage,
+            ..MixtureParams::default()
+        };
+        let mix = BeckmannMixture::build(map, params).unwrap();
         for (oi, &o) in options.iter().enumerate() {
             for k in 0..12 {
                 // 0.25 to 8192 texels (twice the map: both axes folded), centres anywhere.
@@ -148,7 +158,9 @@ fn avx2_and_baseline_are_bit_identical() {
                 assert_eq!(base.simd_path(), "baseline");
                 let (diff, n) = first_difference(&avx2, &base, &mut rng);
                 if let Some(e) = diff {
-                    panic!("{name}, options {oi}, {area} texels, aspect {aspect}: {e}");
+                    panic!(
+                        "{name}, {storage:?}, options {oi}, {area} texels, aspect {aspect}: {e}"
+                    );
                 }
                 compared += n;
                 patches += 1;

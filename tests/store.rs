@@ -7,8 +7,8 @@
 mod support;
 
 use brdf::glint::{
-    BeckmannMixture, BinLookup, BinMap, BinMapParams, Footprint, GlintNdf, MaskingMode,
-    MixtureParams, NormalMap, PatchOptions, PositionNormalMap, PositionNormalParams,
+    BeckmannMixture, BinLookup, BinMap, BinMapParams, Footprint, GlintNdf, LobeStorage,
+    MaskingMode, MixtureParams, NormalMap, PatchOptions, PositionNormalMap, PositionNormalParams,
 };
 use brdf::ndf::Ndf;
 use brdf::{Error, Vec2, Vec3};
@@ -145,6 +145,54 @@ fn mixture_round_trip_is_exact() {
             );
         }
         // Saving the loaded model gives the same bytes.
+        assert_eq!(saved(|w| loaded.save(w)), file);
+    }
+}
+
+/// Compact storage (`LobeStorage::Compact`, model kind 5): the same exactness, on a grid whose
+/// levels halve down to 1 × 1 (32²), one that stops halving (24² → 3²) and one with no level-2
+/// quadtree node on its coarsest levels (6²).
+#[test]
+fn compact_mixture_round_trip_is_exact() {
+    for (n, masking) in [
+        (32, MaskingMode::Exact),
+        (24, MaskingMode::Approximate),
+        (6, MaskingMode::Exact),
+    ] {
+        let m = map(n);
+        let params = MixtureParams {
+            storage: LobeStorage::Compact,
+            patch: PatchOptions {
+                masking,
+                lod_tolerance: 0.5,
+                ..PatchOptions::default()
+            },
+            ..MixtureParams::default()
+        };
+        let built = BeckmannMixture::build(&m, params).unwrap();
+        let file = saved(|w| built.save(w));
+        assert_eq!(&file[12..16], &5u32.to_le_bytes());
+        let loaded = BeckmannMixture::load(&mut file.as_slice()).unwrap();
+        assert_eq!(loaded.params().storage, LobeStorage::Compact);
+        assert_eq!(loaded.memory(), built.memory());
+        assert_eq!(loaded.level_count(), built.level_count());
+        let mut levels = std::collections::BTreeSet::new();
+        for (k, f) in footprints(n).iter().enumerate() {
+            // The tolerance is not stored in files: both with the build's options.
+            let (a, b) = (
+                built.patch_with(f, params.patch),
+                loaded.patch_with(f, params.patch),
+            );
+            levels.insert(a.level());
+            assert_eq!(a.level(), b.level());
+            assert_same_patch(&a, &b, &format!("compact {n}² {masking:?} fp {k}"));
+        }
+        if n >= 24 {
+            assert!(
+                levels.len() >= 2,
+                "{n}²: the footprints use levels {levels:?}"
+            );
+        }
         assert_eq!(saved(|w| loaded.save(w)), file);
     }
 }
@@ -319,6 +367,15 @@ fn small_mixture_file() -> Vec<u8> {
     saved(|w| built.save(w))
 }
 
+fn small_compact_file() -> Vec<u8> {
+    let params = MixtureParams {
+        storage: LobeStorage::Compact,
+        ..MixtureParams::default()
+    };
+    let built = BeckmannMixture::build(&map(6), params).unwrap();
+    saved(|w| built.save(w))
+}
+
 fn load_mixture(bytes: &[u8]) -> brdf::Result<BeckmannMixture> {
     BeckmannMixture::load(&mut &bytes[..])
 }
@@ -349,6 +406,9 @@ fn small_files() -> Vec<(&'static str, Vec<u8>, fn(&[u8]) -> brdf::Result<()>)> 
     let bm = BinMap::build(&m, bm_params).unwrap();
     vec![
         ("mixture", small_mixture_file(), |b| {
+            load_mixture(b).map(drop)
+        }),
+        ("compact mixture", small_compact_file(), |b| {
             load_mixture(b).map(drop)
         }),
         ("normal map", saved(|w| m.save(w)), |b| {
@@ -433,6 +493,121 @@ fn header_errors_name_what_is_wrong() {
     let mut r = f.as_slice();
     assert!(BeckmannMixture::load(&mut r).is_ok());
     assert_eq!(r, b"next");
+}
+
+/// Offsets in the compact mixture file of a 6² map (docs/format.md, kind 5; lobe grid 6², levels of
+/// detail 6² and 3²): the parameters as kind 2 up to 76, level count 76; level 0: frame count 84,
+/// 4 frames 92..156, block count 156, 4 blocks 164..804, error count 804 (0); level 1: frame count
+/// 812, 1 frame 820..836, block count 836, 1 block 844..1004, error count 1004, 9 codes 1012..1021.
+mod compact_at {
+    pub const LEVELS: usize = 76;
+    pub const FRAME0: usize = 92;
+    pub const BLOCK0: usize = 164;
+    pub const ERROR_COUNT1: usize = 1004;
+    pub const END: usize = 1021;
+}
+
+/// Compact files whose checksums are valid but whose contents no build writes: each an
+/// `InvalidFile` naming what is wrong (before any model is made).
+#[test]
+fn inconsistent_compact_contents_are_errors() {
+    let file = small_compact_file();
+    assert_eq!(
+        file.len(),
+        compact_at::END + 8,
+        "the layout the offsets assume"
+    );
+    let f32_at = |f: &[u8], at: usize| f32::from_le_bytes(f[at..at + 4].try_into().unwrap());
+    let with = |at: usize, bytes: &[u8]| {
+        let mut f = file.clone();
+        f[at..at + bytes.len()].copy_from_slice(bytes);
+        reseal(f)
+    };
+    let (lo, hi) = (
+        f32_at(&file, compact_at::FRAME0),
+        f32_at(&file, compact_at::FRAME0 + 8),
+    );
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        (
+            "level count",
+            with(compact_at::LEVELS, &3u64.to_le_bytes()),
+            "levels = 3",
+        ),
+        (
+            "error count",
+            with(compact_at::ERROR_COUNT1, &8u64.to_le_bytes()),
+            "errors holds 8",
+        ),
+        // J₁₁ of lane 0 (words 32.. of the block) = +0 or +∞ in binary16.
+        (
+            "J zero",
+            with(compact_at::BLOCK0 + 64, &0u16.to_le_bytes()),
+            "J =",
+        ),
+        (
+            "J infinite",
+            with(compact_at::BLOCK0 + 64, &0x7C00u16.to_le_bytes()),
+            "J =",
+        ),
+        (
+            "frame reversed",
+            with(compact_at::FRAME0, &(hi + 1.0).to_le_bytes()),
+            "lo > hi",
+        ),
+        (
+            "frame shrunk",
+            with(compact_at::FRAME0, &(0.5 * (lo + hi)).to_le_bytes()),
+            "outside its block's box",
+        ),
+        (
+            "frame huge",
+            with(compact_at::FRAME0, &(-1e30f32).to_le_bytes()),
+            "frames",
+        ),
+    ];
+    for (name, f, needle) in cases {
+        let e = load_mixture(&f).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidFile { .. }) && e.to_string().contains(needle),
+            "{name}: {e}"
+        );
+    }
+}
+
+/// Every single-byte change of a small compact file, re-sealed (so the checksum passes): the loader
+/// returns an error or a mixture whose queries are total (finite, non-negative `d` and pdfs, unit
+/// upper-hemisphere samples) — never a panic. A changed mean code or binary16 J that stays valid is a
+/// legitimate different model; everything else must be refused.
+#[test]
+fn resealed_compact_byte_changes_load_to_total_models_or_errors() {
+    let file = small_compact_file();
+    let (mut ok, mut refused) = (0, 0);
+    let fp = Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 9.0, 6, 6);
+    for k in 24..file.len() - 8 {
+        let mut f = file.clone();
+        f[k] ^= 0x5A;
+        let Ok(mix) = load_mixture(&reseal(f)) else {
+            refused += 1;
+            continue;
+        };
+        ok += 1;
+        let p = mix.patch(&fp);
+        for w in dirs() {
+            let d = p.d(w);
+            assert!(d.is_finite() && d >= 0.0, "byte {k}: d({w}) = {d}");
+            let l = p.lambda(w);
+            assert!(l.is_finite() && l >= 0.0, "byte {k}: lambda({w}) = {l}");
+            let m = p.sample_visible(w, Vec2::new(0.3, 0.8));
+            assert!(
+                m.is_finite() && (m.length() - 1.0).abs() < 1e-3 && m.z >= 0.0,
+                "byte {k}: sample {m}"
+            );
+            let q = p.pdf_visible(w, m);
+            assert!(q.is_finite() && q >= 0.0, "byte {k}: pdf {q}");
+        }
+    }
+    println!("{ok} changed files loaded (all total), {refused} refused");
+    assert!(ok > 0 && refused > 0);
 }
 
 /// Offsets in a mixture file (docs/format.md): header 24, width 24, height 32, spacing 40,

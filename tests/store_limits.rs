@@ -76,6 +76,37 @@ fn lying_sizes_allocate_no_more_than_the_file_holds() {
         "peak {peak} bytes"
     );
 
+    // A compact mixture (model kind 5) declaring a 32768² map: its level 0 needs 8192² frames
+    // (1 GiB) and then 8192² blocks (10 GiB); 1 MiB of frames is present.
+    let params = MixtureParams {
+        storage: brdf::glint::LobeStorage::Compact,
+        ..params
+    };
+    let mut file = Vec::new();
+    BeckmannMixture::build(&map, params)
+        .unwrap()
+        .save(&mut file)
+        .unwrap();
+    assert_eq!(&file[12..16], &5u32.to_le_bytes());
+    file[24..32].copy_from_slice(&32768u64.to_le_bytes());
+    file[32..40].copy_from_slice(&32768u64.to_le_bytes());
+    // Levels 32768², 16384², …, 1²: 16.
+    file[76..84].copy_from_slice(&16u64.to_le_bytes());
+    file[84..92].copy_from_slice(&(8192u64 * 8192).to_le_bytes());
+    file[16..24].copy_from_slice(&(68 + 12_000_000_000u64).to_le_bytes());
+    file.truncate(92);
+    file.resize(92 + (1 << 20) + 8, 0);
+    let file = reseal(file);
+    let (r, peak) = peak_during(|| BeckmannMixture::load(&mut file.as_slice()));
+    assert!(
+        matches!(r, Err(Error::Truncated { what: "frames" })),
+        "{r:?}"
+    );
+    assert!(
+        peak <= 2 * ((1 << 20) + (1 << 16)) + 4096,
+        "peak {peak} bytes"
+    );
+
     // A normal map header declaring 2^30 × 2 texels (16 GiB of slopes) with nothing behind it.
     let mut nm = Vec::new();
     map.save(&mut nm).unwrap();

@@ -89,6 +89,7 @@ pub use mixture::{
     MixtureParams, MixturePatch, PatchOptions,
 };
 pub use mixture::{DEFAULT_SUPERSAMPLING, MAX_SUPERSAMPLING, MomentMethod};
+pub use mixture::{LobeStorage, MIN_COMPACT_SIGMA};
 pub use model::{GlintModel, GlintPatch};
 pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,

@@ -126,6 +126,35 @@ impl SlopeTree {
         SlopeTree { sizes, boxes }
     }
 
+    /// A tree that stores its levels from 2 up only: level 2 as given (⌈nx/4⌉ × ⌈ny/4⌉ boxes, row
+    /// major), levels ≥ 3 the unions above it ([`parent_row`], rows in parallel); level 1 is left
+    /// empty (0 bytes), and so are all levels of a grid with no level 2 (at most 2 × 2 elements).
+    ///
+    /// For models that test each element's box themselves at level 2 (the mixture's compact lobe
+    /// blocks): only [`SlopeTree::for_each_node`] with `stop` ≥ 2 may be called on it (a walk
+    /// below level 2 would index the empty level 1).
+    pub fn from_level2(nx: usize, ny: usize, level2: Vec<[f32; 4]>) -> SlopeTree {
+        let sizes = level_sizes(nx, ny);
+        let mut boxes: Vec<Vec<[f32; 4]>> = vec![Vec::new(); sizes.len().saturating_sub(1)];
+        if sizes.len() < 3 {
+            return SlopeTree { sizes, boxes };
+        }
+        debug_assert_eq!(level2.len(), sizes[2][0] * sizes[2][1]);
+        boxes[1] = level2;
+        for l in 3..sizes.len() {
+            let [pw, ph] = sizes[l - 1];
+            let [w, h] = sizes[l];
+            let prev = &boxes[l - 2];
+            let mut level = vec![[0.0f32; 4]; w * h];
+            level
+                .par_chunks_mut(w)
+                .enumerate()
+                .for_each(|(y, out)| parent_row(pw, ph, y, |k| prev[k], out));
+            boxes[l - 1] = level;
+        }
+        SlopeTree { sizes, boxes }
+    }
+
     /// Index of the top level (its single node is the root); 0 for a 1 × 1 grid.
     #[inline]
     pub fn top(&self) -> usize {

@@ -43,6 +43,8 @@ pub(crate) enum Kind {
     PositionNormalMap = 3,
     /// [`crate::glint::BinMap`].
     BinMap = 4,
+    /// [`crate::glint::BeckmannMixture`] in compact storage ([`crate::glint::LobeStorage::Compact`]).
+    BeckmannMixtureCompact = 5,
 }
 
 impl Kind {
@@ -52,6 +54,7 @@ impl Kind {
             2 => "BeckmannMixture".into(),
             3 => "PositionNormalMap".into(),
             4 => "BinMap".into(),
+            5 => "BeckmannMixture (compact)".into(),
             c => format!("unknown kind {c}"),
         }
     }
@@ -193,6 +196,8 @@ macro_rules! scalar {
         }
     };
 }
+scalar!(u8, 1);
+scalar!(u16, 2);
 scalar!(u32, 4);
 scalar!(u64, 8);
 scalar!(f32, 4);
@@ -310,6 +315,12 @@ impl<'a> Decoder<'a> {
     /// [`Error::Truncated`], [`Error::BadMagic`], [`Error::UnsupportedVersion`],
     /// [`Error::WrongModelKind`], [`Error::Stream`].
     pub(crate) fn open(r: &'a mut dyn Read, expected: Kind) -> Result<Decoder<'a>> {
+        Self::open_any(r, &[expected]).map(|(d, _)| d)
+    }
+
+    /// [`Decoder::open`] for a loader that reads several kinds (`expected`, not empty): the
+    /// decoder and the kind found ([`Error::WrongModelKind`] names the first expected kind).
+    pub(crate) fn open_any(r: &'a mut dyn Read, expected: &[Kind]) -> Result<(Decoder<'a>, Kind)> {
         let mut head = [0u8; HEADER_BYTES];
         read_exact(r, &mut head, "the header")?;
         let mut magic = [0u8; 8];
@@ -325,20 +336,23 @@ impl<'a> Decoder<'a> {
             });
         }
         let kind = u32::get(&head[12..]);
-        if kind != expected as u32 {
+        let Some(&found) = expected.iter().find(|&&k| k as u32 == kind) else {
             return Err(Error::WrongModelKind {
-                expected: Kind::name(expected as u32),
+                expected: Kind::name(expected[0] as u32),
                 found: Kind::name(kind),
             });
-        }
+        };
         let mut sum = Checksum::new();
         sum.update(&head);
-        Ok(Decoder {
-            r,
-            sum,
-            remaining: u64::get(&head[16..]),
-            out_of_range: None,
-        })
+        Ok((
+            Decoder {
+                r,
+                sum,
+                remaining: u64::get(&head[16..]),
+                out_of_range: None,
+            },
+            found,
+        ))
     }
 
     fn take(&mut self, n: usize, what: &'static str) -> Result<()> {

@@ -227,6 +227,36 @@ impl SlopeGaussian {
         inv_chol: [std::f32::consts::SQRT_2, 0.0, std::f32::consts::SQRT_2],
     };
 
+    /// The lobe of a given mean slope and Cholesky factor L = [[l11, 0], [l21, l22]] (Σ = L Lᵀ),
+    /// kept exactly as given (L⁻¹ formed in `f64` as every constructor does): for stored forms that
+    /// hold L (the Beckmann mixture's compact lobe blocks), so that the lobe equals the stored one
+    /// bit for bit. `None` unless the mean is within [`MAX_SLOPE`], l11, l22 > 0 and L, L⁻¹ and the
+    /// normalisation are finite normal `f32` numbers.
+    pub(crate) fn from_mean_cholesky(mean: Vec2, l11: f32, l21: f32, l22: f32) -> Option<Self> {
+        if !(mean.x.abs() <= MAX_SLOPE && mean.y.abs() <= MAX_SLOPE && l11 > 0.0 && l22 > 0.0) {
+            return None;
+        }
+        let (a, b, c) = (l11 as f64, l21 as f64, l22 as f64);
+        let (i11, i22) = (1.0 / a, 1.0 / c);
+        let i21 = -b * i11 * i22;
+        let chol = [l11, l21, l22];
+        let inv_chol = [i11 as f32, i21 as f32, i22 as f32];
+        let norm = inv_chol[0] * inv_chol[2] * FRAC_1_2PI;
+        let normal = |v: f32| v.is_finite() && v.abs() >= f32::MIN_POSITIVE;
+        let ok = normal(l11)
+            && normal(l22)
+            && l21.is_finite()
+            && normal(inv_chol[0])
+            && normal(inv_chol[2])
+            && inv_chol[1].is_finite()
+            && normal(norm);
+        ok.then_some(SlopeGaussian {
+            mean,
+            chol,
+            inv_chol,
+        })
+    }
+
     /// Builds the lobe from an `f64` covariance; `None` unless Σ is positive definite and L, L⁻¹ and
     /// the normalisation are finite normal `f32` numbers.
     fn from_cov_f64(mean: Vec2, sxx: f64, sxy: f64, syy: f64) -> Option<Self> {

@@ -27,7 +27,7 @@ const LEVEL: usize = 2;
 
 /// √(½ log₂ e): the inverse Cholesky factor is stored times this, so that
 /// exp(−½ |L⁻¹ d|²) = 2^(−|J d|²) with J = √(½ log₂ e) L⁻¹.
-const J_SCALE: f64 = 0.849_321_800_288_019_1;
+pub(super) const J_SCALE: f64 = 0.849_321_800_288_019_1;
 /// 1/(2π) ÷ (½ log₂ e): P22 = |Σ|^(−½)/(2π) e^(…) = J₁₁ J₂₂ · this · 2^(…).
 const NORM_OF_J: f64 = 0.220_635_600_152_652_4;
 
@@ -52,6 +52,45 @@ pub(super) struct LobeBlock {
 const _: () = assert!(std::mem::size_of::<LobeBlock>() == 512);
 
 impl LobeBlock {
+    /// A block of zeros (a decode target: every lane is overwritten before use).
+    #[inline]
+    pub(super) fn zeroed() -> LobeBlock {
+        LobeBlock {
+            mx: [0.0; LANES],
+            my: [0.0; LANES],
+            j11: [0.0; LANES],
+            j21: [0.0; LANES],
+            j22: [0.0; LANES],
+            l11: [0.0; LANES],
+            l21: [0.0; LANES],
+            l22: [0.0; LANES],
+        }
+    }
+
+    /// The eight lane arrays, in the order μx, μy, J₁₁, J₂₁, J₂₂, L₁₁, L₂₁, L₂₂ (for the compact
+    /// storage's decoder, compact.rs, which writes them).
+    #[inline]
+    pub(super) fn lanes_mut(&mut self) -> [&mut [f32; LANES]; 8] {
+        [
+            &mut self.mx,
+            &mut self.my,
+            &mut self.j11,
+            &mut self.j21,
+            &mut self.j22,
+            &mut self.l11,
+            &mut self.l21,
+            &mut self.l22,
+        ]
+    }
+
+    /// The eight lane arrays, read only (same order as [`LobeBlock::lanes_mut`]).
+    #[inline]
+    pub(super) fn lanes(&self) -> [&[f32; LANES]; 8] {
+        [
+            &self.mx, &self.my, &self.j11, &self.j21, &self.j22, &self.l11, &self.l21, &self.l22,
+        ]
+    }
+
     fn set(&mut self, lane: usize, g: &SlopeGaussian) {
         let mu = g.mean();
         let l = g.cholesky();
@@ -87,16 +126,7 @@ impl LobeBlocks {
             .into_par_iter()
             .map(|b| {
                 let (bx, by) = (b % bnx, b / bnx);
-                let mut blk = LobeBlock {
-                    mx: [0.0; LANES],
-                    my: [0.0; LANES],
-                    j11: [0.0; LANES],
-                    j21: [0.0; LANES],
-                    j22: [0.0; LANES],
-                    l11: [0.0; LANES],
-                    l21: [0.0; LANES],
-                    l22: [0.0; LANES],
-                };
+                let mut blk = LobeBlock::zeroed();
                 for lane in 0..LANES {
                     let (x, y) = (bx * SIDE + lane % SIDE, by * SIDE + lane / SIDE);
                     let g = if x < nx && y < ny {

@@ -74,18 +74,27 @@ pub(super) struct LevelRef<'a> {
     /// Empty at level 0 (exact).
     pub error: &'a [f32],
     pub sigma_min: f32,
+    /// The level in compact storage (compact.rs): then `moments`, `blocks` and `error` are empty
+    /// and the lobes, blocks and errors are decoded from it.
+    pub compact: Option<&'a super::compact::CompactLevel>,
 }
 
 impl LevelRef<'_> {
     /// Node k (row major) as a [`SlopeGaussian`].
     #[inline]
     pub fn lobe_at(&self, k: usize) -> SlopeGaussian {
+        if let Some(c) = self.compact {
+            return c.lobe(k, self.sigma_min);
+        }
         SlopeGaussian::from_moments(self.moments[k], self.sigma_min)
     }
 
     /// The merge error of node k (0 at level 0).
     #[inline]
     pub fn error_at(&self, k: usize) -> f32 {
+        if let Some(c) = self.compact {
+            return c.error_at(k);
+        }
         self.error.get(k).copied().unwrap_or(0.0)
     }
 }

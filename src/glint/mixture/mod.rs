@@ -19,6 +19,7 @@
 mod blocks;
 mod build;
 mod build_filter;
+mod compact;
 mod hierarchy;
 mod levels;
 mod patch;
@@ -33,6 +34,7 @@ use crate::glint::slope_tree::SlopeTree;
 use crate::glint::{Footprint, GlintNdf, NormalMap};
 use crate::ndf::SlopeGaussian;
 use blocks::LobeBlocks;
+use compact::CompactLevel;
 use hierarchy::LobePyramid;
 use levels::{LevelRef, LobeLevel, build_levels};
 
@@ -135,6 +137,34 @@ impl Default for MomentMethod {
 /// node rows a band holds grow with it; the quadrature error is already ~1e-3 of 4's).
 pub const MAX_SUPERSAMPLING: u32 = 64;
 
+/// How a [`BeckmannMixture`] holds its lobes in memory (and in files).
+///
+/// Trade-off (docs/mixture.md, "Compact storage"; measured in docs/results.md): `Compact` holds
+/// ≤ 16 bytes per lobe in all (against ~84 for `Full`) and loads several times faster, at the cost
+/// of a per-block decode in every query (`d`, the exact masking and the visible sampler run slower,
+/// see the results) and of an encoding error far below the mixture's own (mean slopes to 16 bits
+/// inside their block's slope box, the inverse Cholesky factor to binary16: TV change against the
+/// ground truth ≤ 0.002 measured). Either way the model is self-consistent: `d`, the masking terms,
+/// the samplers and their pdfs all read the same stored lobes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum LobeStorage {
+    /// The raw moments (20 B per lobe), the lobe blocks in `f32` (32 B), the quadtree, the moment
+    /// mip chain and the levels of detail in the same form: ~84 bytes per lobe, the fastest queries.
+    #[default]
+    Full,
+    /// Every level of detail only as compact blocks (per lobe the mean slope as two `u16` inside its
+    /// block's slope box and the scaled inverse Cholesky factor as three binary16: 10 bytes), the
+    /// quadtree from the block level up, one-byte merge errors rounded up, no moments and no mip
+    /// chain (the filtered lobe comes from the levels of detail): ≤ 16 bytes per lobe in all.
+    /// Needs `sigma_min` ≥ [`MIN_COMPACT_SIGMA`].
+    Compact,
+}
+
+/// Smallest `sigma_min` accepted with [`LobeStorage::Compact`]: 2·10⁻⁵. Every entry of the scaled
+/// inverse Cholesky factor is at most √(½ log₂ e)/σ_min in magnitude (the covariance floor keeps every
+/// direction's σ ≥ σ_min), which must stay below binary16's largest value 65504.
+pub const MIN_COMPACT_SIGMA: f32 = 2.0e-5;
+
 /// Default masking mode of patches.
 pub const DEFAULT_MASKING: MaskingMode = MaskingMode::Exact;
 
@@ -202,6 +232,9 @@ pub struct MixtureParams {
     /// How the moments are integrated ([`MomentMethod::default`]: the filter). Not stored in saved
     /// files (a loaded mixture reads its moments and reports the default here).
     pub moments: MomentMethod,
+    /// How the lobes are held ([`LobeStorage::Full`] by default). Stored in files (as the model
+    /// kind, docs/format.md).
+    pub storage: LobeStorage,
 }
 
 impl Default for MixtureParams {
@@ -215,6 +248,7 @@ impl Default for MixtureParams {
             slope_tail: DEFAULT_SLOPE_TAIL,
             patch: PatchOptions::default(),
             moments: MomentMethod::default(),
+            storage: LobeStorage::default(),
         }
     }
 }
@@ -259,6 +293,16 @@ impl MixtureParams {
                 reason: "must be in [1, 64] (MAX_SUPERSAMPLING)",
             });
         }
+        if self.storage == LobeStorage::Compact
+            && (self.sigma_min.is_nan() || self.sigma_min < MIN_COMPACT_SIGMA)
+        {
+            return Err(Error::InvalidParameter {
+                name: "sigma_min",
+                value: self.sigma_min as f64,
+                reason: "must be >= 2e-5 (MIN_COMPACT_SIGMA) with LobeStorage::Compact: the \
+                         inverse Cholesky factors must fit binary16",
+            });
+        }
         if !(self.slope_tail > 0.0 && self.slope_tail < 1.0) {
             return Err(Error::InvalidParameter {
                 name: "slope_tail",
@@ -286,6 +330,11 @@ impl MixtureParams {
 }
 
 /// Memory held by a [`BeckmannMixture`], in bytes.
+///
+/// Under [`LobeStorage::Compact`]: `lobe_bytes` and `mip_bytes` are 0 (no moments, no mip chain),
+/// `block_bytes` holds level 0's compact blocks (160 bytes per 4 × 4 lobes), `hierarchy_bytes` its
+/// quadtree from level 2 up, and `level_bytes` the levels l ≥ 1 in the same form with one byte of
+/// merge error per node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MixtureMemory {
     /// Number of lobes.
@@ -329,7 +378,10 @@ impl MixtureMemory {
 /// 4 × 4 lobes that `d`, the exact masking and the samplers evaluate 16 lanes at a time); the quadtree
 /// of slope boxes (~5.3 bytes per lobe), the moment mip chain (~6.7 bytes per lobe) and the levels of
 /// detail (~20 bytes per lobe for a full chain: merged lobes, blocks, quadtree, merge error), see
-/// [`BeckmannMixture::memory`] and docs/mixture.md ("Lobe blocks").
+/// [`BeckmannMixture::memory`] and docs/mixture.md ("Lobe blocks"). Under
+/// [`LobeStorage::Compact`] ([`MixtureParams::storage`]) only compact blocks of every level, their
+/// quadtree from level 2 up and one-byte merge errors: ≤ 16 bytes per lobe, the model defined by the
+/// decoded lobes (docs/mixture.md, "Compact storage").
 ///
 /// # Reference
 /// \[Chermain2019\] §3 (eq. 1-6), §4 (eq. 7-17), §5 (hierarchy).
@@ -347,6 +399,9 @@ pub struct BeckmannMixture {
     pyramid: LobePyramid,
     /// The levels of detail l ≥ 1 (`levels[l - 1]`), derived from the lobes (levels.rs).
     levels: Vec<LobeLevel>,
+    /// Under [`LobeStorage::Compact`], every level (0 included) in compact form, and the fields
+    /// above empty; empty under [`LobeStorage::Full`].
+    compact: Vec<CompactLevel>,
     params: MixtureParams,
     /// Half-width of the slope boxes in lobe standard deviations, k = √(−2 ln tail).
     box_k: f32,
@@ -448,6 +503,12 @@ impl BeckmannMixture {
     ) -> Self {
         let [nx, ny] = grid;
         let box_k = (-2.0 * (params.slope_tail as f64).ln()).sqrt() as f32;
+        if params.storage == LobeStorage::Compact {
+            let pad = SlopeGaussian::from_moments([0.0; 5], params.sigma_min);
+            let full_levels = build_levels(nx, ny, &lobes, params.sigma_min, box_k, &pad);
+            let compact = compact::build(nx, ny, &lobes, params.sigma_min, box_k, full_levels);
+            return Self::with_compact(width, height, grid, spacing, params, box_k, compact);
+        }
         // Blocks and tree in one streaming pass (no whole-grid temporaries), then the mip chain.
         let (blocks, tree) = store::derive_blocks_and_tree(nx, ny, &lobes, params.sigma_min, box_k);
         let pyramid = LobePyramid::build(nx, ny, &lobes);
@@ -463,8 +524,53 @@ impl BeckmannMixture {
             tree,
             pyramid,
             levels,
+            compact: Vec::new(),
             params,
             box_k,
+        }
+    }
+
+    /// A mixture in compact storage from its compact levels (level 0 first).
+    fn with_compact(
+        width: usize,
+        height: usize,
+        grid: [usize; 2],
+        spacing: [f64; 2],
+        params: MixtureParams,
+        box_k: f32,
+        compact: Vec<CompactLevel>,
+    ) -> Self {
+        BeckmannMixture {
+            width,
+            height,
+            grid,
+            spacing,
+            lobes: Vec::new(),
+            blocks: LobeBlocks {
+                bnx: 0,
+                blocks: Vec::new(),
+            },
+            tree: SlopeTree::from_level2(1, 1, Vec::new()),
+            pyramid: LobePyramid::build(1, 1, &[[0.0; 5]]),
+            levels: Vec::new(),
+            compact,
+            params,
+            box_k,
+        }
+    }
+
+    /// How the lobes are held.
+    pub fn storage(&self) -> LobeStorage {
+        self.params.storage
+    }
+
+    /// The filtered moments at a position (level-0 lobe units) and level of detail: the moment mip
+    /// chain's trilinear lookup, or under compact storage the levels of detail's (compact.rs).
+    pub(super) fn filtered_moments(&self, p: [f64; 2], lod: f64) -> [f32; 5] {
+        if self.compact.is_empty() {
+            self.pyramid.filtered(&self.lobes, p, lod)
+        } else {
+            compact::filtered(&self.compact, p, lod)
         }
     }
 
@@ -489,7 +595,8 @@ impl BeckmannMixture {
     }
 
     /// The stored moments, row major over the lobe grid:
-    /// `[E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]` of the interpolated map's slopes under k_i.
+    /// `[E[x̃], E[ỹ], E[x̃²], E[ỹ²], E[x̃ỹ]]` of the interpolated map's slopes under k_i. Empty under
+    /// [`LobeStorage::Compact`], which holds no moments (use [`BeckmannMixture::lobe`]).
     pub fn moments(&self) -> &[[f32; 5]] {
         &self.lobes
     }
@@ -506,7 +613,7 @@ impl BeckmannMixture {
 
     #[inline]
     fn lobe_at(&self, k: usize) -> SlopeGaussian {
-        SlopeGaussian::from_moments(self.lobes[k], self.params.sigma_min)
+        self.level_ref(0).lobe_at(k)
     }
 
     /// The slope-box half-width k in lobe standard deviations: √(−2 ln `slope_tail`).
@@ -516,6 +623,16 @@ impl BeckmannMixture {
 
     /// Bytes held by the lobes, the hierarchy and the mip chain.
     pub fn memory(&self) -> MixtureMemory {
+        if let Some(l0) = self.compact.first() {
+            return MixtureMemory {
+                lobes: self.grid[0] * self.grid[1],
+                lobe_bytes: 0,
+                hierarchy_bytes: l0.tree.bytes() + std::mem::size_of::<[f32; 4]>(),
+                mip_bytes: 0,
+                block_bytes: l0.blocks.len() * std::mem::size_of::<compact::CompactBlock>(),
+                level_bytes: self.compact[1..].iter().map(CompactLevel::bytes).sum(),
+            };
+        }
         MixtureMemory {
             lobes: self.lobes.len(),
             lobe_bytes: self.lobes.len() * 20,
@@ -529,11 +646,29 @@ impl BeckmannMixture {
     /// Number of levels of detail, level 0 (the lobes) included: 1 + the number of times both
     /// sides of the lobe grid halve evenly.
     pub fn level_count(&self) -> usize {
-        1 + self.levels.len()
+        if self.compact.is_empty() {
+            1 + self.levels.len()
+        } else {
+            self.compact.len()
+        }
     }
 
     /// Level l (clamped to the coarsest) as the patch reads it.
     fn level_ref(&self, l: usize) -> LevelRef<'_> {
+        if !self.compact.is_empty() {
+            let l = l.min(self.compact.len() - 1);
+            let c = &self.compact[l];
+            return LevelRef {
+                level: l,
+                grid: c.grid,
+                moments: &[],
+                blocks: &self.blocks,
+                tree: &c.tree,
+                error: &[],
+                sigma_min: self.params.sigma_min,
+                compact: Some(c),
+            };
+        }
         let l = l.min(self.levels.len());
         match l {
             0 => LevelRef {
@@ -544,6 +679,7 @@ impl BeckmannMixture {
                 tree: &self.tree,
                 error: &[],
                 sigma_min: self.params.sigma_min,
+                compact: None,
             },
             _ => {
                 let lv = &self.levels[l - 1];
@@ -555,6 +691,7 @@ impl BeckmannMixture {
                     tree: &lv.tree,
                     error: &lv.error,
                     sigma_min: self.params.sigma_min,
+                    compact: None,
                 }
             }
         }
@@ -562,13 +699,24 @@ impl BeckmannMixture {
 
     /// The merge-error bounds e(n) of level l ≥ 1 (row major over its nodes; empty for level 0 or
     /// beyond the coarsest level): upper bounds of the TV between each merged lobe and the mixture
-    /// of the level-0 lobes it replaces (src/glint/mixture/levels.rs).
+    /// of the level-0 lobes it replaces (src/glint/mixture/levels.rs). Empty under
+    /// [`LobeStorage::Compact`], whose errors are one-byte codes: see [`BeckmannMixture::level_error`].
     pub fn level_errors(&self, l: usize) -> &[f32] {
         if l == 0 {
             &[]
         } else {
             self.levels.get(l - 1).map_or(&[], |lv| lv.error.as_slice())
         }
+    }
+
+    /// The merge-error bound e(n) of node k (row major) of level l, in either storage (0 at level 0
+    /// or out of range). Under [`LobeStorage::Compact`] the stored bound rounded up to its one-byte
+    /// code, with the encoding's own error included (docs/mixture.md, "Compact storage").
+    pub fn level_error(&self, l: usize, k: usize) -> f32 {
+        if l == 0 || l >= self.level_count() {
+            return 0.0;
+        }
+        self.level_ref(l).error_at(k)
     }
 
     /// The patch of a footprint with explicit options (masking mode, level of detail).

@@ -436,7 +436,7 @@ impl<'a> MixturePatch<'a> {
         let fp = FootprintLobes::new(mixture, footprint);
         let area = fp.area();
         let lod = 0.5 * area.max(1e-300).log2();
-        let filtered_m = mixture.pyramid.filtered(&mixture.lobes, fp.c, lod);
+        let filtered_m = mixture.filtered_moments(fp.c, lod);
         let filtered = SlopeGaussian::from_moments(filtered_m, mixture.params.sigma_min);
         let (lv, gathered) = match Self::level_range(mixture, &fp, area, &options) {
             None => (mixture.level_ref(0), None),
@@ -595,12 +595,17 @@ impl<'a> MixturePatch<'a> {
             *wi = acc;
             let k = axes[1].lobe_of_slot(s / lx) * lv.grid[0] + axes[0].lobe_of_slot(s % lx);
             lod_error += wn * lv.error_at(k) as f64;
-            let (mu, cov) = lobe_mean_cov(&lv.moments[k], s2).unwrap_or_else(|| {
-                let lobe = lv.lobe_at(k);
-                let (mu, c) = (lobe.mean(), lobe.covariance());
-                let c = [c.x_axis.x, c.x_axis.y, c.y_axis.y].map(f64::from);
-                ([mu.x as f64, mu.y as f64], c)
-            });
+            // No stored moments (compact storage): the decoded lobe's mean and L Lᵀ.
+            let m = lv.moments.get(k);
+            let (mu, cov) = m
+                .and_then(|m| lobe_mean_cov(m, s2))
+                .or_else(|| lv.mean_cov(k))
+                .unwrap_or_else(|| {
+                    let lobe = lv.lobe_at(k);
+                    let (mu, c) = (lobe.mean(), lobe.covariance());
+                    let c = [c.x_axis.x, c.x_axis.y, c.y_axis.y].map(f64::from);
+                    ([mu.x as f64, mu.y as f64], c)
+                });
             m1[0] += wn * mu[0];
             m1[1] += wn * mu[1];
             m2[0] += wn * (cov[0] + mu[0] * mu[0]);
@@ -801,7 +806,6 @@ impl<'a> MixturePatch<'a> {
     /// a depth-first walk of the quadtree to its leaves, each lobe rebuilt from its moments.
     fn sum_p22_scalar(&self, g: &Gathered, s: Vec2) -> (f64, usize) {
         let (mix, lv) = (self.mixture, self.lv());
-        let tree = lv.tree;
         let [nx, _] = lv.grid;
         let lx = g.axes[0].len;
         let (xs, nxs) = g.axes[0].segments();
@@ -811,12 +815,14 @@ impl<'a> MixturePatch<'a> {
         let mut touched = 0usize;
         for &(x_lo, x_hi, x_off) in &xs[..nxs] {
             for &(y_lo, y_hi, y_off) in &ys[..nys] {
-                tree.for_each_leaf((x_lo, x_hi), (y_lo, y_hi), s, |x, y| {
+                lv.for_each_leaf((x_lo, x_hi), (y_lo, y_hi), s, |x, y| {
                     let k = y * nx + x;
-                    let p22 = match leaf.p22_in_box(&lv.moments[k], s) {
+                    let leaf_of = |m| leaf.p22_in_box(m, s);
+                    let p22 = match lv.moments.get(k).map_or(Leaf::Degenerate, leaf_of) {
                         Leaf::Outside => return,
                         Leaf::Inside(p) => p,
-                        // Non-finite moments: the lobe's documented fallback.
+                        // Non-finite moments: the lobe's documented fallback (and compact
+                        // storage, which holds no moments: the decoded lobe).
                         Leaf::Degenerate => {
                             let lobe = lv.lobe_at(k);
                             if !contains(&lobe_box(&lobe, mix.box_k), s) {
@@ -852,11 +858,12 @@ impl<'a> MixturePatch<'a> {
         mut f: impl FnMut(&blocks::LobeBlock, &[f32; LANES], usize, usize),
     ) {
         let bw = &g.bufs.block_weights;
-        let blocks = self.lv().blocks;
+        let lv = self.lv();
+        let mut buf = blocks::LobeBlock::zeroed();
         for r in &g.rects[..g.n_rects] {
             for by in r.by0..r.by0 + r.bh {
                 for bx in r.bx0..r.bx0 + r.bw {
-                    f(blocks.block(bx, by), r.weights(bw, bx, by), bx, by);
+                    f(lv.block(bx, by, &mut buf), r.weights(bw, bx, by), bx, by);
                 }
             }
         }
@@ -1171,6 +1178,7 @@ impl blocks::BlockPass for SumP22<'_, '_, '_> {
         let bw = &g.bufs.block_weights;
         let mut acc = [0.0f64; LANES];
         let mut blocks_seen = 0usize;
+        let mut buf = blocks::LobeBlock::zeroed();
         for r in &g.rects[..g.n_rects] {
             blocks::for_each_block(
                 lv.tree,
@@ -1181,7 +1189,7 @@ impl blocks::BlockPass for SumP22<'_, '_, '_> {
                 |bx, by| {
                     blocks_seen += 1;
                     let w = r.weights(bw, bx, by);
-                    blocks::p22_lanes::<true>(lv.blocks.block(bx, by), w, s, k2, &mut acc);
+                    blocks::p22_lanes::<true>(lv.block(bx, by, &mut buf), w, s, k2, &mut acc);
                 },
             );
         }
