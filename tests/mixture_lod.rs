@@ -97,7 +97,7 @@ impl Grid {
         for c in mix {
             let (a, b, d) = (c.cov[0] + r * r, c.cov[1], c.cov[2] + r * r);
             let det = a * d - b * b;
-            if !(det > 0.0) || c.w == 0.0 {
+            if det.is_nan() || det <= 0.0 || c.w == 0.0 {
                 continue;
             }
             let norm = c.w / (std::f64::consts::TAU * det.sqrt());
@@ -141,7 +141,7 @@ struct GridNdf<'a> {
 
 impl Ndf for GridNdf<'_> {
     fn d(&self, m: Vec3) -> f32 {
-        if !(m.z > 0.0) {
+        if m.z.is_nan() || m.z <= 0.0 {
             return 0.0;
         }
         let s = [-(m.x / m.z) as f64, -(m.y / m.z) as f64];
