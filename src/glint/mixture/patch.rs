@@ -698,10 +698,12 @@ impl<'a> MixturePatch<'a> {
     }
 
     /// The level of detail's error bound Σ W_n e_r(n): an upper bound of the TV between this
-    /// patch's slope density and the full mixture's with the same node weights, both blurred by an
-    /// isotropic Gaussian of std r in slope space, r the largest of [`super::LOD_RESOLUTIONS`] not
-    /// above `PatchOptions::lod_resolution` (0 at level 0; 1 under the filtered lobe, which has no
-    /// bound). See src/glint/mixture/levels.rs.
+    /// patch's slope density and that of the level-0 lobes its nodes replace, each node's weight
+    /// W_n spread evenly over its lobes, both blurred by an isotropic Gaussian of std r in slope
+    /// space, r the largest of [`super::LOD_RESOLUTIONS`] not above `PatchOptions::lod_resolution`
+    /// (0 at level 0; 1 under the filtered lobe, which has no bound). The difference between that
+    /// even spread and the full mixture's own weights is not bounded (measured 0.0005-0.013 in TV,
+    /// docs/mixture.md). See src/glint/mixture/levels.rs.
     pub fn lod_error(&self) -> f32 {
         self.gathered.as_ref().map_or(1.0, |g| g.lod_error as f32)
     }
