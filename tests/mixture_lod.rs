@@ -440,9 +440,9 @@ fn level_of_detail_respects_its_tolerance_at_its_resolution() {
             let full = patch_mixture(&full_p);
             for r in [0.01f32, 0.04] {
                 let rr = r as f64;
-                // Step: a fifth of the narrowest convolved σ (≥ r), so the midpoint rule resolves
+                // Step: a quarter of the narrowest convolved σ (≥ r), so the midpoint rule resolves
                 // every lobe.
-                let grid = Grid::covering(&[&full], rr / 5.0, rr);
+                let grid = Grid::covering(&[&full], rr / 4.0, rr);
                 let coarse = Grid {
                     step: 2.0 * grid.step,
                     n: grid.n.div_ceil(2),
