@@ -56,6 +56,7 @@ fn params() -> MixtureParams {
             masking: MaskingMode::Exact,
             lod_lobes: f32::INFINITY,
             lod_tolerance: 0.0,
+            ..PatchOptions::default()
         },
         ..MixtureParams::default()
     }
@@ -216,6 +217,7 @@ fn queries(c: &mut Criterion) {
                 masking: MaskingMode::Approximate,
                 lod_lobes: f32::INFINITY,
                 lod_tolerance: 0.0,
+                ..PatchOptions::default()
             };
             let patch = mix.patch_with(&footprint(area), options);
             g.bench_with_input(BenchmarkId::from_parameter(area), &w, |b, w| {
@@ -281,6 +283,7 @@ fn lod(c: &mut Criterion) {
         masking: MaskingMode::Exact,
         lod_lobes: f32::INFINITY,
         lod_tolerance: 0.0,
+        ..PatchOptions::default()
     };
     let lod = PatchOptions::default();
     for (name, map) in maps() {

@@ -1,6 +1,8 @@
 //! The mixture's levels of detail chosen by error (issue 15 item 2): TV to the ground truth and the
-//! time of one `d` against the footprint size, for the full mixture, three tolerances (0.01, the
-//! default, 0.03 and 0.1, with the default cost cap) and the single filtered lobe.
+//! time of one `d` against the footprint size, for the full mixture, the default level of detail
+//! (tolerance 0.01 at slope resolution r = 0.01), the same tolerance at r = 0 (the continuous bound)
+//! and at r = 0.04, tolerance 0.03 at r = 0.01, the single filtered lobe, and levels 1-3 forced by
+//! the cost cap (what each level costs in TV where the target asks for 10× cheaper `d`).
 //!
 //! `cargo run --release --example mixture_lod -- [--out DIR] [--quick] [--size N]`
 //!
@@ -11,8 +13,9 @@
 //! (1 with `--quick`). Time: one thread, 512 fixed normals (half drawn from the full mixture's
 //! D_P cos θ, half bin centres), the best of 3 alternating rounds over the configurations, each
 //! round repeating the 512 calls for ≥ 20 ms. Writes `mixture_lod.csv`, and per map
-//! `mixture_lod_tv_{map}.png` and `mixture_lod_time_{map}.png`; prints a Markdown table
-//! (docs/results.md, "Levels of detail chosen by error (issue 15)").
+//! `mixture_lod_tv_{map}.png` and `mixture_lod_time_{map}.png` (the charted configurations); prints
+//! two Markdown tables (docs/results.md, "Levels of detail chosen by error (issue 15)"): TV / time /
+//! level per configuration and footprint, and issue 15's target cell by cell at ≥ 4096 texels.
 
 mod common;
 
@@ -27,46 +30,63 @@ use common::{Chart, Res, Scale, Series};
 use std::io::Write;
 use std::time::Instant;
 
-/// One patch configuration of the sweep.
+/// One patch configuration of the sweep: its options for a footprint of `texels` texels.
 struct Config {
     label: &'static str,
-    options: PatchOptions,
+    options: Box<dyn Fn(f32) -> PatchOptions>,
+    /// Drawn on the charts (the forced levels are in the tables and the CSV only).
+    charted: bool,
+    /// The level forced by the cost cap (tolerance 0), if any.
+    forced: Option<u32>,
 }
 
 fn configs() -> Vec<Config> {
-    let tol = |t: f32| PatchOptions {
+    let lod = |t: f32, r: f32| PatchOptions {
         lod_tolerance: t,
+        lod_resolution: r,
         ..PatchOptions::default()
     };
+    let fixed = |label, options: PatchOptions| Config {
+        label,
+        options: Box::new(move |_| options),
+        charted: true,
+        forced: None,
+    };
+    // Level l by the cost cap: a cap just above the footprint's node count at level l.
+    let forced = |label, l: u32| Config {
+        label,
+        options: Box::new(move |texels| PatchOptions {
+            lod_lobes: 1.01 * texels / 4f32.powi(l as i32),
+            lod_tolerance: 0.0,
+            ..PatchOptions::default()
+        }),
+        charted: false,
+        forced: Some(l),
+    };
     vec![
-        Config {
-            label: "full mixture",
-            options: PatchOptions {
+        fixed(
+            "full mixture",
+            PatchOptions {
                 lod_lobes: f32::INFINITY,
                 lod_tolerance: 0.0,
                 ..PatchOptions::default()
             },
-        },
-        Config {
-            label: "tol 0.01 (default)",
-            options: tol(0.01),
-        },
-        Config {
-            label: "tol 0.03",
-            options: tol(0.03),
-        },
-        Config {
-            label: "tol 0.1",
-            options: tol(0.1),
-        },
-        Config {
-            label: "filtered lobe",
-            options: PatchOptions {
+        ),
+        fixed("default: tol 0.01 / r 0.01", PatchOptions::default()),
+        fixed("tol 0.01 / r 0", lod(0.01, 0.0)),
+        fixed("tol 0.01 / r 0.04", lod(0.01, 0.04)),
+        fixed("tol 0.03 / r 0.01", lod(0.03, 0.01)),
+        fixed(
+            "filtered lobe",
+            PatchOptions {
                 lod_lobes: 0.0,
                 lod_tolerance: 0.0,
                 ..PatchOptions::default()
             },
-        },
+        ),
+        forced("level 1 (cap)", 1),
+        forced("level 2 (cap)", 2),
+        forced("level 3 (cap)", 3),
     ]
 }
 
@@ -150,7 +170,7 @@ fn main() -> Res<()> {
             let truth = binned_pndf(map, &fp, Kernel::Gaussian, &bins, positions, 17);
             let patches: Vec<MixturePatch> = configs
                 .iter()
-                .map(|c| mix.patch_with(&fp, c.options))
+                .map(|c| mix.patch_with(&fp, (c.options)(texels)))
                 .collect();
             let normals: Vec<Vec3> = (0..512)
                 .map(|k| {
@@ -167,7 +187,7 @@ fn main() -> Res<()> {
             for _round in 0..3 {
                 for (i, c) in configs.iter().enumerate() {
                     d_s[i] = d_s[i].min(time_d(&patches[i], &normals));
-                    patch_s[i] = patch_s[i].min(time_patch(&mix, &fp, c.options));
+                    patch_s[i] = patch_s[i].min(time_patch(&mix, &fp, (c.options)(texels)));
                 }
             }
             for (i, p) in patches.iter().enumerate() {
@@ -200,7 +220,7 @@ fn write_outputs(
     let mut csv = std::fs::File::create(out.join("mixture_lod.csv"))?;
     writeln!(
         csv,
-        "map,texels,config,tolerance,lod_lobes,level,lod_error,slots,tv,tv_increase,d_ns,patch_us"
+        "map,texels,config,tolerance,resolution,lod_lobes,level,lod_error,slots,tv,tv_increase,d_ns,patch_us"
     )?;
     let full = |r: &Row| {
         rows.iter()
@@ -208,15 +228,16 @@ fn write_outputs(
             .expect("full row")
     };
     for r in rows {
-        let c = &configs[r.config];
+        let o = (configs[r.config].options)(r.texels);
         writeln!(
             csv,
-            "{},{},{},{},{},{},{:.5},{},{:.5},{:.5},{:.1},{:.2}",
+            "{},{},{},{},{},{},{},{:.5},{},{:.5},{:.5},{:.1},{:.2}",
             r.map,
             r.texels,
-            c.label,
-            c.options.lod_tolerance,
-            c.options.lod_lobes,
+            configs[r.config].label,
+            o.lod_tolerance,
+            o.lod_resolution,
+            o.lod_lobes,
             r.level,
             r.lod_error,
             r.slots,
@@ -226,21 +247,23 @@ fn write_outputs(
             r.patch_s * 1e6
         )?;
     }
+    let shown: Vec<usize> = (0..configs.len()).filter(|&i| configs[i].charted).collect();
     println!("| map | texels | {} |", {
-        configs
+        shown
             .iter()
-            .map(|c| format!("{} TV / d / level", c.label))
+            .map(|&i| format!("{} TV / d / level", configs[i].label))
             .collect::<Vec<_>>()
             .join(" | ")
     });
-    println!("|---|---|{}", "---|".repeat(configs.len()));
+    println!("|---|---|{}", "---|".repeat(shown.len()));
     for (name, _) in maps {
         let here: Vec<&Row> = rows.iter().filter(|r| r.map == *name).collect();
         let mut texels: Vec<f32> = here.iter().map(|r| r.texels).collect();
         texels.dedup();
         for t in texels {
-            let cells: Vec<String> = (0..configs.len())
-                .map(|i| {
+            let cells: Vec<String> = shown
+                .iter()
+                .map(|&i| {
                     let r = here
                         .iter()
                         .find(|r| r.texels == t && r.config == i)
@@ -257,6 +280,7 @@ fn write_outputs(
             let series: Vec<Series> = configs
                 .iter()
                 .enumerate()
+                .filter(|(_, c)| c.charted)
                 .map(|(i, c)| Series {
                     label: c.label.to_string(),
                     points: here
@@ -281,8 +305,43 @@ fn write_outputs(
             println!("{}", path.display());
         }
     }
+    target_table(rows, configs);
     println!("{}", out.join("mixture_lod.csv").display());
     Ok(())
+}
+
+/// Issue 15's target cell by cell at ≥ 4096 texels: for every configuration other than the full
+/// mixture, its level, bound, TV increase against the full mixture's TV to the same truth, and the
+/// `d` speed-up (full ÷ this, same run); "met" when the speed-up is ≥ 10 and the increase ≤ 0.01.
+fn target_table(rows: &[Row], configs: &[Config]) {
+    println!();
+    println!(
+        "| map | texels | config | level | bound Σ W e_r | TV increase | `d` speed-up | target |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for r in rows.iter().filter(|r| r.texels >= 4096.0 && r.config > 0) {
+        let full = rows
+            .iter()
+            .find(|q| q.map == r.map && q.texels == r.texels && q.config == 0)
+            .expect("full row");
+        let c = &configs[r.config];
+        if c.forced.is_some_and(|l| r.level != l as usize) {
+            continue;
+        }
+        let (inc, speed) = (r.tv - full.tv, full.d_s / r.d_s);
+        let met = speed >= 10.0 && inc <= 0.01;
+        println!(
+            "| {} | {} | {} | {} | {:.3} | {:+.3} | {:.1}× | {} |",
+            r.map,
+            r.texels,
+            c.label,
+            r.level,
+            r.lod_error,
+            inc,
+            speed,
+            if met { "met" } else { "no" }
+        );
+    }
 }
 
 fn fmt_time(s: f64) -> String {

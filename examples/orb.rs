@@ -81,6 +81,7 @@ mod tests {
                 masking,
                 lod_lobes,
                 lod_tolerance: 0.0,
+                ..PatchOptions::default()
             },
         };
         [

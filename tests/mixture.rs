@@ -51,6 +51,7 @@ fn exact_params() -> MixtureParams {
             masking: MaskingMode::Exact,
             lod_lobes: f32::INFINITY,
             lod_tolerance: 0.0,
+            ..PatchOptions::default()
         },
         ..MixtureParams::default()
     }
@@ -405,6 +406,7 @@ fn white_furnace_exact_and_approximate() {
                     masking,
                     lod_lobes: f32::INFINITY,
                     lod_tolerance: 0.0,
+                    ..PatchOptions::default()
                 };
                 let patch = mix.patch_with(&footprint(area, Vec2::new(0.37, 0.61)), options);
                 for theta in thetas {
@@ -650,6 +652,7 @@ fn bad_input() {
                         masking,
                         lod_lobes: lod,
                         lod_tolerance: tol,
+                        ..PatchOptions::default()
                     },
                 );
                 for &w in &dirs {
@@ -745,6 +748,7 @@ fn accuracy_table() {
                     masking: MaskingMode::Approximate,
                     lod_lobes: 0.0,
                     lod_tolerance: 0.0,
+                    ..PatchOptions::default()
                 },
             );
             let (d, c, k, noise) = tv_both_truths(&exact, &t);
@@ -829,6 +833,7 @@ fn lod_table() {
                     masking: MaskingMode::Approximate,
                     lod_lobes: 0.0,
                     lod_tolerance: 0.0,
+                    ..PatchOptions::default()
                 },
             );
             let tv = tv_distance(&exact, &reference, 1);
@@ -891,6 +896,7 @@ fn build_2048() {
                 masking: MaskingMode::Exact,
                 lod_lobes: f32::INFINITY,
                 lod_tolerance: 0.0,
+                ..PatchOptions::default()
             },
         );
         let t_patch = t.elapsed();
@@ -924,6 +930,7 @@ fn build_2048() {
                 masking: MaskingMode::Approximate,
                 lod_lobes: f32::INFINITY,
                 lod_tolerance: 0.0,
+                ..PatchOptions::default()
             },
         );
         let t = std::time::Instant::now();
@@ -1108,6 +1115,9 @@ fn lod_against_full(
         fp,
         PatchOptions {
             lod_tolerance: tol,
+            // The continuous bound: this compares continuous TVs (tests/mixture_lod.rs checks the
+            // bounds at r > 0 against blurred TVs).
+            lod_resolution: 0.0,
             ..exact_params().patch
         },
     );
@@ -1158,6 +1168,7 @@ fn merged_patch<'a>(mix: &'a BeckmannMixture, area: f32, masking: MaskingMode) -
             masking,
             lod_lobes: f32::INFINITY,
             lod_tolerance: 1.0,
+            ..PatchOptions::default()
         },
     );
     assert!(p.level() >= 1, "level {}", p.level());
@@ -1208,6 +1219,7 @@ fn chi_square_and_furnace_at_a_merged_level() {
             masking: MaskingMode::Exact,
             lod_lobes: 8.0,
             lod_tolerance: 0.0,
+            ..PatchOptions::default()
         },
     );
     assert_eq!(patch.level(), 1);

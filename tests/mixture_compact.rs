@@ -39,6 +39,7 @@ const FULL_MIXTURE: PatchOptions = PatchOptions {
     masking: MaskingMode::Exact,
     lod_lobes: f32::INFINITY,
     lod_tolerance: 0.0,
+    lod_resolution: brdf::glint::DEFAULT_LOD_RESOLUTION,
 };
 
 /// Memory per lobe from `memory()`: ≤ 16 bytes in all under compact storage (the target),

@@ -115,6 +115,7 @@ fn avx2_and_baseline_are_bit_identical() {
             masking: MaskingMode::Exact,
             lod_lobes: f32::INFINITY,
             lod_tolerance: 0.0,
+            ..PatchOptions::default()
         },
         PatchOptions::default(),
     ];

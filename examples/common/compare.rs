@@ -107,6 +107,7 @@ fn mixture_methods(map: &NormalMap, settings: &Settings) -> Res<Vec<Box<dyn Meth
         masking,
         lod_lobes,
         lod_tolerance: 0.0,
+        ..PatchOptions::default()
     };
     let inf = f32::INFINITY;
     let m = |options, label, mip_only| -> Box<dyn Method> {

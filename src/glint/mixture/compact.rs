@@ -484,7 +484,7 @@ pub(super) fn build(
         );
         cl.error = (0..w * h)
             .into_par_iter()
-            .map(|k| encode_error(lv.error[k] as f64 + q[k] as f64 + q0[k] as f64))
+            .map(|k| encode_error(lv.error[0][k] as f64 + q[k] as f64 + q0[k] as f64))
             .collect();
         out.push(cl);
         qmax = q0;

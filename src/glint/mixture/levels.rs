@@ -31,6 +31,17 @@
 //! TV(Σ W_n G_n, Σ W_n M_n) ≤ Σ W_n e(n) (convexity), which is what the patch compares with its
 //! tolerance (src/glint/mixture/patch.rs).
 //!
+//! **At a slope resolution r.** The same bound holds for the lobes convolved with an isotropic
+//! Gaussian N(0, r² I) in slope space: convolution adds r² I to every covariance, the convolved
+//! merged lobe is still the moment match of the convolved children (the spread term is unchanged),
+//! and both the χ² and Pinsker forms above are computed in closed form from those covariances. So
+//! e_r(n) (the recursion above with r² I added to every covariance) bounds
+//! TV(G_n ∗ N_r, M_n ∗ N_r): the error a viewer sees who blurs the P-NDF by N_r (a light or a
+//! histogram bin of about that angular size). The true TV is non-increasing in r (convolution is
+//! a Markov kernel: data processing inequality), so a bound stored at r_k ≤ r also bounds the TV
+//! at r, and so are both closed forms (χ² and KL obey the same inequality). The levels store e_r
+//! for each r of [`LOD_RESOLUTIONS`]; r = 0 is the continuous bound.
+//!
 //! Levels exist only while the grid divides evenly (nx and ny multiples of 2^l), so every node has
 //! exactly four children and a level tiles the map as level 0 does.
 
@@ -38,6 +49,17 @@ use super::blocks::LobeBlocks;
 use super::hierarchy::lobe_box;
 use crate::glint::slope_tree::SlopeTree;
 use crate::ndf::SlopeGaussian;
+
+use super::LOD_RESOLUTIONS;
+
+/// Number of tabulated resolutions.
+pub(super) const N_RES: usize = LOD_RESOLUTIONS.len();
+
+/// The index of the largest tabulated resolution ≤ r (0 for r below the second one, NaN or
+/// negative): the stored bound that is valid at r (module docs).
+pub(super) fn resolution_index(r: f32) -> usize {
+    LOD_RESOLUTIONS.iter().rposition(|&t| t <= r).unwrap_or(0)
+}
 
 /// One level l ≥ 1 of merged lobes (see the module docs).
 #[derive(Clone, Debug)]
@@ -50,14 +72,18 @@ pub(super) struct LobeLevel {
     pub blocks: LobeBlocks,
     /// The slope-box quadtree over the merged lobes.
     pub tree: SlopeTree,
-    /// The merge error e(n) ∈ [0, 1] per node (see the module docs).
-    pub error: Vec<f32>,
+    /// The merge errors e_r(n) ∈ [0, 1] per node, one vector per resolution r of
+    /// [`LOD_RESOLUTIONS`] (see the module docs).
+    pub error: [Vec<f32>; N_RES],
 }
 
 impl LobeLevel {
     /// Bytes held by the level.
     pub fn bytes(&self) -> usize {
-        self.moments.len() * 20 + self.blocks.bytes() + self.tree.bytes() + self.error.len() * 4
+        self.moments.len() * 20
+            + self.blocks.bytes()
+            + self.tree.bytes()
+            + self.error.iter().map(|e| e.len() * 4).sum::<usize>()
     }
 }
 
@@ -71,8 +97,8 @@ pub(super) struct LevelRef<'a> {
     pub moments: &'a [[f32; 5]],
     pub blocks: &'a LobeBlocks,
     pub tree: &'a SlopeTree,
-    /// Empty at level 0 (exact).
-    pub error: &'a [f32],
+    /// The merge errors per resolution (module docs); empty at level 0 (exact).
+    pub error: &'a [Vec<f32>],
     pub sigma_min: f32,
     /// The level in compact storage (compact.rs): then `moments`, `blocks` and `error` are empty
     /// and the lobes, blocks and errors are decoded from it.
@@ -89,13 +115,20 @@ impl LevelRef<'_> {
         SlopeGaussian::from_moments(self.moments[k], self.sigma_min)
     }
 
-    /// The merge error of node k (0 at level 0).
+    /// The merge error of node k at the resolution of index `res` in [`LOD_RESOLUTIONS`] (0 at
+    /// level 0).
     #[inline]
-    pub fn error_at(&self, k: usize) -> f32 {
+    pub fn error_at(&self, k: usize, res: usize) -> f32 {
+        // Compact storage keeps one code per node, the bound at r = 0 (plus the encoding's TV):
+        // an upper bound at every resolution r ≥ 0, since blurring both sides only shrinks a TV.
         if let Some(c) = self.compact {
             return c.error_at(k);
         }
-        self.error.get(k).copied().unwrap_or(0.0)
+        self.error
+            .get(res)
+            .and_then(|e| e.get(k))
+            .copied()
+            .unwrap_or(0.0)
     }
 }
 
@@ -146,10 +179,45 @@ fn chi2_term(
     v.is_finite().then_some(v)
 }
 
-/// Merges four child lobes: the moment-matched moments and the one-step bound of
-/// TV(G_n, Σ ¼ G_c), the smaller of Pinsker's √(¼ Σ ¼ ln(det Σ_n / det Σ_c)) and
-/// ½ √χ²(Σ ¼ G_c || G_n) (module docs).
-fn merge(children: [&SlopeGaussian; 4]) -> ([f32; 5], f64) {
+/// The one-step bound of TV(G_n ∗ N_r, Σ ¼ G_c ∗ N_r) for children and merged lobe as (mean,
+/// covariance), r² = `r2`: the smaller of Pinsker's √(¼ Σ ¼ ln(det Σ_n / det Σ_c)) and
+/// ½ √χ²(Σ ¼ G_c || G_n), every covariance plus r² I (module docs).
+fn one_step_bound(mc: &[([f64; 2], [f64; 3]); 4], g: &([f64; 2], [f64; 3]), r2: f64) -> f64 {
+    let widen = |(m, c): &([f64; 2], [f64; 3])| (*m, [c[0] + r2, c[1], c[2] + r2]);
+    let mc = mc.each_ref().map(widen);
+    let g = widen(g);
+    let ln_det_n = det(&g.1).ln();
+    let kl: f64 = mc
+        .iter()
+        .map(|(_, c)| 0.25 * 0.5 * (ln_det_n - det(c).ln()))
+        .sum();
+    // KL ≥ 0 in exact arithmetic; rounding (identical children) may leave −1e-16. A non-finite KL
+    // (degenerate child) counts as the largest TV, 1.
+    let pinsker = if kl.is_finite() {
+        (0.5 * kl.max(0.0)).sqrt()
+    } else {
+        1.0
+    };
+    let mut chi2 = -1.0;
+    for i in &mc {
+        for j in &mc {
+            match chi2_term(i, j, &g) {
+                Some(v) => chi2 += v / 16.0,
+                None => chi2 = f64::INFINITY,
+            }
+        }
+    }
+    let by_chi2 = if chi2.is_finite() {
+        0.5 * chi2.max(0.0).sqrt()
+    } else {
+        1.0
+    };
+    pinsker.min(by_chi2).min(1.0)
+}
+
+/// Merges four child lobes: the moment-matched moments and, per resolution r of
+/// [`LOD_RESOLUTIONS`], the one-step bound of TV(G_n ∗ N_r, Σ ¼ G_c ∗ N_r) ([`one_step_bound`]).
+fn merge(children: [&SlopeGaussian; 4]) -> ([f32; 5], [f64; N_RES]) {
     let mc = children.map(mean_cov);
     let mut raw = [0.0f64; 5];
     for (mu, c) in &mc {
@@ -168,34 +236,9 @@ fn merge(children: [&SlopeGaussian; 4]) -> ([f32; 5], f64) {
         cov[1] += 0.25 * (c[1] + dx * dy);
         cov[2] += 0.25 * (c[2] + dy * dy);
     }
-    let ln_det_n = det(&cov).ln();
-    let kl: f64 = mc
-        .iter()
-        .map(|(_, c)| 0.25 * 0.5 * (ln_det_n - det(c).ln()))
-        .sum();
-    // KL ≥ 0 in exact arithmetic; rounding (identical children) may leave −1e-16. A non-finite KL
-    // (degenerate child) counts as the largest TV, 1.
-    let pinsker = if kl.is_finite() {
-        (0.5 * kl.max(0.0)).sqrt()
-    } else {
-        1.0
-    };
     let g = (mean, cov);
-    let mut chi2 = -1.0;
-    for i in &mc {
-        for j in &mc {
-            match chi2_term(i, j, &g) {
-                Some(v) => chi2 += v / 16.0,
-                None => chi2 = f64::INFINITY,
-            }
-        }
-    }
-    let by_chi2 = if chi2.is_finite() {
-        0.5 * chi2.max(0.0).sqrt()
-    } else {
-        1.0
-    };
-    (raw.map(|v| v as f32), pinsker.min(by_chi2).min(1.0))
+    let bounds = LOD_RESOLUTIONS.map(|r| one_step_bound(&mc, &g, r as f64 * r as f64));
+    (raw.map(|v| v as f32), bounds)
 }
 
 /// The levels l ≥ 1 of a lobe grid of `nx × ny` lobes (`lobes` row major, as D evaluates them),
@@ -230,8 +273,8 @@ pub(super) fn build_levels(
                 prev_lobes[i]
             }
         };
-        let prev_err: &[f32] = out.last().map_or(&[], |l| l.error.as_slice());
-        let merged: Vec<([f32; 5], f32)> = (0..w * h)
+        let prev_err: Option<&[Vec<f32>; N_RES]> = out.last().map(|l| &l.error);
+        let merged: Vec<([f32; 5], [f32; N_RES])> = (0..w * h)
             .into_par_iter()
             .map(|k| {
                 let (x, y) = (k % w, k / w);
@@ -243,15 +286,17 @@ pub(super) fn build_levels(
                 ];
                 let c = idx.map(child);
                 let (m, tv) = merge([&c[0], &c[1], &c[2], &c[3]]);
-                let below: f64 = idx
-                    .iter()
-                    .map(|&i| 0.25 * prev_err.get(i).copied().unwrap_or(0.0) as f64)
-                    .sum();
-                (m, (tv + below).min(1.0) as f32)
+                let e = std::array::from_fn(|r| {
+                    let below: f64 = prev_err
+                        .map_or(0.0, |pe| idx.iter().map(|&i| 0.25 * pe[r][i] as f64).sum());
+                    (tv[r] + below).min(1.0) as f32
+                });
+                (m, e)
             })
             .collect();
         let moments: Vec<[f32; 5]> = merged.iter().map(|p| p.0).collect();
-        let error: Vec<f32> = merged.iter().map(|p| p.1).collect();
+        let error: [Vec<f32>; N_RES] =
+            std::array::from_fn(|r| merged.iter().map(|p| p.1[r]).collect());
         let gaussians: Vec<SlopeGaussian> = moments
             .par_iter()
             .map(|m| SlopeGaussian::from_moments(*m, sigma_min))
@@ -288,7 +333,7 @@ mod tests {
         let back = SlopeGaussian::from_moments(m, 0.01);
         assert!((back.mean() - g.mean()).length() < 1e-6);
         assert!((back.covariance().x_axis.x - 0.0025).abs() < 1e-7);
-        assert!(tv < 1e-6, "{tv}");
+        assert!(tv.iter().all(|&t| t < 1e-6), "{tv:?}");
     }
 
     /// The one-step bound against a numerical TV (midpoint rule) of children at offsets ±d of
@@ -321,7 +366,8 @@ mod tests {
                     lobe(d, 0.0, s),
                 ]
             };
-            let (m, bound) = merge([&c[0], &c[1], &c[2], &c[3]]);
+            let (m, bounds) = merge([&c[0], &c[1], &c[2], &c[3]]);
+            let bound = bounds[0];
             let g = SlopeGaussian::from_moments(m, 0.01);
             if !mixed {
                 let var_x = (s * s + d * d) as f64;
@@ -347,6 +393,40 @@ mod tests {
             assert!(tv <= bound + 1e-4, "d {d} s {s}: TV {tv} > bound {bound}");
             if d <= 2.0 * s && tv > 1e-3 {
                 assert!(bound <= 2.0 * tv, "d {d} s {s}: bound {bound} ≫ TV {tv}");
+            }
+            // At each resolution r > 0: the children and the merged lobe convolved with N(0, r² I)
+            // (r² added to the variances), TV by the midpoint rule (400² cells on ±(d + 10 σ_max)²,
+            // σ_max = 1.5 s + r), against the stored bound (+1e-4 as above); and the bounds are
+            // non-increasing in r (module docs).
+            for k in 1..N_RES {
+                let r = LOD_RESOLUTIONS[k];
+                assert!(bounds[k] <= bounds[k - 1], "{bounds:?}");
+                let widen = |g: &SlopeGaussian| {
+                    let (m, c) = (g.mean(), g.covariance());
+                    SlopeGaussian::new(m, c + glam::Mat2::from_diagonal(glam::Vec2::splat(r * r)))
+                        .unwrap()
+                };
+                let (cw, gw) = (c.each_ref().map(widen), widen(&g));
+                let h = (d + 10.0 * (1.5 * s + r)) as f64;
+                let n = 400;
+                let dx = 2.0 * h / n as f64;
+                let mut tv_r = 0.0;
+                for i in 0..n {
+                    for j in 0..n {
+                        let p = glam::Vec2::new(
+                            (-h + (i as f64 + 0.5) * dx) as f32,
+                            (-h + (j as f64 + 0.5) * dx) as f32,
+                        );
+                        let mix: f64 = cw.iter().map(|l| 0.25 * l.p22(p) as f64).sum();
+                        tv_r += 0.5 * (mix - gw.p22(p) as f64).abs() * dx * dx;
+                    }
+                }
+                println!("  r {r}: TV {tv_r:.5}, bound {:.5}", bounds[k]);
+                assert!(
+                    tv_r <= bounds[k] + 1e-4,
+                    "d {d} s {s} r {r}: TV {tv_r} > bound {}",
+                    bounds[k]
+                );
             }
         }
     }

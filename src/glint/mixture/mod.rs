@@ -91,17 +91,38 @@ pub const DEFAULT_SLOPE_TAIL: f32 = 1.0e-6;
 /// TV); it now picks the finest level of merged lobes under the cap. See docs/mixture.md.
 pub const DEFAULT_LOD_LOBES: f32 = 16384.0;
 
-/// Default level-of-detail tolerance: the bound Σ W_n e(n) on the total variation between a patch
-/// of merged lobes and the full mixture that a patch may spend (e(n) the merge error of node n,
-/// src/glint/mixture/levels.rs). 0 keeps the full mixture.
+/// Default level-of-detail tolerance: the bound Σ W_n e_r(n) on the total variation between a
+/// patch of merged lobes and the full mixture that a patch may spend (e_r(n) the merge error of
+/// node n at the slope resolution r = [`PatchOptions::lod_resolution`], src/glint/mixture/levels.rs).
+/// 0 keeps the full mixture.
 ///
-/// Since |TV(lod, R) − TV(full, R)| ≤ TV(lod, full) for any reference R, the tolerance bounds the
-/// increase of the TV to any (binned) ground truth, up to the node-weight approximation
-/// (docs/mixture.md). 0.01 is issue 15's budget for that increase; the footprint sweep of
-/// docs/results.md ("Levels of detail chosen by error") measured +0.013 at 0.1 on the scratched map
-/// (within that tolerance, over the 0.01 budget) for 5× cheaper `d`. The bound is conservative: at
-/// 0.01 the tolerance alone merged nothing in that sweep, and smooth maps merge only under the cost cap.
+/// Since |TV(lod, R) − TV(full, R)| ≤ TV(lod, full) for any reference R, at r = 0 the tolerance
+/// bounds the increase of the TV to any (binned) ground truth, up to the node-weight approximation
+/// (docs/mixture.md); at r > 0 it bounds the increase seen through a Gaussian blur of std r. 0.01 is
+/// issue 15's budget for that increase; the footprint sweep of docs/results.md ("Levels of detail
+/// chosen by error") measured +0.013 at 0.1 on the scratched map (within that tolerance, over the
+/// 0.01 budget) for 5× cheaper `d`. At 0.01 the tolerance alone merged nothing on the 512² maps of
+/// that sweep at r = 0, 0.01 or 0.04: merged levels there change the P-NDF's shape by more than
+/// 0.01 (docs/mixture.md, "Why merged levels lose"), and levels ≥ 1 come from the cost cap.
 pub const DEFAULT_LOD_TOLERANCE: f32 = 0.01;
+
+/// The slope resolutions r at which the levels store their merge-error bounds (slope units, an
+/// isotropic Gaussian's standard deviation): a patch reads the bound at the largest of these ≤
+/// [`PatchOptions::lod_resolution`], which also bounds the error at that resolution (the TV of
+/// blurred densities can only shrink as the blur grows). 0 is the continuous bound.
+pub const LOD_RESOLUTIONS: [f32; 3] = [0.0, 0.01, 0.04];
+
+/// Default resolution of the level-of-detail error: r = 0.01 in slope (~0.57° of normal
+/// direction), the standard deviation of an isotropic Gaussian blur applied to both P-NDFs before
+/// their total variation is bounded (src/glint/mixture/levels.rs).
+///
+/// Why 0.01: the ground truth the crate measures against is binned on 64² equal-area hemisphere
+/// bins, 0.039 wide in slope near the normal, whose uniform spread has a standard deviation of
+/// 0.039/√12 = 0.011; and a renderer sees the P-NDF through its lights: a light of angular radius ρ
+/// moves the half vector by ρ/2, so 0.01 is the spread of a light about 4.6° across (a sun, 0.53°,
+/// blurs by 0.0012; r = 0 keeps the continuous bound for point lights). Measured effect in
+/// docs/results.md "Levels of detail chosen by error (issue 15)".
+pub const DEFAULT_LOD_RESOLUTION: f32 = 0.01;
 
 /// How the build integrates each lobe's five slope moments (\[Chermain2019\] eq. 6).
 ///
@@ -197,6 +218,12 @@ pub struct PatchOptions {
     /// (and whose nodes are no wider than half the footprint's smaller standard deviation); 0 keeps the
     /// full mixture (level 0), unless the cost cap moves it. Not stored in saved files.
     pub lod_tolerance: f32,
+    /// Slope resolution r of the tolerance's error ([`DEFAULT_LOD_RESOLUTION`], slope units): the
+    /// bound Σ W_n e_r(n) is on the TV between the two P-NDFs after both are blurred by an isotropic
+    /// Gaussian of standard deviation r in slope space, read at the largest r of
+    /// [`LOD_RESOLUTIONS`] not above this. 0: the continuous TV (the bound before this option). Not
+    /// stored in saved files.
+    pub lod_resolution: f32,
 }
 
 impl Default for PatchOptions {
@@ -205,6 +232,7 @@ impl Default for PatchOptions {
             masking: DEFAULT_MASKING,
             lod_lobes: DEFAULT_LOD_LOBES,
             lod_tolerance: DEFAULT_LOD_TOLERANCE,
+            lod_resolution: DEFAULT_LOD_RESOLUTION,
         }
     }
 }
@@ -323,6 +351,14 @@ impl MixtureParams {
                 name: "lod_tolerance",
                 value: t as f64,
                 reason: "must be finite and >= 0 (0 keeps the full mixture)",
+            });
+        }
+        let r = self.patch.lod_resolution;
+        if !(r >= 0.0 && r.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "lod_resolution",
+                value: r as f64,
+                reason: "must be finite and >= 0 (0: the continuous bound)",
             });
         }
         Ok(())
@@ -689,7 +725,7 @@ impl BeckmannMixture {
                     moments: &lv.moments,
                     blocks: &lv.blocks,
                     tree: &lv.tree,
-                    error: &lv.error,
+                    error: lv.error.as_slice(),
                     sigma_min: self.params.sigma_min,
                     compact: None,
                 }
@@ -699,13 +735,24 @@ impl BeckmannMixture {
 
     /// The merge-error bounds e(n) of level l ≥ 1 (row major over its nodes; empty for level 0 or
     /// beyond the coarsest level): upper bounds of the TV between each merged lobe and the mixture
-    /// of the level-0 lobes it replaces (src/glint/mixture/levels.rs). Empty under
+    /// of the level-0 lobes it replaces (src/glint/mixture/levels.rs), in continuous slope space
+    /// (r = 0); [`BeckmannMixture::level_errors_at`] for the other resolutions. Empty under
     /// [`LobeStorage::Compact`], whose errors are one-byte codes: see [`BeckmannMixture::level_error`].
     pub fn level_errors(&self, l: usize) -> &[f32] {
+        self.level_errors_at(l, 0)
+    }
+
+    /// [`BeckmannMixture::level_errors`] at the resolution `LOD_RESOLUTIONS[res]`: bounds of the TV
+    /// after both densities are blurred by an isotropic Gaussian of that standard deviation in
+    /// slope space (empty for `res` out of range).
+    pub fn level_errors_at(&self, l: usize, res: usize) -> &[f32] {
         if l == 0 {
             &[]
         } else {
-            self.levels.get(l - 1).map_or(&[], |lv| lv.error.as_slice())
+            self.levels
+                .get(l - 1)
+                .and_then(|lv| lv.error.get(res))
+                .map_or(&[], |e| e.as_slice())
         }
     }
 
@@ -716,7 +763,7 @@ impl BeckmannMixture {
         if l == 0 || l >= self.level_count() {
             return 0.0;
         }
-        self.level_ref(l).error_at(k)
+        self.level_ref(l).error_at(k, 0)
     }
 
     /// The patch of a footprint with explicit options (masking mode, level of detail).

@@ -12,7 +12,7 @@
 
 use super::blocks::{self, LANES, SIDE};
 use super::hierarchy::lobe_box;
-use super::levels::LevelRef;
+use super::levels::{LevelRef, resolution_index};
 use super::{BeckmannMixture, MaskingMode, PatchOptions, build::kernel_sigma};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
@@ -172,8 +172,8 @@ struct Gathered<'a> {
     n_rects: usize,
     /// Σ W_i μ_i: the patch mean slope.
     mean_slope: Vec2,
-    /// Σ W_n e(n): the bound of the TV between this level's patch and the full mixture's
-    /// (0 at level 0).
+    /// Σ W_n e_r(n) at the patch's resolution r: the bound of the TV between this level's patch and
+    /// the full mixture's, both blurred by N(0, r² I) in slope space (0 at level 0).
     lod_error: f64,
     /// The patch's slope covariance Σ_P = Σ W_i (Σ_i + μ_i μ_iᵀ) − μ_P μ_Pᵀ, [xx, xy, yy] (f64), with
     /// each lobe's covariance as its D uses it (floored, correlation clamped): the second moment that
@@ -222,8 +222,9 @@ fn clamped_covariance(vx: f64, vy: f64, c: f64, s2: f64) -> f64 {
 ///   Σ W_i ⟨wo,m⟩⁺ D_i / V_P(wo) = `pdf_visible` (exact V_P in both masking modes).
 /// - Level of detail: the patch is made of the nodes of one level l of merged lobes
 ///   (src/glint/mixture/levels.rs; l = 0 is the lobes themselves): the coarsest level whose nodes
-///   are no wider than half the footprint's smaller standard deviation and whose bound Σ W_n e(n) on the
-///   TV to the full mixture is at most `lod_tolerance`, then moved coarser if the footprint still
+///   are no wider than half the footprint's smaller standard deviation and whose bound Σ W_n e_r(n) on the
+///   TV to the full mixture at slope resolution r = `lod_resolution` (both P-NDFs blurred by
+///   N(0, r² I)) is at most `lod_tolerance`, then moved coarser if the footprint still
 ///   covers more than `lod_lobes` nodes (the filtered lobe alone if no level is coarse enough).
 ///   D_P, both masking modes, both samplers and their pdfs all use that one level.
 ///
@@ -438,6 +439,7 @@ impl<'a> MixturePatch<'a> {
         let lod = 0.5 * area.max(1e-300).log2();
         let filtered_m = mixture.filtered_moments(fp.c, lod);
         let filtered = SlopeGaussian::from_moments(filtered_m, mixture.params.sigma_min);
+        let res = resolution_index(options.lod_resolution);
         let (lv, gathered) = match Self::level_range(mixture, &fp, area, &options) {
             None => (mixture.level_ref(0), None),
             Some((finest, coarsest)) => {
@@ -453,7 +455,7 @@ impl<'a> MixturePatch<'a> {
                 while l < coarsest {
                     let next = mixture.level_ref(l + 1);
                     let eff = Effective::at_level(&fp, l + 1);
-                    let e = Self::lod_error_of(mixture, next, &eff, &mut bufs);
+                    let e = Self::lod_error_of(mixture, next, &eff, res, &mut bufs);
                     if e > options.lod_tolerance as f64 {
                         break;
                     }
@@ -466,6 +468,7 @@ impl<'a> MixturePatch<'a> {
                         mixture,
                         lv,
                         &Effective::at_level(&fp, l),
+                        res,
                         bufs,
                     )),
                 )
@@ -546,12 +549,14 @@ impl<'a> MixturePatch<'a> {
         axes
     }
 
-    /// Σ W_n e(n) of the level over the footprint (what [`Self::gather`] reports as `lod_error`),
-    /// from the weights alone: the error-only pass of the level-of-detail search.
+    /// Σ W_n e_r(n) of the level over the footprint at the resolution of index `res` (what
+    /// [`Self::gather`] reports as `lod_error`), from the weights alone: the error-only pass of the
+    /// level-of-detail search.
     fn lod_error_of(
         mix: &BeckmannMixture,
         lv: LevelRef<'_>,
         eff: &Effective,
+        res: usize,
         bufs: &mut Lent<'_, SlotBuffers>,
     ) -> f64 {
         let w = &mut bufs.cdf;
@@ -561,7 +566,7 @@ impl<'a> MixturePatch<'a> {
         for (s, &wi) in w.iter().enumerate() {
             let k = axes[1].lobe_of_slot(s / lx) * lv.grid[0] + axes[0].lobe_of_slot(s % lx);
             total += wi;
-            err += wi * lv.error_at(k) as f64;
+            err += wi * lv.error_at(k, res) as f64;
         }
         if total > 0.0 { err / total } else { 0.0 }
     }
@@ -570,6 +575,7 @@ impl<'a> MixturePatch<'a> {
         mix: &BeckmannMixture,
         lv: LevelRef<'_>,
         eff: &Effective,
+        res: usize,
         mut bufs: Lent<'b, SlotBuffers>,
     ) -> Gathered<'b> {
         // Raw weights are summed into the cdf buffer, then normalised and accumulated in place.
@@ -594,7 +600,7 @@ impl<'a> MixturePatch<'a> {
             acc += wn;
             *wi = acc;
             let k = axes[1].lobe_of_slot(s / lx) * lv.grid[0] + axes[0].lobe_of_slot(s % lx);
-            lod_error += wn * lv.error_at(k) as f64;
+            lod_error += wn * lv.error_at(k, res) as f64;
             // No stored moments (compact storage): the decoded lobe's mean and L Lᵀ.
             let m = lv.moments.get(k);
             let (mu, cov) = m
@@ -702,9 +708,13 @@ impl<'a> MixturePatch<'a> {
         self.mixture.level_ref(self.level)
     }
 
-    /// The level of detail's error bound Σ W_n e(n): an upper bound of the TV between this patch's
-    /// D_P and the full mixture's with the same node weights (0 at level 0; 1 under the filtered
-    /// lobe, which has no bound). See src/glint/mixture/levels.rs.
+    /// The level of detail's error bound Σ W_n e_r(n): an upper bound of the TV between this
+    /// patch's slope density and that of the level-0 lobes its nodes replace, each node's weight
+    /// W_n spread evenly over its lobes, both blurred by an isotropic Gaussian of std r in slope
+    /// space, r the largest of [`super::LOD_RESOLUTIONS`] not above `PatchOptions::lod_resolution`
+    /// (0 at level 0; 1 under the filtered lobe, which has no bound). The difference between that
+    /// even spread and the full mixture's own weights is not bounded (measured 0.0005-0.013 in TV,
+    /// docs/mixture.md). See src/glint/mixture/levels.rs.
     pub fn lod_error(&self) -> f32 {
         self.gathered.as_ref().map_or(1.0, |g| g.lod_error as f32)
     }
