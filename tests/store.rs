@@ -816,6 +816,23 @@ fn write_fuzz_seeds() {
             &format!("mixture{n}"),
             saved(|w| mx.save(w)),
         );
+        // Compact storage (model kind 5): 1², 3² (no level-2 node: the single block's own frame)
+        // and 8² (frames from the quadtree's level 2).
+        for k in [n, n + 5] {
+            let cm = BeckmannMixture::build(
+                &map(k),
+                MixtureParams {
+                    storage: LobeStorage::Compact,
+                    ..params
+                },
+            )
+            .unwrap();
+            write(
+                "store_mixture",
+                &format!("compact{k}"),
+                saved(|w| cm.save(w)),
+            );
+        }
         let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
         write(
             "store_position_normal",

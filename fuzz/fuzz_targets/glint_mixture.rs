@@ -3,7 +3,9 @@
 #![no_main]
 
 use arbitrary::Arbitrary;
-use brdf::glint::{BeckmannMixture, GlintNdf, MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::{
+    BeckmannMixture, GlintNdf, LobeStorage, MaskingMode, MixtureParams, PatchOptions,
+};
 use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
 use brdf_fuzz::{FootprintInput, MapInput, Probe, check_bxdf, check_ndf};
 use libfuzzer_sys::fuzz_target;
@@ -15,6 +17,7 @@ struct Input {
     sigma_min: f32,
     samples: u8,
     approximate: bool,
+    compact: bool,
     lod_lobes: f32,
     footprint: FootprintInput,
     probe: Probe,
@@ -34,6 +37,11 @@ fuzz_target!(|input: Input| {
             },
             lod_lobes: input.lod_lobes,
             ..PatchOptions::default()
+        },
+        storage: if input.compact {
+            LobeStorage::Compact
+        } else {
+            LobeStorage::Full
         },
         ..MixtureParams::default()
     };
