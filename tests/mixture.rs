@@ -369,25 +369,6 @@ fn paper_projected_area_matches_per_lobe_clamped_integrals() {
     }
 }
 
-/// The directional albedo ∫ f cos θi dωi of the BRDF in the renderer's measure (geometric cos θi),
-/// by importance sampling with its own (chi-square tested) sampler over `n` stratified draws: the
-/// mean of `sample().weight()` and its standard error.
-fn albedo<N: Ndf>(brdf: &MicrofacetBrdf<N, NoFresnel>, wo: Vec3, n: usize) -> (f64, f64) {
-    let mut rng = support::rng(5);
-    let (mut s, mut s2) = (0.0f64, 0.0f64);
-    for k in 0..n {
-        let u = Vec2::new((k as f32 + rng.random::<f32>()) / n as f32, rng.random());
-        let v = brdf
-            .sample(wo, 0.5, u)
-            .map_or(0.0, |smp| smp.weight().x as f64);
-        s += v;
-        s2 += v * v;
-    }
-    let mean = s / n as f64;
-    let var = (s2 / n as f64 - mean * mean).max(0.0);
-    (mean, (var / n as f64).sqrt())
-}
-
 /// The white furnace of the P-BRDF (F = 1, separable G2) in the renderer's measure, with exact and
 /// approximate masking: ∫ f cos θi dωi = ∫ D_wo(m) G1(wi, m) dm ≤ 1 whenever V_P(wo) is exact or an
 /// upper bound (src/bxdf/microfacet.rs, "The renderer's measure"), which both modes guarantee (the
@@ -413,7 +394,7 @@ fn white_furnace_exact_and_approximate() {
                     let wo = support::dir(theta, 60.0);
                     let brdf =
                         MicrofacetBrdf::new(&patch, NoFresnel).with_masking(Masking::Separable);
-                    let (e, err) = albedo(&brdf, wo, 2000);
+                    let (e, err) = support::albedo(&brdf, wo, 2000);
                     // ≤ 1 + 4 standard errors (stratified draws make the bound conservative)
                     // + 1e-5 for the f32 evaluation of f, pdf and A (a few ulps each): a patch
                     // that is a single mirror-like lobe sits at 1 with a tiny error.
@@ -1231,7 +1212,7 @@ fn chi_square_and_furnace_at_a_merged_level() {
             for theta in [0.0, 70.0, 85.0] {
                 let wo = support::dir(theta, 60.0);
                 let brdf = MicrofacetBrdf::new(&patch, NoFresnel).with_masking(Masking::Separable);
-                let (e, err) = albedo(&brdf, wo, 2000);
+                let (e, err) = support::albedo(&brdf, wo, 2000);
                 // As in `white_furnace_exact_and_approximate`: 4 standard errors + 1e-5 (f32).
                 assert!(
                     e.is_finite() && e <= 1.0 + 4.0 * err + 1e-5,

@@ -15,7 +15,7 @@ use brdf::glint::{
     MixturePatch, NormalMap, PatchOptions,
 };
 use brdf::ndf::Ndf;
-use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
+use brdf::{MicrofacetBrdf, Vec2, Vec3};
 use rand::RngExt;
 use support::chi2::Chi2;
 
@@ -314,24 +314,6 @@ fn compact_tv_table_merged() {
     println!("{TV_HEADER}\n{}", rows.join("\n"));
 }
 
-/// The directional albedo ∫ f cos θi dωi (renderer's measure) by the BRDF's own sampler, `n`
-/// stratified draws: (mean, standard error).
-fn albedo<N: Ndf>(brdf: &MicrofacetBrdf<N, NoFresnel>, wo: Vec3, n: usize) -> (f64, f64) {
-    let mut rng = support::rng(5);
-    let (mut s, mut s2) = (0.0f64, 0.0f64);
-    for k in 0..n {
-        let u = Vec2::new((k as f32 + rng.random::<f32>()) / n as f32, rng.random());
-        let v = brdf
-            .sample(wo, 0.5, u)
-            .map_or(0.0, |smp| smp.weight().x as f64);
-        s += v;
-        s2 += v * v;
-    }
-    let mean = s / n as f64;
-    let var = (s2 / n as f64 - mean * mean).max(0.0);
-    (mean, (var / n as f64).sqrt())
-}
-
 /// White furnace of the P-BRDF (F = 1, separable G2) through the public `Bxdf` in the renderer's
 /// measure (geometric cos θi), full and compact storage, θo from 0° to 89° (grazing): each ≤ 1 + 4
 /// standard errors (+1e-5 for f32 evaluation, as tests/mixture.rs), and the two within 4 standard
@@ -350,8 +332,8 @@ fn compact_furnace_unchanged() {
                 let wo = support::dir(theta, 60.0);
                 let bf = MicrofacetBrdf::new(&pf, NoFresnel).with_masking(Masking::Separable);
                 let bc = MicrofacetBrdf::new(&pc, NoFresnel).with_masking(Masking::Separable);
-                let (ef, sf) = albedo(&bf, wo, 2000);
-                let (ec, sc) = albedo(&bc, wo, 2000);
+                let (ef, sf) = support::albedo(&bf, wo, 2000);
+                let (ec, sc) = support::albedo(&bc, wo, 2000);
                 for (e, s) in [(ef, sf), (ec, sc)] {
                     assert!(
                         e.is_finite() && e <= 1.0 + 4.0 * s + 1e-5,

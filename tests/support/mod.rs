@@ -67,3 +67,28 @@ pub fn procedural_maps(n: usize) -> Vec<(&'static str, brdf::glint::NormalMap)> 
         ("flakes", flakes(n, n, FlakesParams::default(), 4).unwrap()),
     ]
 }
+
+/// The directional albedo ∫ f cos θi dωi of the BRDF in the renderer's measure (geometric cos θi),
+/// by importance sampling with its own (chi-square tested) sampler over `n` stratified draws: the
+/// mean of `sample().weight()` and its standard error.
+pub fn albedo<N: brdf::ndf::Ndf>(
+    brdf: &brdf::MicrofacetBrdf<N, brdf::fresnel::NoFresnel>,
+    wo: glam::Vec3,
+    n: usize,
+) -> (f64, f64) {
+    use brdf::Bxdf;
+    use rand::RngExt;
+    let mut rng = rng(5);
+    let (mut s, mut s2) = (0.0f64, 0.0f64);
+    for k in 0..n {
+        let u = glam::Vec2::new((k as f32 + rng.random::<f32>()) / n as f32, rng.random());
+        let v = brdf
+            .sample(wo, 0.5, u)
+            .map_or(0.0, |smp| smp.weight().x as f64);
+        s += v;
+        s2 += v * v;
+    }
+    let mean = s / n as f64;
+    let var = (s2 / n as f64 - mean * mean).max(0.0);
+    (mean, (var / n as f64).sqrt())
+}

@@ -695,49 +695,13 @@ impl<'a> LevelRef<'a> {
 /// lookup, `hierarchy::LobePyramid::filtered`, with the levels of detail as its levels; lod clamped
 /// to the coarsest level held, NaN → 0).
 pub(super) fn filtered(levels: &[CompactLevel], p: [f64; 2], lod: f64) -> [f32; 5] {
-    let top = (levels.len() - 1) as f64;
-    let lod = if lod.is_nan() {
-        0.0
-    } else {
-        lod.clamp(0.0, top)
-    };
-    let p = if p[0].is_finite() && p[1].is_finite() {
-        p
-    } else {
-        [0.0, 0.0]
-    };
-    let l0 = lod.floor();
-    let t = lod - l0;
-    let l0 = l0 as usize;
-    let bilinear = |l: usize| -> [f64; 5] {
-        let lv = &levels[l];
-        let [w, h] = lv.grid;
-        let scale = (1u64 << l) as f64;
-        let px = p[0] / scale - 0.5;
-        let py = p[1] / scale - 0.5;
-        let (bx, by) = (px.floor(), py.floor());
-        let (fx, fy) = (px - bx, py - by);
-        let at = |i: f64, j: f64| {
-            let i = (i as i64).rem_euclid(w as i64) as usize;
-            let j = (j as i64).rem_euclid(h as i64) as usize;
-            lv.lane(j * w + i).raw_moments()
-        };
-        let c = [
-            (at(bx, by), (1.0 - fx) * (1.0 - fy)),
-            (at(bx + 1.0, by), fx * (1.0 - fy)),
-            (at(bx, by + 1.0), (1.0 - fx) * fy),
-            (at(bx + 1.0, by + 1.0), fx * fy),
-        ];
-        std::array::from_fn(|k| c.iter().map(|(m, wt)| m[k] * wt).sum())
-    };
-    let a = bilinear(l0);
-    let out = if t > 0.0 && l0 + 1 < levels.len() {
-        let b = bilinear(l0 + 1);
-        std::array::from_fn(|k| a[k] * (1.0 - t) + b[k] * t)
-    } else {
-        a
-    };
-    out.map(|v| v as f32)
+    super::hierarchy::trilinear(
+        levels.len(),
+        p,
+        lod,
+        |l| levels[l].grid,
+        |l, k| levels[l].lane(k).raw_moments(),
+    )
 }
 
 #[cfg(test)]

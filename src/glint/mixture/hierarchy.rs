@@ -69,59 +69,76 @@ impl LobePyramid {
         if l == 0 { lobes } else { &self.levels[l - 1] }
     }
 
-    /// Bilinear lookup of level `l` at a position given in lobe units (lobe i has its centre at
-    /// i + ½), with wrapping; in `f64`.
-    fn bilinear(&self, lobes: &[[f32; 5]], l: usize, p: [f64; 2]) -> [f64; 5] {
-        let [w, h] = self.sizes[l];
-        let data = self.level(lobes, l);
-        let scale = (1u64 << l) as f64;
-        let px = p[0] / scale - 0.5;
-        let py = p[1] / scale - 0.5;
-        let (bx, by) = (px.floor(), py.floor());
-        let (fx, fy) = (px - bx, py - by);
-        let at = |i: f64, j: f64| {
-            let i = (i as i64).rem_euclid(w as i64) as usize;
-            let j = (j as i64).rem_euclid(h as i64) as usize;
-            data[j * w + i]
-        };
-        let c = [
-            (at(bx, by), (1.0 - fx) * (1.0 - fy)),
-            (at(bx + 1.0, by), fx * (1.0 - fy)),
-            (at(bx, by + 1.0), (1.0 - fx) * fy),
-            (at(bx + 1.0, by + 1.0), fx * fy),
-        ];
-        std::array::from_fn(|k| c.iter().map(|(m, wt)| m[k] as f64 * wt).sum())
-    }
-
     /// Trilinear lookup: level of detail `lod` (clamped to [0, top], NaN → 0), position in lobe
     /// units. A convex combination of lobe moments, so a valid moment set.
     pub fn filtered(&self, lobes: &[[f32; 5]], p: [f64; 2], lod: f64) -> [f32; 5] {
-        let top = (self.sizes.len() - 1) as f64;
-        let lod = if lod.is_nan() {
-            0.0
-        } else {
-            lod.clamp(0.0, top)
-        };
-        let p = if p[0].is_finite() && p[1].is_finite() {
-            p
-        } else {
-            [0.0, 0.0]
-        };
-        let l0 = lod.floor();
-        let t = lod - l0;
-        let l0 = l0 as usize;
-        let a = self.bilinear(lobes, l0, p);
-        let out = if t > 0.0 && l0 + 1 < self.sizes.len() {
-            let b = self.bilinear(lobes, l0 + 1, p);
-            std::array::from_fn(|k| a[k] * (1.0 - t) + b[k] * t)
-        } else {
-            a
-        };
-        out.map(|v| v as f32)
+        trilinear(
+            self.sizes.len(),
+            p,
+            lod,
+            |l| self.sizes[l],
+            |l, k| self.level(lobes, l)[k].map(f64::from),
+        )
     }
 
     /// Bytes held by levels ≥ 1.
     pub fn bytes(&self) -> usize {
         self.levels.iter().map(|l| l.len() * 20).sum()
     }
+}
+
+/// Trilinear lookup in a chain of `n_levels` levels of raw moments: bilinear with wrapping in the two
+/// levels around `lod` (clamped to [0, n_levels − 1], NaN → 0), blended linearly; the position `p` is
+/// in level-0 lobe units (lobe i has its centre at i + ½; non-finite → the origin), level l's nodes
+/// are 2^l lobes wide. `size(l)` is level l's grid, `at(l, k)` the raw moments of its node k (row
+/// major). Shared by the moment mip chain and compact storage's levels (compact.rs), in `f64`.
+pub(super) fn trilinear(
+    n_levels: usize,
+    p: [f64; 2],
+    lod: f64,
+    size: impl Fn(usize) -> [usize; 2],
+    at: impl Fn(usize, usize) -> [f64; 5],
+) -> [f32; 5] {
+    let top = (n_levels - 1) as f64;
+    let lod = if lod.is_nan() {
+        0.0
+    } else {
+        lod.clamp(0.0, top)
+    };
+    let p = if p[0].is_finite() && p[1].is_finite() {
+        p
+    } else {
+        [0.0, 0.0]
+    };
+    let bilinear = |l: usize| -> [f64; 5] {
+        let [w, h] = size(l);
+        let scale = (1u64 << l) as f64;
+        let px = p[0] / scale - 0.5;
+        let py = p[1] / scale - 0.5;
+        let (bx, by) = (px.floor(), py.floor());
+        let (fx, fy) = (px - bx, py - by);
+        let node = |i: f64, j: f64| {
+            let i = (i as i64).rem_euclid(w as i64) as usize;
+            let j = (j as i64).rem_euclid(h as i64) as usize;
+            at(l, j * w + i)
+        };
+        let c = [
+            (node(bx, by), (1.0 - fx) * (1.0 - fy)),
+            (node(bx + 1.0, by), fx * (1.0 - fy)),
+            (node(bx, by + 1.0), (1.0 - fx) * fy),
+            (node(bx + 1.0, by + 1.0), fx * fy),
+        ];
+        std::array::from_fn(|k| c.iter().map(|(m, wt)| m[k] * wt).sum())
+    };
+    let l0 = lod.floor();
+    let t = lod - l0;
+    let l0 = l0 as usize;
+    let a = bilinear(l0);
+    let out = if t > 0.0 && l0 + 1 < n_levels {
+        let b = bilinear(l0 + 1);
+        std::array::from_fn(|k| a[k] * (1.0 - t) + b[k] * t)
+    } else {
+        a
+    };
+    out.map(|v| v as f32)
 }
