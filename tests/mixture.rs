@@ -18,7 +18,6 @@ use brdf::glint::{
 use brdf::ndf::Ndf;
 use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
 use rand::RngExt;
-use support::chi2::Chi2;
 
 const N: usize = 64;
 
@@ -478,33 +477,7 @@ fn chi_square_of_both_samplers() {
     }
     let mix = BeckmannMixture::build(&noise(N, 4), exact_params()).unwrap();
     let patch = mix.patch(&footprint(16.0, Vec2::new(0.3, 0.3)));
-    chi2_patch_samplers(&patch, "mixture", &[30.0, 75.0]);
-}
-
-/// Chi-square (10⁶ draws, 100 × 200 cells) of a patch's normal sampler and of its visible sampler
-/// at each θo (φo = 20°).
-fn chi2_patch_samplers(patch: &MixturePatch, label: &str, thetas: &[f64]) {
-    let cfg = |name: &str| Chi2 {
-        res_z: 100,
-        res_phi: 200,
-        samples: 1_000_000,
-        ..Chi2::new(name, 3)
-    };
-    cfg(&format!("{label} normals"))
-        .run(
-            |_, u| Some(patch.sample_normal(u)),
-            |m| patch.pdf_normal(m) as f64,
-        )
-        .unwrap();
-    for &theta in thetas {
-        let wo = support::dir(theta, 20.0);
-        cfg(&format!("{label} visible {theta}"))
-            .run(
-                |_, u| Some(patch.sample_visible(wo, u)),
-                |m| patch.pdf_visible(wo, m) as f64,
-            )
-            .unwrap();
-    }
+    support::chi2_patch_samplers(&patch, "mixture", &[30.0, 75.0], true);
 }
 
 /// A direction to probe D at: draw k (even) from the patch's normal sampler, odd k uniform in
@@ -1204,7 +1177,7 @@ fn chi_square_and_furnace_at_a_merged_level() {
         },
     );
     assert_eq!(patch.level(), 1);
-    chi2_patch_samplers(&patch, "level-1", &[60.0]);
+    support::chi2_patch_samplers(&patch, "level-1", &[60.0], true);
     for (name, map) in procedural_maps() {
         let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
         for masking in [MaskingMode::Exact, MaskingMode::Approximate] {

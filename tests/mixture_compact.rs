@@ -11,13 +11,12 @@ mod support;
 use brdf::bxdf::Masking;
 use brdf::fresnel::NoFresnel;
 use brdf::glint::{
-    self, BeckmannMixture, Footprint, GlintNdf, LobeStorage, MaskingMode, MixtureParams,
-    MixturePatch, NormalMap, PatchOptions,
+    self, BeckmannMixture, Footprint, GlintNdf, LobeStorage, MaskingMode, MixtureParams, NormalMap,
+    PatchOptions,
 };
 use brdf::ndf::Ndf;
 use brdf::{MicrofacetBrdf, Vec2, Vec3};
 use rand::RngExt;
-use support::chi2::Chi2;
 
 fn params(storage: LobeStorage) -> MixtureParams {
     MixtureParams {
@@ -369,7 +368,7 @@ fn compact_chi_square() {
     let map = NormalMap::from_slopes(n, n, slopes).unwrap();
     let mix = BeckmannMixture::build(&map, params(LobeStorage::Compact)).unwrap();
     let fp = Footprint::isotropic_texels(Vec2::new(0.3, 0.3), 16.0, n, n);
-    chi2_patch_samplers(
+    support::chi2_patch_samplers(
         &mix.patch_with(&fp, FULL_MIXTURE),
         "compact",
         &[30.0, 88.0],
@@ -384,34 +383,7 @@ fn compact_chi_square() {
         },
     );
     assert!(merged.level() >= 1);
-    chi2_patch_samplers(&merged, "compact merged", &[60.0], false);
-}
-
-/// Chi-square of the visible sampler at each θo (φo = 20°), and of the normal sampler if `normals`.
-fn chi2_patch_samplers(patch: &MixturePatch, label: &str, thetas: &[f64], normals: bool) {
-    let cfg = |name: &str| Chi2 {
-        res_z: 100,
-        res_phi: 200,
-        samples: 1_000_000,
-        ..Chi2::new(name, 3)
-    };
-    if normals {
-        cfg(&format!("{label} normals"))
-            .run(
-                |_, u| Some(patch.sample_normal(u)),
-                |m| patch.pdf_normal(m) as f64,
-            )
-            .unwrap();
-    }
-    for &theta in thetas {
-        let wo = support::dir(theta, 20.0);
-        cfg(&format!("{label} visible {theta}"))
-            .run(
-                |_, u| Some(patch.sample_visible(wo, u)),
-                |m| patch.pdf_visible(wo, m) as f64,
-            )
-            .unwrap();
-    }
+    support::chi2_patch_samplers(&merged, "compact merged", &[60.0], false);
 }
 
 /// Compact storage refuses a `sigma_min` whose inverse Cholesky factors would not fit binary16,

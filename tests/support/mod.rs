@@ -92,3 +92,37 @@ pub fn albedo<N: brdf::ndf::Ndf>(
     let var = (s2 / n as f64 - mean * mean).max(0.0);
     (mean, (var / n as f64).sqrt())
 }
+
+/// Chi-square (10⁶ draws, 100 × 200 cells) of a mixture patch's visible sampler at each θo
+/// (φo = 20°), and of its normal sampler if `normals`.
+pub fn chi2_patch_samplers(
+    patch: &brdf::glint::MixturePatch,
+    label: &str,
+    thetas: &[f64],
+    normals: bool,
+) {
+    use brdf::ndf::Ndf;
+    let cfg = |name: &str| chi2::Chi2 {
+        res_z: 100,
+        res_phi: 200,
+        samples: 1_000_000,
+        ..chi2::Chi2::new(name, 3)
+    };
+    if normals {
+        cfg(&format!("{label} normals"))
+            .run(
+                |_, u| Some(patch.sample_normal(u)),
+                |m| patch.pdf_normal(m) as f64,
+            )
+            .unwrap();
+    }
+    for &theta in thetas {
+        let wo = dir(theta, 20.0);
+        cfg(&format!("{label} visible {theta}"))
+            .run(
+                |_, u| Some(patch.sample_visible(wo, u)),
+                |m| patch.pdf_visible(wo, m) as f64,
+            )
+            .unwrap();
+    }
+}
