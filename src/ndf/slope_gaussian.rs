@@ -236,25 +236,7 @@ impl SlopeGaussian {
         if !(mean.x.abs() <= MAX_SLOPE && mean.y.abs() <= MAX_SLOPE && l11 > 0.0 && l22 > 0.0) {
             return None;
         }
-        let (a, b, c) = (l11 as f64, l21 as f64, l22 as f64);
-        let (i11, i22) = (1.0 / a, 1.0 / c);
-        let i21 = -b * i11 * i22;
-        let chol = [l11, l21, l22];
-        let inv_chol = [i11 as f32, i21 as f32, i22 as f32];
-        let norm = inv_chol[0] * inv_chol[2] * FRAC_1_2PI;
-        let normal = |v: f32| v.is_finite() && v.abs() >= f32::MIN_POSITIVE;
-        let ok = normal(l11)
-            && normal(l22)
-            && l21.is_finite()
-            && normal(inv_chol[0])
-            && normal(inv_chol[2])
-            && inv_chol[1].is_finite()
-            && normal(norm);
-        ok.then_some(SlopeGaussian {
-            mean,
-            chol,
-            inv_chol,
-        })
+        Self::from_factor_f64(mean, l11 as f64, l21 as f64, l22 as f64)
     }
 
     /// Builds the lobe from an `f64` covariance; `None` unless Σ is positive definite and L, L⁻¹ and
@@ -273,7 +255,13 @@ impl SlopeGaussian {
         if l22_sq.is_nan() || l22_sq <= 0.0 {
             return None;
         }
-        let l22 = l22_sq.sqrt();
+        Self::from_factor_f64(mean, l11, l21, l22_sq.sqrt())
+    }
+
+    /// The lobe of mean `mean` and Cholesky factor L given in `f64` (rounded once to `f32`), with
+    /// L⁻¹ formed in `f64`; `None` unless L, L⁻¹ and the normalisation are finite normal `f32`
+    /// numbers (L₂₁ and L⁻¹₂₁ finite).
+    fn from_factor_f64(mean: Vec2, l11: f64, l21: f64, l22: f64) -> Option<Self> {
         let (i11, i22) = (1.0 / l11, 1.0 / l22);
         let i21 = -l21 * i11 * i22;
         let chol = [l11 as f32, l21 as f32, l22 as f32];
