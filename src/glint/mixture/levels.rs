@@ -336,6 +336,24 @@ mod tests {
         assert!(tv.iter().all(|&t| t < 1e-6), "{tv:?}");
     }
 
+    /// TV between the equal-weight mixture of `children` and `g` by the midpoint rule on
+    /// [−h, h]², n² cells.
+    fn tv_midpoint(children: &[SlopeGaussian; 4], g: &SlopeGaussian, h: f64, n: usize) -> f64 {
+        let dx = 2.0 * h / n as f64;
+        let mut tv = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let p = glam::Vec2::new(
+                    (-h + (i as f64 + 0.5) * dx) as f32,
+                    (-h + (j as f64 + 0.5) * dx) as f32,
+                );
+                let mix: f64 = children.iter().map(|l| 0.25 * l.p22(p) as f64).sum();
+                tv += 0.5 * (mix - g.p22(p) as f64).abs() * dx * dx;
+            }
+        }
+        tv
+    }
+
     /// The one-step bound against a numerical TV (midpoint rule) of children at offsets ±d of
     /// width s, equal or unequal widths: the bound must hold (it is a theorem; this checks the
     /// algebra) and be within 2× of the TV for overlapping children (d ≤ 2 s; the χ² form; measured
@@ -375,20 +393,7 @@ mod tests {
                 assert!(g.mean().length() < 1e-7);
             }
             // TV by the midpoint rule on ±(d + 12 s)², 1000² cells.
-            let h = (d + 12.0 * s) as f64;
-            let n = 1000;
-            let dx = 2.0 * h / n as f64;
-            let mut tv = 0.0;
-            for i in 0..n {
-                for j in 0..n {
-                    let p = glam::Vec2::new(
-                        (-h + (i as f64 + 0.5) * dx) as f32,
-                        (-h + (j as f64 + 0.5) * dx) as f32,
-                    );
-                    let mix: f64 = c.iter().map(|l| 0.25 * l.p22(p) as f64).sum();
-                    tv += 0.5 * (mix - g.p22(p) as f64).abs() * dx * dx;
-                }
-            }
+            let tv = tv_midpoint(&c, &g, (d + 12.0 * s) as f64, 1000);
             println!("d/s {} mixed {mixed}: TV {tv:.5}, bound {bound:.5}", d / s);
             assert!(tv <= bound + 1e-4, "d {d} s {s}: TV {tv} > bound {bound}");
             if d <= 2.0 * s && tv > 1e-3 {
@@ -407,20 +412,7 @@ mod tests {
                         .unwrap()
                 };
                 let (cw, gw) = (c.each_ref().map(widen), widen(&g));
-                let h = (d + 10.0 * (1.5 * s + r)) as f64;
-                let n = 400;
-                let dx = 2.0 * h / n as f64;
-                let mut tv_r = 0.0;
-                for i in 0..n {
-                    for j in 0..n {
-                        let p = glam::Vec2::new(
-                            (-h + (i as f64 + 0.5) * dx) as f32,
-                            (-h + (j as f64 + 0.5) * dx) as f32,
-                        );
-                        let mix: f64 = cw.iter().map(|l| 0.25 * l.p22(p) as f64).sum();
-                        tv_r += 0.5 * (mix - gw.p22(p) as f64).abs() * dx * dx;
-                    }
-                }
+                let tv_r = tv_midpoint(&cw, &gw, (d + 10.0 * (1.5 * s + r)) as f64, 400);
                 println!("  r {r}: TV {tv_r:.5}, bound {:.5}", bounds[k]);
                 assert!(
                     tv_r <= bounds[k] + 1e-4,
