@@ -11,6 +11,12 @@
 //! size (allocate and write every byte once: the page faults and stores any load must pay, since the
 //! model's memory is new) and copying the file into fresh memory. Their ratio to the build is the
 //! most that any loader of this in-memory layout could reach on the machine.
+//!
+//! Also charts the medians (`--out DIR`, default target/brdf-out): `store_build_load.png`, per model
+//! the build, the load and the fill floor on a log time axis, with the target (load at
+//! build / 20) marked.
+
+mod common;
 
 use brdf::glint::{BeckmannMixture, BinMap, BinMapParams, LobeStorage, MixtureParams, NormalMap};
 use brdf::glint::{PositionNormalMap, PositionNormalParams, bumpy};
@@ -113,6 +119,99 @@ fn measure<M>(
     row
 }
 
+/// The chart of build, load and fill-floor medians per model (log time axis, milliseconds).
+fn chart(path: &std::path::Path, rows: &[Row], n: usize) -> common::Res<()> {
+    use plotters::prelude::*;
+    common::register_font();
+    let ms = |v: &[f64]| 1e3 * median(v.to_vec());
+    let all: Vec<f64> = rows
+        .iter()
+        .flat_map(|r| {
+            [
+                ms(&r.builds),
+                ms(&r.loads),
+                ms(&r.fills),
+                ms(&r.builds) / 20.0,
+            ]
+        })
+        .collect();
+    let lo = all.iter().copied().fold(f64::INFINITY, f64::min) / 2.0;
+    let hi = all.iter().copied().fold(0.0, f64::max) * 2.0;
+    let (w, h) = (900u32, 120 + 90 * rows.len() as u32);
+    let mut buf = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let k = rows.len() as f64;
+        let mut c = ChartBuilder::on(&root)
+            .caption(
+                format!("Build against load, bumpy {n}² map (medians; log time)"),
+                ("sans-serif", 20),
+            )
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(210)
+            .build_cartesian_2d((lo..hi).log_scale(), -0.6..k - 0.4)?;
+        let names: Vec<&str> = rows.iter().map(|r| r.name).collect();
+        c.configure_mesh()
+            .x_desc("milliseconds")
+            .y_labels(rows.len().max(1))
+            .y_label_formatter(&|y| {
+                let i = y.round();
+                if (y - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
+                    names[names.len() - 1 - i as usize].to_string()
+                } else {
+                    String::new()
+                }
+            })
+            .disable_y_mesh()
+            .draw()?;
+        let series = [
+            ("build", RGBColor(49, 104, 142)),
+            ("load", RGBColor(230, 120, 20)),
+            (
+                "fill floor (allocate and write the model's memory once)",
+                RGBColor(150, 150, 150),
+            ),
+        ];
+        for (s, &(label, colour)) in series.iter().enumerate() {
+            let bars: Vec<_> = rows
+                .iter()
+                .enumerate()
+                .map(|(i, r)| {
+                    let v = ms(match s {
+                        0 => &r.builds,
+                        1 => &r.loads,
+                        _ => &r.fills,
+                    });
+                    let y = (rows.len() - 1 - i) as f64 + 0.25 - 0.25 * s as f64;
+                    Rectangle::new([(lo, y - 0.1), (v, y + 0.1)], colour.filled())
+                })
+                .collect();
+            c.draw_series(bars)?.label(label).legend(move |(x, y)| {
+                Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled())
+            });
+        }
+        let target = rows.iter().enumerate().map(|(i, r)| {
+            let y = (rows.len() - 1 - i) as f64;
+            let x = ms(&r.builds) / 20.0;
+            PathElement::new(vec![(x, y - 0.42), (x, y + 0.42)], RED.stroke_width(2))
+        });
+        c.draw_series(target)?
+            .label("target: load at build / 20")
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x + 6, y - 6), (x + 6, y + 6)], RED.stroke_width(2))
+            });
+        c.configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+    }
+    common::save_rgb(path, w, h, buf)
+}
+
 fn main() {
     let n = arg("--size").unwrap_or(2048);
     let loads = arg("--loads").unwrap_or(5);
@@ -210,5 +309,12 @@ fn main() {
             r.file_bytes as f64 / texels,
             r.memory_bytes as f64 / texels
         );
+    }
+    let path = common::out_dir()
+        .map(|d| d.join("store_build_load.png"))
+        .expect("output directory");
+    match chart(&path, &rows, n) {
+        Ok(()) => println!("\nchart: {}", path.display()),
+        Err(e) => eprintln!("chart not written: {e}"),
     }
 }

@@ -83,11 +83,14 @@ pub enum Error {
         found: [u8; 8],
     },
     /// A stored model's file has a format version this build cannot read.
-    #[error("unsupported file format version {found} (this build reads version {supported})")]
+    #[error(
+        "unsupported file format version {found} (this build reads up to version {supported}; \
+         the oldest version read depends on the model, docs/format.md)"
+    )]
     UnsupportedVersion {
         /// The version in the file.
         found: u32,
-        /// The version this build reads.
+        /// The newest version this build reads (the one it writes).
         supported: u32,
     },
     /// A stored model's file holds another kind of model than the one asked for.

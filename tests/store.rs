@@ -146,7 +146,29 @@ fn mixture_round_trip_is_exact() {
         }
         // Saving the loaded model gives the same bytes.
         assert_eq!(saved(|w| loaded.save(w)), file);
+        // The same mixture in format version 2 (no merge errors: recomputed on load) answers the
+        // same, so the stored errors are the ones the build computes.
+        let old = BeckmannMixture::load(&mut as_version_2(&file).as_slice()).unwrap();
+        for (k, f) in footprints(n).iter().enumerate() {
+            assert_same_patch(
+                &built.patch(f),
+                &old.patch(f),
+                &format!("{masking:?} fp {k}, version 2"),
+            );
+        }
     }
+}
+
+/// A full mixture's version-3 file as version 2 wrote it: the payload cut after the lobes (no merge
+/// errors), the header's version and payload length set, re-sealed.
+fn as_version_2(file: &[u8]) -> Vec<u8> {
+    let lobes = u64::from_le_bytes(file[at::LOBE_COUNT..at::LOBES].try_into().unwrap()) as usize;
+    let end = at::LOBES + 20 * lobes;
+    let mut f = file[..end].to_vec();
+    f.extend_from_slice(&[0u8; 8]);
+    f[8..12].copy_from_slice(&2u32.to_le_bytes());
+    f[16..24].copy_from_slice(&((end - 24) as u64).to_le_bytes());
+    reseal(f)
 }
 
 /// Compact storage (`LobeStorage::Compact`, model kind 5): the same exactness, on a grid whose
@@ -283,7 +305,9 @@ fn inconsistent_bin_maps_are_errors() {
     );
     let texels = (n * sub) * (n * sub);
     let inverse_at = 80;
-    let offsets_at = inverse_at + 4 * texels + 8;
+    // 𝓑 as u16 (25 bins), after 𝓑⁻¹ (format version 3).
+    let bin_map_at = inverse_at + 4 * texels + 8;
+    let offsets_at = bin_map_at + 2 * texels + 8;
     let roots_at = offsets_at + 4 * 26 + 8;
     let forest_at = roots_at + 4 * 25 + 8;
     let forest_len =
@@ -293,6 +317,11 @@ fn inconsistent_bin_maps_are_errors() {
     let with = |at: usize, v: u32| {
         let mut f = file.clone();
         f[at..at + 4].copy_from_slice(&v.to_le_bytes());
+        reseal(f)
+    };
+    let with_u16 = |at: usize, v: u16| {
+        let mut f = file.clone();
+        f[at..at + 2].copy_from_slice(&v.to_le_bytes());
         reseal(f)
     };
     let swap = |a: usize, b: usize| {
@@ -311,11 +340,27 @@ fn inconsistent_bin_maps_are_errors() {
     let (s, e, _) = built.bin_range(root_bin).unwrap();
     let mid = built.forest()[0] as usize;
     assert!(s < mid && mid < e);
+    // A sub-texel given another bin by 𝓑 than the list that holds it.
+    let pair_bin = (0..25).find(|&b| b != root_bin).unwrap();
+    let k0 = built.texels_of_bin(root_bin)[0] as usize;
+    let disagree =
+        format!("is in the list of bin {root_bin} but the bin map gives it bin Some({pair_bin})");
+    let not_a_bin = format!("bin map[{k0}] = 25 is not a bin");
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![
         (
             "sub-texel beyond the grid",
             with(inverse_at, texels as u32),
-            "out of range",
+            "outside its leaf's region",
+        ),
+        (
+            "bin map disagreeing with the lists",
+            with_u16(bin_map_at + 2 * k0, pair_bin as u16),
+            &disagree,
+        ),
+        (
+            "bin map value beyond the bins",
+            with_u16(bin_map_at + 2 * k0, 25),
+            &not_a_bin,
         ),
         (
             "offsets decreasing",
@@ -356,6 +401,32 @@ fn inconsistent_bin_maps_are_errors() {
             "{name}: {e}"
         );
     }
+    // A sub-texel repeated (in place of another) within a list too short for a tree: its region is
+    // the whole map and 𝓑 is untouched, so only the fingerprint of 𝓑 against 𝓑⁻¹ sees it.
+    let params = BinMapParams {
+        leaf_size: 64,
+        ..params
+    };
+    let built = BinMap::build(&map(n), params).unwrap();
+    let mut f = saved(|w| built.save(w));
+    let b = (0..25)
+        .find(|&b| {
+            built
+                .bin_range(b)
+                .is_some_and(|r| r.2.is_none() && r.1 - r.0 >= 2)
+        })
+        .unwrap();
+    let (s, _, _) = built.bin_range(b).unwrap();
+    let first = u32_at(&f, inverse_at + 4 * s);
+    f[inverse_at + 4 * (s + 1)..inverse_at + 4 * (s + 2)].copy_from_slice(&first.to_le_bytes());
+    let e = BinMap::load(&mut reseal(f).as_slice()).unwrap_err();
+    assert!(
+        e.to_string().contains(&format!(
+            "inverse[{}] = {first} is out of range or repeated",
+            s + 1
+        )),
+        "{e}"
+    );
 }
 
 fn small_mixture_file() -> Vec<u8> {
@@ -434,7 +505,19 @@ fn every_flipped_byte_is_an_error() {
                 let e = load(&f).unwrap_err();
                 let expected = match k {
                     0..8 => matches!(e, Error::BadMagic { .. }),
-                    8..12 => matches!(e, Error::UnsupportedVersion { .. }),
+                    // A flip to version 2 (from 3, bit 0 of byte 8) is a version still read for
+                    // every kind but the bin map: the checksum, which covers the header, refuses it.
+                    // (A full mixture read as version 2 stops short of its merge errors first.)
+                    8..12 => {
+                        matches!(e, Error::UnsupportedVersion { .. })
+                            || (k == 8
+                                && f[8] == 2
+                                && kind != "bin map"
+                                && matches!(
+                                    e,
+                                    Error::ChecksumMismatch { .. } | Error::InvalidFile { .. }
+                                ))
+                    }
                     12..16 => matches!(e, Error::WrongModelKind { .. }),
                     // The payload length: too long leaves bytes over or runs out; too short cuts a
                     // field.
@@ -462,18 +545,53 @@ fn header_errors_name_what_is_wrong() {
     let e = load_mixture(&f).unwrap_err();
     assert!(e.to_string().contains("BRDFGLNT"), "{e}");
     let mut f = file.clone();
-    f[8..12].copy_from_slice(&3u32.to_le_bytes());
+    f[8..12].copy_from_slice(&4u32.to_le_bytes());
     let e = load_mixture(&reseal(f)).unwrap_err();
     assert!(
         matches!(
             e,
             Error::UnsupportedVersion {
-                found: 3,
-                supported: 2
+                found: 4,
+                supported: 3
             }
         ),
         "{e}"
     );
+    // Format version 2 is still read for every kind but the bin map (which gained 𝓑 in version 3;
+    // the full mixture gained its merge errors, recomputed when absent); older versions are not.
+    for (kind, file, load) in small_files() {
+        let v2 = if kind == "mixture" {
+            as_version_2(&file)
+        } else {
+            let mut f = file.clone();
+            f[8..12].copy_from_slice(&2u32.to_le_bytes());
+            reseal(f)
+        };
+        let r = load(&v2);
+        if kind == "bin map" {
+            assert!(
+                matches!(
+                    r,
+                    Err(Error::UnsupportedVersion {
+                        found: 2,
+                        supported: 3
+                    })
+                ),
+                "{kind}: {r:?}"
+            );
+        } else {
+            assert!(r.is_ok(), "{kind}: {r:?}");
+        }
+        let mut f = file.clone();
+        f[8..12].copy_from_slice(&1u32.to_le_bytes());
+        assert!(
+            matches!(
+                load(&reseal(f)),
+                Err(Error::UnsupportedVersion { found: 1, .. })
+            ),
+            "{kind}"
+        );
+    }
     // A mixture file handed to the other loaders.
     let e = PositionNormalMap::load(&mut file.as_slice()).unwrap_err();
     let msg = e.to_string();
@@ -619,6 +737,9 @@ mod at {
     pub const MASKING: usize = 68;
     pub const LOBE_COUNT: usize = 76;
     pub const LOBES: usize = 84;
+    /// After the 36 lobes of the 6² map: the level count, then level 1's error count and records.
+    pub const LEVELS: usize = LOBES + 36 * 20;
+    pub const ERRORS: usize = LEVELS + 16;
 }
 
 #[test]
@@ -699,6 +820,43 @@ fn inconsistent_contents_with_valid_checksums_are_errors() {
             },
             "lobes[0][0]",
         ),
+        // Version 3: one level of merge errors (6² lobes → 3² nodes) after the 36 lobes.
+        (
+            "level count",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::LEVELS, &2u64.to_le_bytes());
+                f
+            },
+            "levels = 2 but the lobe grid 6×6 has 1",
+        ),
+        (
+            "merge error above 1",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::ERRORS + 12 * 4 + 8, &1.5f32.to_le_bytes());
+                f
+            },
+            "merge errors[4][2]",
+        ),
+        (
+            "NaN merge error",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::ERRORS, &f32::NAN.to_le_bytes());
+                f
+            },
+            "merge errors[0][0]",
+        ),
+        (
+            "negative merge error",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::ERRORS + 12 * 8 + 4, &(-1e-3f32).to_le_bytes());
+                f
+            },
+            "merge errors[8][1]",
+        ),
     ];
     for (name, f, needle) in cases {
         let e = load_mixture(&reseal(f)).unwrap_err();
@@ -729,12 +887,18 @@ fn values_in_later_chunks_are_checked_after_the_checksum() {
     let mixture = BeckmannMixture::build(&m, MixtureParams::default()).unwrap();
     let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
     type Load = fn(&[u8]) -> brdf::Result<()>;
-    /// Name in the error, file, record bytes, record index, component, bad value, loader.
-    type Case = (&'static str, Vec<u8>, usize, usize, usize, f32, Load);
+    /// Name in the error, file, offset of the array's first record, record bytes, record index,
+    /// component, bad value, loader.
+    type Case = (&'static str, Vec<u8>, usize, usize, usize, usize, f32, Load);
+    let count = 64 * 64;
+    let pn_file = saved(|w| pn.save(w));
+    // The position-normal elements end the payload; the lobes start it (the merge errors follow).
+    let pn_start = pn_file.len() - 8 - count * 24;
     let cases: [Case; 2] = [
         (
             "lobes[4000][2]",
             saved(|w| mixture.save(w)),
+            at::LOBES,
             20,
             4000,
             2,
@@ -743,7 +907,8 @@ fn values_in_later_chunks_are_checked_after_the_checksum() {
         ),
         (
             "elements[3000][4]",
-            saved(|w| pn.save(w)),
+            pn_file,
+            pn_start,
             24,
             3000,
             4,
@@ -751,9 +916,7 @@ fn values_in_later_chunks_are_checked_after_the_checksum() {
             |f| PositionNormalMap::load(&mut &f[..]).map(|_| ()),
         ),
     ];
-    for (needle, file, record, index, component, value, load) in cases {
-        let count = 64 * 64;
-        let start = file.len() - 8 - count * record;
+    for (needle, file, start, record, index, component, value, load) in cases {
         let mut f = file.clone();
         let at = start + index * record + 4 * component;
         f[at..at + 4].copy_from_slice(&value.to_le_bytes());

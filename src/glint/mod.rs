@@ -60,6 +60,7 @@ mod image_io;
 mod mixture;
 mod model;
 mod moments;
+mod multiset;
 mod normal_map;
 mod position_normal;
 mod procedural;

@@ -22,8 +22,13 @@ use std::io::{Read, Write};
 /// The first 8 bytes of every file.
 pub(crate) const MAGIC: [u8; 8] = *b"BRDFGLNT";
 
-/// The format version written, and the only one read.
-pub(crate) const VERSION: u32 = 2;
+/// The format version written. Version 3 added 𝓑 to the bin map's payload and the levels' merge
+/// errors to the full mixture's; version 2 files of every kind but the bin map are still read
+/// ([`OLDEST_READ`]; a version-2 full mixture gets its merge errors recomputed).
+pub(crate) const VERSION: u32 = 3;
+
+/// The oldest format version read (for every kind but the bin map, whose loader needs version 3).
+pub(crate) const OLDEST_READ: u32 = 2;
 
 /// Bytes of the header (magic, version, kind, payload length).
 const HEADER_BYTES: usize = 24;
@@ -306,6 +311,8 @@ pub(crate) struct Decoder<'a> {
     /// The first value found out of range by [`Decoder::array_in_range`], reported by
     /// [`Decoder::finish`] once the checksum has been checked.
     out_of_range: Option<Error>,
+    /// The file's format version ([`OLDEST_READ`] ..= [`VERSION`]).
+    version: u32,
 }
 
 impl<'a> Decoder<'a> {
@@ -329,7 +336,7 @@ impl<'a> Decoder<'a> {
             return Err(Error::BadMagic { found: magic });
         }
         let version = u32::get(&head[8..]);
-        if version != VERSION {
+        if !(OLDEST_READ..=VERSION).contains(&version) {
             return Err(Error::UnsupportedVersion {
                 found: version,
                 supported: VERSION,
@@ -350,9 +357,29 @@ impl<'a> Decoder<'a> {
                 sum,
                 remaining: u64::get(&head[16..]),
                 out_of_range: None,
+                version,
             },
             found,
         ))
+    }
+
+    /// The file's format version.
+    pub(crate) fn version(&self) -> u32 {
+        self.version
+    }
+
+    /// Refuses a file older than `oldest` (a payload whose layout changed in that version).
+    ///
+    /// # Errors
+    /// [`Error::UnsupportedVersion`].
+    pub(crate) fn require_version(&self, oldest: u32) -> Result<()> {
+        if self.version < oldest {
+            return Err(Error::UnsupportedVersion {
+                found: self.version,
+                supported: VERSION,
+            });
+        }
+        Ok(())
     }
 
     fn take(&mut self, n: usize, what: &'static str) -> Result<()> {

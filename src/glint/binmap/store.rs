@@ -1,20 +1,30 @@
-//! Saving and loading a built [`BinMap`] (format: docs/format.md, kind 4).
+//! Saving and loading a built [`BinMap`] (format: docs/format.md, kind 4, format version 3).
 //!
 //! Stored: the map size, the build parameters (sub-texel resolution s included), the inverse bin map
-//! 𝓑⁻¹ in the forest's order (u32 per sub-texel of the (s·width) × (s·height) grid), the prefix-sum
-//! offsets of the bins' lists (B + 1) and their tree roots (B), the packed forest, and the coarse
-//! slope-moment chain of the masking lobe. Rebuilt on load (cheap, by the build's own routines): the
-//! bin map 𝓑 itself (sub-texel k is in bin b exactly when k is in b's list of 𝓑⁻¹), the per-bin
-//! tables (centre slopes, masking facets) and the lookup (dense or hash) from the offsets and roots.
+//! 𝓑⁻¹ in the forest's order (u32 per sub-texel of the (s·width) × (s·height) grid), the bin map 𝓑
+//! itself (u16 per sub-texel, u32 above 2¹⁶ bins), the prefix-sum offsets of the bins' lists (B + 1)
+//! and their tree roots (B), the packed forest, and the coarse slope-moment chain of the masking lobe.
+//! Rebuilt on load (cheap, by the build's own routines): the per-bin tables (centre slopes, masking
+//! facets) and the lookup (dense or hash) from the offsets and roots.
 //!
 //! The inverse map and the forest are stored rather than rebuilt because sorting the texels into the
-//! trees is most of the build. The loader therefore validates them completely before use: 𝓑⁻¹ is a
-//! permutation of the sub-texels (so 𝓑 derived from it is total and consistent with the offsets); the forest is exactly the pre-order layout
-//! the builder writes (each internal node where the previous one ends, right-child links consistent,
-//! a list gets a tree exactly when it is longer than the leaf size), and every leaf's texels lie in
-//! the leaf's region (regions nest, so every internal node's two ranges then hold exactly the
-//! texels on each side of its split, the builder's partition). A file that passes is a bin map the builder could
-//! have produced.
+//! trees is most of the build; 𝓑 is stored because deriving it from 𝓑⁻¹ writes one sub-texel at a
+//! random place per list entry (most of a format-2 load). The loader validates everything before
+//! use, with sequential reads only:
+//! - the forest is exactly the pre-order layout the builder writes (each internal node where the
+//!   previous one ends, right-child links consistent, a list gets a tree exactly when it is longer
+//!   than the leaf size), and every leaf's texels lie in the leaf's region (regions nest, so every
+//!   internal node's two ranges then hold exactly the texels on each side of its split, the
+//!   builder's partition);
+//! - 𝓑 and 𝓑⁻¹ describe the same assignment: the multiset of pairs (k, b) over the lists of 𝓑⁻¹
+//!   equals the multiset of pairs (k, 𝓑(k)) over the sub-texels, compared by a randomised
+//!   fingerprint ([`crate::glint::multiset`]). The right side holds every sub-texel once, so equal
+//!   multisets make 𝓑⁻¹ a permutation of the sub-texels that lists each one in the bin 𝓑 gives it.
+//!   A file whose 𝓑 and 𝓑⁻¹ disagree passes with probability at most n / (2⁶¹ − 1) for n
+//!   sub-texels (below 2⁻³⁷ at 2048², s = 2) over the loader's random draw; a disagreement found is
+//!   then located exactly, to name it in the error.
+//!
+//! A file that passes is a bin map the builder could have produced.
 
 use super::forest::NO_TREE;
 use super::lookup::Table;
@@ -22,13 +32,14 @@ use super::{BinIndex, BinLookup, BinMap, BinMapParams, MASKING_FIRST_LEVEL, chec
 use crate::Result;
 use crate::glint::MAX_SLOPE;
 use crate::glint::moments::{MomentLevel, MomentPyramid};
+use crate::glint::multiset;
 use crate::glint::store::{self, Decoder, Kind, invalid};
 use rayon::prelude::*;
 use std::io::{Read, Write};
 
 impl BinMap {
-    /// Writes the bin map in the crate's binary format (docs/format.md): size, parameters, 𝓑⁻¹,
-    /// bin offsets and roots, forest and coarse moments, exactly (about 4 bytes per sub-texel plus 8
+    /// Writes the bin map in the crate's binary format (docs/format.md): size, parameters, 𝓑⁻¹, 𝓑,
+    /// bin offsets and roots, forest and coarse moments, exactly (about 6 bytes per sub-texel plus 8
     /// per bin). Writes in 64 KiB blocks.
     ///
     /// # Errors
@@ -62,6 +73,10 @@ impl BinMap {
             })?;
             e.put(p.sigma_min)?;
             e.array(self.inverse.iter().map(|&k| [k]))?;
+            match &self.bin_map {
+                BinIndex::U16(v) => e.array(v.iter().map(|&b| [b]))?,
+                BinIndex::U32(v) => e.array(v.iter().map(|&b| [b]))?,
+            }
             e.array(offsets.iter().map(|&o| [o]))?;
             e.array(entries.iter().map(|&(_, root)| [root]))?;
             e.array(self.nodes.iter().map(|&v| [v]))?;
@@ -88,6 +103,7 @@ impl BinMap {
     /// inconsistency of 𝓑, 𝓑⁻¹, the offsets, the forest or the moments (see the module docs).
     pub fn load(r: &mut impl Read) -> Result<Self> {
         let mut d = Decoder::open(r, Kind::BinMap)?;
+        d.require_version(3)?;
         let width = d.len("width", i32::MAX as usize)?;
         let height = d.len("height", i32::MAX as usize)?;
         let params = BinMapParams {
@@ -115,6 +131,12 @@ impl BinMap {
         }
         let nb = bins.len();
         let inverse = flat(d.array::<u32, 1>("inverse", texels)?);
+        // The builder's storage choice (u16 when every bin fits).
+        let bin_map = if nb <= 1 << 16 {
+            BinIndex::U16(bytemuck::cast_vec(d.array::<u16, 1>("bin map", texels)?))
+        } else {
+            BinIndex::U32(flat(d.array::<u32, 1>("bin map", texels)?))
+        };
         let offsets = flat(d.array::<u32, 1>("offsets", nb + 1)?);
         let roots = flat(d.array::<u32, 1>("roots", nb)?);
         // Internal nodes hold at least 2 texels and those of one depth are disjoint, so a forest has
@@ -159,12 +181,12 @@ impl BinMap {
             })?;
         }
         check_offsets(&offsets, inverse.len())?;
-        // Deriving 𝓑, walking the forest and the per-bin tables (which need only the offsets) are
-        // independent.
-        let ((bin_map, forest), (facets, center_slope)) = rayon::join(
+        // The forest walk (with the lists' fingerprint), 𝓑's fingerprint and the per-bin tables
+        // (which need only the offsets) are independent.
+        let z = multiset::random_point();
+        let ((lists, assigned), (facets, center_slope)) = rayon::join(
             || {
                 rayon::join(
-                    || bins_of(&inverse, &offsets, nb),
                     || {
                         check_forest(
                             &inverse,
@@ -173,14 +195,17 @@ impl BinMap {
                             &nodes,
                             [grid_w, grid_h],
                             params.leaf_size,
+                            z,
                         )
                     },
+                    || assignment_fingerprint(&bin_map, nb, z),
                 )
             },
             || super::bin_tables(&bins, &offsets),
         );
-        let bin_map = bin_map?;
-        forest?;
+        if lists? != assigned? {
+            return Err(disagreement(&inverse, &offsets, &bin_map));
+        }
         Ok(BinMap {
             width,
             height,
@@ -224,111 +249,74 @@ fn check_offsets(offsets: &[u32], n: usize) -> Result<()> {
     Ok(())
 }
 
-/// 𝓑 from 𝓑⁻¹ and offsets already checked by [`check_offsets`]: 𝓑⁻¹ must be a permutation of the
-/// sub-texels (each index in range and listed once), so every sub-texel gets exactly one bin (the one
-/// whose list holds it).
-fn bins_of(inverse: &[u32], offsets: &[u32], nb: usize) -> Result<BinIndex> {
-    // The builder's storage choice (u16 when every bin fits).
-    Ok(if nb <= 1 << 16 {
-        let mut v = vec![0u16; inverse.len()];
-        scatter_bins(inverse, offsets, &mut v, |b| b as u16)?;
-        BinIndex::U16(v)
-    } else {
-        let mut v = vec![0u32; inverse.len()];
-        scatter_bins(inverse, offsets, &mut v, |b| b as u32)?;
-        BinIndex::U32(v)
-    })
+/// The pair (sub-texel k, bin b) as one element of GF(2⁶¹ − 1): k · B + b, below 2⁵⁶ for k < 2³²
+/// and B ≤ 4096² bins (unique for b < B).
+#[inline(always)]
+fn pair(k: u32, b: usize, nb: usize) -> u64 {
+    k as u64 * nb as u64 + b as u64
 }
 
-/// Sub-texels per block of 𝓑 in [`scatter_bins`]: 2¹⁶, so that a block of 𝓑 (128 KiB as `u16`) and
-/// its bit set (8 KiB) stay in a core's cache while its pairs are written, and a sub-texel's index
-/// within its block fits a `u16`.
-const BLOCK_BITS: u32 = 16;
-
-/// Writes bin b into `bin_map[k]` for every k of b's list, checking that every k is in range and
-/// listed once (with the offsets already checked, the lists then hold each sub-texel exactly once).
-///
-/// The lists visit sub-texels all over the map, so writing 𝓑 in list order misses the cache at
-/// every write (~40 ns per sub-texel: 0.7 s of a 1 s load at 2048², s = 2). Instead, a two-pass
-/// partition: the (index within block, bin) pairs are first appended, in list order, to one
-/// contiguous bucket per block of 2¹⁶ sub-texels (sequential reads, one write cursor per block),
-/// then each block of 𝓑 is filled from its bucket with a block-local bit set, blocks in parallel.
-/// A repeated sub-texel is found within its block; the error then names its first position in 𝓑⁻¹
-/// through [`first_repeat`] (the slow path of corrupt files only).
-fn scatter_bins<T: Copy + Default + Send + Sync>(
-    inverse: &[u32],
-    offsets: &[u32],
-    bin_map: &mut [T],
-    bin: impl Fn(usize) -> T,
-) -> Result<()> {
-    let n = inverse.len();
-    let block = 1usize << BLOCK_BITS;
-    let blocks = n.div_ceil(block);
-    let mut starts = vec![0usize; blocks + 1];
-    for (i, &k) in inverse.iter().enumerate() {
-        if k as usize >= n {
-            return Err(not_a_permutation(i, k, n));
-        }
-        starts[(k >> BLOCK_BITS) as usize + 1] += 1;
-    }
-    for b in 0..blocks {
-        starts[b + 1] += starts[b];
-    }
-    let mut pairs = vec![(0u16, T::default()); n];
-    let mut cursor = starts[..blocks].to_vec();
-    for b in 0..offsets.len() - 1 {
-        let v = bin(b);
-        for &k in &inverse[offsets[b] as usize..offsets[b + 1] as usize] {
-            let c = &mut cursor[(k >> BLOCK_BITS) as usize];
-            pairs[*c] = (k as u16, v);
-            *c += 1;
-        }
-    }
-    let unique = bin_map
-        .par_chunks_mut(block)
-        .zip(starts.par_windows(2))
-        .all(|(chunk, range)| {
-            let mut seen = vec![0u64; block / 64];
-            pairs[range[0]..range[1]].iter().all(|&(local, v)| {
-                let local = local as usize;
-                let bit = 1u64 << (local % 64);
-                let word = &mut seen[local / 64];
-                let fresh = *word & bit == 0;
-                *word |= bit;
-                if let Some(slot) = chunk.get_mut(local) {
-                    *slot = v;
+/// The fingerprint at `z` of the pairs (k, 𝓑(k)) over every sub-texel k, chunks in parallel; an
+/// error if some 𝓑(k) is not a bin (its pair would alias another sub-texel's).
+fn assignment_fingerprint(bin_map: &BinIndex, nb: usize, z: u64) -> Result<u64> {
+    const CHUNK: usize = 1 << 16;
+    fn chunks<T: Copy + Into<u64> + Sync>(v: &[T], nb: usize, z: u64) -> Result<u64> {
+        v.par_chunks(CHUNK)
+            .enumerate()
+            .map(|(c, chunk)| {
+                if let Some(t) = chunk.iter().position(|&b| b.into() >= nb as u64) {
+                    let k = c * CHUNK + t;
+                    return Err(invalid(format!(
+                        "bin map[{k}] = {} is not a bin (there are {nb})",
+                        chunk[t].into()
+                    )));
                 }
-                fresh
+                let base = (c * CHUNK) as u32;
+                Ok(multiset::product(
+                    z,
+                    chunk
+                        .iter()
+                        .enumerate()
+                        .map(|(t, &b)| pair(base + t as u32, b.into() as usize, nb)),
+                ))
             })
-        });
-    if unique {
-        Ok(())
-    } else {
-        Err(first_repeat(inverse))
+            .try_reduce(|| 1, |a, b| Ok(multiset::combine(a, b)))
+    }
+    match bin_map {
+        BinIndex::U16(v) => chunks(v, nb, z),
+        BinIndex::U32(v) => chunks(v, nb, z),
     }
 }
 
-fn not_a_permutation(i: usize, k: u32, n: usize) -> crate::Error {
-    invalid(format!(
-        "inverse[{i}] = {k} is out of range or repeated (not a permutation of the {n} sub-texels)"
-    ))
-}
-
-/// The error naming the first position of 𝓑⁻¹ whose sub-texel appeared before (one was found).
-fn first_repeat(inverse: &[u32]) -> crate::Error {
+/// Names the first disagreement between 𝓑⁻¹ (its entries already known to be sub-texels) and 𝓑,
+/// once their fingerprints differ: a sub-texel listed twice, or listed in a bin other than its 𝓑.
+/// The slow path of corrupt files only (a random access per entry).
+fn disagreement(inverse: &[u32], offsets: &[u32], bin_map: &BinIndex) -> crate::Error {
     let n = inverse.len();
     let mut seen = vec![0u64; n.div_ceil(64)];
-    for (i, &k) in inverse.iter().enumerate() {
-        let k = k as usize;
-        let bit = 1u64 << (k % 64);
-        match seen.get_mut(k / 64) {
-            Some(word) if *word & bit == 0 => *word |= bit,
-            _ => return not_a_permutation(i, k as u32, n),
+    for b in 0..offsets.len() - 1 {
+        let start = offsets[b] as usize;
+        for (i, &k) in (start..).zip(&inverse[start..offsets[b + 1] as usize]) {
+            let k = k as usize;
+            let bit = 1u64 << (k % 64);
+            match seen.get_mut(k / 64) {
+                Some(word) if *word & bit == 0 => *word |= bit,
+                _ => {
+                    return invalid(format!(
+                        "inverse[{i}] = {k} is out of range or repeated (not a permutation of the \
+                         {n} sub-texels)"
+                    ));
+                }
+            }
+            let found = bin_map.get(k);
+            if found != Some(b) {
+                return invalid(format!(
+                    "inverse[{i}] = {k} is in the list of bin {b} but the bin map gives it bin {found:?}"
+                ));
+            }
         }
     }
-    invalid(format!(
-        "inverse repeats a sub-texel (not a permutation of the {n} sub-texels)"
-    ))
+    invalid("the bin map and the inverse bin map disagree (multiset fingerprints differ)".into())
 }
 
 /// The forest is exactly the builder's layout (see forest.rs): bins in order, each list longer than
@@ -338,6 +326,9 @@ fn first_repeat(inverse: &[u32]) -> crate::Error {
 /// a node split its region at the builder's split, so this puts every internal node's left range on
 /// one side of its split and its right range on the other: the builder's partition. Cost O(texels +
 /// nodes) (one division per texel), no allocation.
+///
+/// Returns the fingerprint at `z` of the pairs (k, b) over every entry k of every bin b's list (each
+/// list hashed right after its tree's walk, while it is in cache).
 fn check_forest(
     inverse: &[u32],
     offsets: &[u32],
@@ -345,19 +336,24 @@ fn check_forest(
     nodes: &[u32],
     size: [usize; 2],
     leaf: usize,
-) -> Result<()> {
+    z: u64,
+) -> Result<u64> {
     let f = Forest {
         inverse,
         nodes,
-        width: size[0] as u32,
+        width: Divisor::new(size[0] as u32),
         leaf,
     };
     // Each tree is walked from its stored root, bins in parallel; the layout (trees back to back in
     // bin order, from 0 to the end of the array) is then checked in order on the walks' ends.
-    let ends: Vec<Result<Option<usize>>> = (0..roots.len())
+    let ends: Vec<Result<(Option<usize>, u64)>> = (0..roots.len())
         .into_par_iter()
         .map(|b| {
             let (start, end) = (offsets[b] as usize, offsets[b + 1] as usize);
+            let print = || {
+                let list = &inverse[start..end];
+                multiset::product(z, list.iter().map(|&k| pair(k, b, roots.len())))
+            };
             if end - start <= leaf {
                 return if roots[b] == NO_TREE {
                     f.node(
@@ -367,7 +363,7 @@ fn check_forest(
                         [0, 0, size[0] as u32, size[1] as u32],
                         &mut 0,
                     )
-                    .map(|()| None)
+                    .map(|()| (None, print()))
                 } else {
                     Err(invalid(format!(
                         "roots[{b}] = {} where the forest layout needs {NO_TREE} (no tree)",
@@ -383,10 +379,11 @@ fn check_forest(
                 [0, 0, size[0] as u32, size[1] as u32],
                 &mut cursor,
             )
-            .map(|()| Some(cursor))
+            .map(|()| (Some(cursor), print()))
         })
         .collect();
     let mut cursor = 0usize;
+    let mut print = 1;
     for (b, walked) in ends.into_iter().enumerate() {
         // The same first error as walking the trees one after the other: a misplaced root before
         // anything found inside its tree.
@@ -397,9 +394,11 @@ fn check_forest(
                 roots[b]
             )));
         }
-        if let Some(end) = walked? {
+        let (end, p) = walked?;
+        if let Some(end) = end {
             cursor = end;
         }
+        print = multiset::combine(print, p);
     }
     if cursor != nodes.len() {
         return Err(invalid(format!(
@@ -407,14 +406,44 @@ fn check_forest(
             nodes.len()
         )));
     }
-    Ok(())
+    Ok(print)
 }
 
 struct Forest<'a> {
     inverse: &'a [u32],
     nodes: &'a [u32],
-    width: u32,
+    width: Divisor,
     leaf: usize,
+}
+
+/// Division of u32 numerators by a fixed u32 divisor d ≥ 2 by one multiplication: with
+/// M = ⌊(2⁶⁴ − 1)/d⌋ + 1, ⌊n/d⌋ is the high 64 bits of M·n for every n < 2³² (Lemire, Kaser and
+/// Kurz 2019, "Faster remainder by direct computation", §3), the remainder n − d·⌊n/d⌋. d = 1 (a
+/// one-sub-texel-wide grid, where M would wrap to 0) is answered directly.
+#[derive(Clone, Copy)]
+struct Divisor {
+    d: u32,
+    m: u64,
+}
+
+impl Divisor {
+    fn new(d: u32) -> Divisor {
+        let d = d.max(1);
+        Divisor {
+            d,
+            m: (u64::MAX / d as u64).wrapping_add(1),
+        }
+    }
+
+    /// (n mod d, ⌊n/d⌋).
+    #[inline(always)]
+    fn rem_div(self, n: u32) -> (u32, u32) {
+        if self.d == 1 {
+            return (0, n);
+        }
+        let q = ((self.m as u128 * n as u128) >> 64) as u32;
+        (n - q * self.d, q)
+    }
 }
 
 impl Forest<'_> {
@@ -432,7 +461,7 @@ impl Forest<'_> {
         if e - s <= self.leaf {
             let w = self.width;
             let outside = |k: u32| {
-                let (x, y) = (k % w, k / w);
+                let (x, y) = w.rem_div(k);
                 x < x0 || x >= x1 || y < y0 || y >= y1
             };
             if let Some(i) = (s..e).find(|&i| outside(self.inverse[i])) {
@@ -478,5 +507,49 @@ impl Forest<'_> {
             )));
         }
         self.node(b, mid, e, right, cursor)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Divisor;
+
+    #[test]
+    fn divisor_matches_hardware_division() {
+        let ds = [
+            1u32,
+            2,
+            3,
+            7,
+            255,
+            256,
+            510,
+            4095,
+            4096,
+            65_537,
+            1 << 31,
+            u32::MAX - 1,
+            u32::MAX,
+        ];
+        let ns = [
+            0u32,
+            1,
+            2,
+            4095,
+            4096,
+            16_777_215,
+            1 << 31,
+            u32::MAX - 1,
+            u32::MAX,
+        ];
+        for &d in &ds {
+            let v = Divisor::new(d);
+            for &n in ns
+                .iter()
+                .chain(&[d - 1, d, d.wrapping_add(1), d.wrapping_mul(3)])
+            {
+                assert_eq!(v.rem_div(n), (n % d, n / d), "{n} / {d}");
+            }
+        }
     }
 }

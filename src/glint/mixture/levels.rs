@@ -219,8 +219,17 @@ fn one_step_bound(mc: &[([f64; 2], [f64; 3]); 4], g: &([f64; 2], [f64; 3]), r2: 
 /// [`LOD_RESOLUTIONS`], the one-step bound of TV(G_n ∗ N_r, Σ ¼ G_c ∗ N_r) ([`one_step_bound`]).
 fn merge(children: [&SlopeGaussian; 4]) -> ([f32; 5], [f64; N_RES]) {
     let mc = children.map(mean_cov);
+    let (raw, g) = merged_moments(&mc);
+    let bounds = LOD_RESOLUTIONS.map(|r| one_step_bound(&mc, &g, r as f64 * r as f64));
+    (raw, bounds)
+}
+
+/// The moment-matched merge of four children given as (mean, covariance): the raw moments (as
+/// stored, f32) and the merged (mean, covariance) in f64.
+#[allow(clippy::type_complexity)]
+fn merged_moments(mc: &[([f64; 2], [f64; 3]); 4]) -> ([f32; 5], ([f64; 2], [f64; 3])) {
     let mut raw = [0.0f64; 5];
-    for (mu, c) in &mc {
+    for (mu, c) in mc {
         raw[0] += 0.25 * mu[0];
         raw[1] += 0.25 * mu[1];
         raw[2] += 0.25 * (c[0] + mu[0] * mu[0]);
@@ -230,15 +239,25 @@ fn merge(children: [&SlopeGaussian; 4]) -> ([f32; 5], [f64; N_RES]) {
     let mean = [raw[0], raw[1]];
     // The covariance from central sums (not raw[2] − raw[0]², which cancels for large means).
     let mut cov = [0.0f64; 3];
-    for (mu, c) in &mc {
+    for (mu, c) in mc {
         let (dx, dy) = (mu[0] - mean[0], mu[1] - mean[1]);
         cov[0] += 0.25 * (c[0] + dx * dx);
         cov[1] += 0.25 * (c[1] + dx * dy);
         cov[2] += 0.25 * (c[2] + dy * dy);
     }
-    let g = (mean, cov);
-    let bounds = LOD_RESOLUTIONS.map(|r| one_step_bound(&mc, &g, r as f64 * r as f64));
-    (raw.map(|v| v as f32), bounds)
+    (raw.map(|v| v as f32), (mean, cov))
+}
+
+/// The node grids of the levels l ≥ 1 of an `nx × ny` lobe grid: halved while both sides are even
+/// (and the grid holds at least 4 lobes), as [`build_levels`] makes them.
+pub(super) fn level_grids(nx: usize, ny: usize) -> Vec<[usize; 2]> {
+    let mut out = Vec::new();
+    let (mut pw, mut ph) = (nx, ny);
+    while pw % 2 == 0 && ph % 2 == 0 && pw * ph >= 4 {
+        (pw, ph) = (pw / 2, ph / 2);
+        out.push([pw, ph]);
+    }
+    out
 }
 
 /// The levels l ≥ 1 of a lobe grid of `nx × ny` lobes (`lobes` row major, as D evaluates them),
@@ -249,6 +268,11 @@ fn merge(children: [&SlopeGaussian; 4]) -> ([f32; 5], [f64; N_RES]) {
 /// # Reference
 /// Moment matching of \[Chermain2019\] §4.2.2 (there for a single filtered lobe); the error bound is
 /// Pinsker's inequality with the convexity of KL (module docs).
+///
+/// `stored` holds the merge errors of every level (as [`LobeLevel::error`], one entry per level of
+/// [`level_grids`]) when they come from a file: the merged moments are then recomputed (cheap, and
+/// exactly as the build merges them) but the error bounds, most of the cost of a build's levels,
+/// are taken as stored.
 pub(super) fn build_levels(
     nx: usize,
     ny: usize,
@@ -256,13 +280,16 @@ pub(super) fn build_levels(
     sigma_min: f32,
     box_k: f32,
     pad: &SlopeGaussian,
+    stored: Option<Vec<[Vec<f32>; N_RES]>>,
 ) -> Vec<LobeLevel> {
     use rayon::prelude::*;
     let mut out: Vec<LobeLevel> = Vec::new();
     let mut prev_lobes: Vec<SlopeGaussian> = Vec::new();
+    let mut stored = stored.map(|v| v.into_iter());
     let (mut pw, mut ph) = (nx, ny);
     while pw % 2 == 0 && ph % 2 == 0 && pw * ph >= 4 {
         let (w, h) = (pw / 2, ph / 2);
+        let given: Option<[Vec<f32>; N_RES]> = stored.as_mut().and_then(|it| it.next());
         // Level 0's lobes are made from their moments where needed (as the blocks are), so that
         // no whole-grid array of Gaussians is held; coarser levels keep the previous level's.
         let first = out.is_empty();
@@ -274,29 +301,44 @@ pub(super) fn build_levels(
             }
         };
         let prev_err: Option<&[Vec<f32>; N_RES]> = out.last().map(|l| &l.error);
-        let merged: Vec<([f32; 5], [f32; N_RES])> = (0..w * h)
-            .into_par_iter()
-            .map(|k| {
-                let (x, y) = (k % w, k / w);
-                let idx = [
-                    2 * y * pw + 2 * x,
-                    2 * y * pw + 2 * x + 1,
-                    (2 * y + 1) * pw + 2 * x,
-                    (2 * y + 1) * pw + 2 * x + 1,
-                ];
-                let c = idx.map(child);
-                let (m, tv) = merge([&c[0], &c[1], &c[2], &c[3]]);
-                let e = std::array::from_fn(|r| {
-                    let below: f64 = prev_err
-                        .map_or(0.0, |pe| idx.iter().map(|&i| 0.25 * pe[r][i] as f64).sum());
-                    (tv[r] + below).min(1.0) as f32
-                });
-                (m, e)
-            })
-            .collect();
-        let moments: Vec<[f32; 5]> = merged.iter().map(|p| p.0).collect();
-        let error: [Vec<f32>; N_RES] =
-            std::array::from_fn(|r| merged.iter().map(|p| p.1[r]).collect());
+        let children = |k: usize| {
+            let (x, y) = (k % w, k / w);
+            let idx = [
+                2 * y * pw + 2 * x,
+                2 * y * pw + 2 * x + 1,
+                (2 * y + 1) * pw + 2 * x,
+                (2 * y + 1) * pw + 2 * x + 1,
+            ];
+            (idx, idx.map(child))
+        };
+        let (moments, error): (Vec<[f32; 5]>, [Vec<f32>; N_RES]) = match given {
+            Some(error) => {
+                let moments = (0..w * h)
+                    .into_par_iter()
+                    .map(|k| merged_moments(&children(k).1.map(|c| mean_cov(&c))).0)
+                    .collect();
+                (moments, error)
+            }
+            None => {
+                let merged: Vec<([f32; 5], [f32; N_RES])> = (0..w * h)
+                    .into_par_iter()
+                    .map(|k| {
+                        let (idx, c) = children(k);
+                        let (m, tv) = merge([&c[0], &c[1], &c[2], &c[3]]);
+                        let e = std::array::from_fn(|r| {
+                            let below: f64 = prev_err.map_or(0.0, |pe| {
+                                idx.iter().map(|&i| 0.25 * pe[r][i] as f64).sum()
+                            });
+                            (tv[r] + below).min(1.0) as f32
+                        });
+                        (m, e)
+                    })
+                    .collect();
+                let moments = merged.iter().map(|p| p.0).collect();
+                let error = std::array::from_fn(|r| merged.iter().map(|p| p.1[r]).collect());
+                (moments, error)
+            }
+        };
         let gaussians: Vec<SlopeGaussian> = moments
             .par_iter()
             .map(|m| SlopeGaussian::from_moments(*m, sigma_min))

@@ -502,18 +502,21 @@ impl BeckmannMixture {
                 progress,
             ),
         };
-        Ok(Self::assemble(width, height, grid, spacing, params, lobes))
+        Ok(Self::assemble(width, height, grid, spacing, params, lobes, None))
     }
 
     /// The mixture of stored parts (crate-private; see `store.rs`): validates `params`, derives the
     /// lobe grid as [`BeckmannMixture::build`] does and checks the lobe count against it, then
-    /// rebuilds the hierarchy and the mip chain exactly as the build does. The moments themselves are
-    /// not checked here (the loader bounds them).
+    /// rebuilds the hierarchy, the mip chain and the levels of detail exactly as the build does,
+    /// except that the levels' merge errors are `errors` when given (one entry per level, the
+    /// loader checks their sizes and range). The moments themselves are not checked here (the
+    /// loader bounds them).
     pub(crate) fn from_parts(
         width: usize,
         height: usize,
         params: MixtureParams,
         lobes: Vec<[f32; 5]>,
+        errors: Option<Vec<[Vec<f32>; levels::N_RES]>>,
     ) -> Result<Self> {
         params.validate()?;
         crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))?;
@@ -525,10 +528,13 @@ impl BeckmannMixture {
                 reason: "the lobe count does not match the lobe grid of the map size and spacing",
             });
         }
-        Ok(Self::assemble(width, height, grid, spacing, params, lobes))
+        Ok(Self::assemble(
+            width, height, grid, spacing, params, lobes, errors,
+        ))
     }
 
-    /// The derived parts (slope boxes, hierarchy, mip chain) of given lobes.
+    /// The derived parts (slope boxes, hierarchy, mip chain, levels of detail) of given lobes; the
+    /// levels' merge errors computed, or taken from `errors` (full storage only).
     fn assemble(
         width: usize,
         height: usize,
@@ -536,12 +542,13 @@ impl BeckmannMixture {
         spacing: [f64; 2],
         params: MixtureParams,
         lobes: Vec<[f32; 5]>,
+        errors: Option<Vec<[Vec<f32>; levels::N_RES]>>,
     ) -> Self {
         let [nx, ny] = grid;
         let box_k = (-2.0 * (params.slope_tail as f64).ln()).sqrt() as f32;
         if params.storage == LobeStorage::Compact {
             let pad = SlopeGaussian::from_moments([0.0; 5], params.sigma_min);
-            let full_levels = build_levels(nx, ny, &lobes, params.sigma_min, box_k, &pad);
+            let full_levels = build_levels(nx, ny, &lobes, params.sigma_min, box_k, &pad, None);
             let compact = compact::build(nx, ny, &lobes, params.sigma_min, box_k, full_levels);
             return Self::with_compact(width, height, grid, spacing, params, box_k, compact);
         }
@@ -549,7 +556,7 @@ impl BeckmannMixture {
         let (blocks, tree) = store::derive_blocks_and_tree(nx, ny, &lobes, params.sigma_min, box_k);
         let pyramid = LobePyramid::build(nx, ny, &lobes);
         let pad = SlopeGaussian::from_moments([0.0; 5], params.sigma_min);
-        let levels = build_levels(nx, ny, &lobes, params.sigma_min, box_k, &pad);
+        let levels = build_levels(nx, ny, &lobes, params.sigma_min, box_k, &pad, errors);
         BeckmannMixture {
             width,
             height,

@@ -1,13 +1,20 @@
 //! Saving and loading a built [`BeckmannMixture`] (format: docs/format.md, kind 2).
 //!
-//! Stored: the map size, the build parameters and the lobes' moments (20 bytes per lobe). The lobe
-//! blocks, the slope boxes' hierarchy and the moment mip chain are rebuilt on load by the same code
-//! as the build ([`derive_blocks_and_tree`], O(lobes), parallel): this keeps files at 20 bytes per
-//! lobe and every query of a loaded mixture bit-identical to the built one.
+//! Stored: the map size, the build parameters, the lobes' moments (20 bytes per lobe) and, since
+//! format version 3, the merge-error bounds of the levels of detail (N_RES `f32` per node of every
+//! level l ≥ 1: 4 bytes per lobe). The lobe blocks, the slope boxes' hierarchy, the moment mip chain
+//! and the levels' merged lobes are rebuilt on load by the same code as the build
+//! ([`derive_blocks_and_tree`], O(lobes), parallel): this keeps files at 24 bytes per lobe and every
+//! query of a loaded mixture bit-identical to the built one. The merge errors are stored because
+//! their χ² bounds are most of the cost of a build's levels (recomputing them made a format-2 load
+//! take 80 % of a build at 2048²); a loader checks only that each is a finite value in [0, 1] (the
+//! range of a total variation). They steer the level-of-detail choice and nothing else, so a
+//! tampered error can change which level a patch uses, never make an evaluation non-finite.
 
 use super::blocks::{LobeBlocks, SIDE};
 use super::compact::{self, CompactBlock};
 use super::hierarchy::lobe_box;
+use super::levels::{N_RES, level_grids};
 use super::{BeckmannMixture, LobeStorage, MaskingMode, MixtureParams, PatchOptions};
 use crate::Result;
 use crate::glint::MAX_SLOPE;
@@ -117,7 +124,15 @@ impl BeckmannMixture {
             })?;
             e.put(p.patch.lod_lobes)?;
             if p.storage == LobeStorage::Full {
-                return e.array(self.lobes.iter().copied());
+                e.array(self.lobes.iter().copied())?;
+                // Format version 3: the levels' merge-error bounds (their derivation is most of a
+                // build's levels; the merged moments are recomputed on load).
+                e.len(self.levels.len())?;
+                for l in &self.levels {
+                    let n = l.error[0].len();
+                    e.array((0..n).map(|i| std::array::from_fn::<f32, N_RES, _>(|r| l.error[r][i])))?;
+                }
+                return Ok(());
             }
             e.len(self.compact.len())?;
             for c in &self.compact {
@@ -209,8 +224,28 @@ impl BeckmannMixture {
             2 | 3 => (0.0, m2),
             _ => (-m2, m2),
         })?;
+        // Version 3 stores the levels' merge errors (bounds of a total variation: in [0, 1]);
+        // version 2 files did not, and get them recomputed.
+        let errors = if d.version() >= 3 {
+            let grids = level_grids(nx, ny);
+            let n = d.len("levels", usize::MAX)?;
+            if n != grids.len() {
+                return Err(store::invalid(format!(
+                    "levels = {n} but the lobe grid {nx}×{ny} has {} levels of detail above the lobes",
+                    grids.len()
+                )));
+            }
+            let mut errors = Vec::with_capacity(n);
+            for &[w, h] in &grids {
+                let e = d.array_in_range::<N_RES>("merge errors", w * h, |_| (0.0, 1.0))?;
+                errors.push(std::array::from_fn(|r| e.iter().map(|v| v[r]).collect()));
+            }
+            Some(errors)
+        } else {
+            None
+        };
         d.finish()?;
-        BeckmannMixture::from_parts(width, height, params, lobes).map_err(refused)
+        BeckmannMixture::from_parts(width, height, params, lobes, errors).map_err(refused)
     }
 }
 
@@ -226,11 +261,7 @@ fn load_compact(
     let box_k = (-2.0 * (params.slope_tail as f64).ln()).sqrt() as f32;
     // The level grids exactly as the build makes them (levels.rs: while both sides halve).
     let mut grids = vec![grid];
-    let [mut pw, mut ph] = grid;
-    while pw % 2 == 0 && ph % 2 == 0 && pw * ph >= 4 {
-        (pw, ph) = (pw / 2, ph / 2);
-        grids.push([pw, ph]);
-    }
+    grids.extend(level_grids(grid[0], grid[1]));
     let n = d.len("levels", usize::MAX)?;
     if n != grids.len() {
         return Err(store::invalid(format!(
