@@ -304,14 +304,20 @@ fn inconsistent_bin_maps_are_errors() {
         "the default sub-texel resolution the layout assumes"
     );
     let texels = (n * sub) * (n * sub);
-    let inverse_at = 80;
-    // 𝓑 as u16 (25 bins), after 𝓑⁻¹ (format version 3).
-    let bin_map_at = inverse_at + 4 * texels + 8;
-    let offsets_at = bin_map_at + 2 * texels + 8;
-    let roots_at = offsets_at + 4 * 26 + 8;
-    let forest_at = roots_at + 4 * 25 + 8;
-    let forest_len =
-        u64::from_le_bytes(file[forest_at - 8..forest_at].try_into().unwrap()) as usize;
+    // Format version 3: offsets, roots, forest, then 𝓑⁻¹ and 𝓑 (as u16: 25 bins).
+    let layout = |file: &[u8]| {
+        let offsets_at = 80;
+        let roots_at = offsets_at + 4 * 26 + 8;
+        let forest_at = roots_at + 4 * 25 + 8;
+        let forest_len =
+            u64::from_le_bytes(file[forest_at - 8..forest_at].try_into().unwrap()) as usize;
+        let inverse_at = forest_at + 4 * forest_len + 8;
+        let bin_map_at = inverse_at + 4 * texels + 8;
+        (
+            offsets_at, roots_at, forest_at, forest_len, inverse_at, bin_map_at,
+        )
+    };
+    let (offsets_at, roots_at, forest_at, forest_len, inverse_at, bin_map_at) = layout(&file);
     assert_eq!(forest_len, built.forest().len(), "layout of the test");
     let u32_at = |f: &[u8], at: usize| u32::from_le_bytes(f[at..at + 4].try_into().unwrap());
     let with = |at: usize, v: u32| {
@@ -409,6 +415,7 @@ fn inconsistent_bin_maps_are_errors() {
     };
     let built = BinMap::build(&map(n), params).unwrap();
     let mut f = saved(|w| built.save(w));
+    let inverse_at = layout(&f).4;
     let b = (0..25)
         .find(|&b| {
             built

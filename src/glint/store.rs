@@ -423,6 +423,17 @@ impl<'a> Decoder<'a> {
         what: &'static str,
         expected: usize,
     ) -> Result<Vec<[T; N]>> {
+        self.array_with(what, expected, |_, _| {})
+    }
+
+    /// [`Decoder::array`] that also shows every chunk of records to `chunk(index of its first
+    /// record, records)` as it is read (while it is in cache).
+    pub(crate) fn array_with<T: Scalar, const N: usize>(
+        &mut self,
+        what: &'static str,
+        expected: usize,
+        chunk: impl FnMut(usize, &[[T; N]]),
+    ) -> Result<Vec<[T; N]>> {
         let n: u64 = self.get(what)?;
         if n != expected as u64 {
             return Err(Error::InvalidFile {
@@ -431,7 +442,7 @@ impl<'a> Decoder<'a> {
                 ),
             });
         }
-        self.records(what, expected)
+        self.records_with(what, expected, chunk)
     }
 
     /// An array written by [`Encoder::array`] whose element count is free up to `max` (checked, as
@@ -456,17 +467,9 @@ impl<'a> Decoder<'a> {
         expected: usize,
         bound: impl Fn(usize) -> (f32, f32),
     ) -> Result<Vec<[f32; N]>> {
-        let n: u64 = self.get(what)?;
-        if n != expected as u64 {
-            return Err(Error::InvalidFile {
-                reason: format!(
-                    "{what} holds {n} elements but the parameters read so far need {expected}"
-                ),
-            });
-        }
         let bounds: [(f32, f32); N] = std::array::from_fn(&bound);
         let mut bad = None;
-        let out = self.records_with(what, expected, |first, chunk: &[[f32; N]]| {
+        let out = self.array_with(what, expected, |first, chunk: &[[f32; N]]| {
             if bad.is_none() && !all_in_range(chunk, &bounds) {
                 bad = first_out_of_range(chunk, first, what, &bounds).err();
             }

@@ -1,11 +1,11 @@
 //! Saving and loading a built [`BinMap`] (format: docs/format.md, kind 4, format version 3).
 //!
-//! Stored: the map size, the build parameters (sub-texel resolution s included), the inverse bin map
-//! 𝓑⁻¹ in the forest's order (u32 per sub-texel of the (s·width) × (s·height) grid), the bin map 𝓑
-//! itself (u16 per sub-texel, u32 above 2¹⁶ bins), the prefix-sum offsets of the bins' lists (B + 1)
-//! and their tree roots (B), the packed forest, and the coarse slope-moment chain of the masking lobe.
-//! Rebuilt on load (cheap, by the build's own routines): the per-bin tables (centre slopes, masking
-//! facets) and the lookup (dense or hash) from the offsets and roots.
+//! Stored: the map size, the build parameters (sub-texel resolution s included), the prefix-sum
+//! offsets of the bins' lists (B + 1) and their tree roots (B), the packed forest, the inverse bin
+//! map 𝓑⁻¹ in the forest's order (u32 per sub-texel of the (s·width) × (s·height) grid), the bin map
+//! 𝓑 itself (u16 per sub-texel, u32 above 2¹⁶ bins), and the coarse slope-moment chain of the
+//! masking lobe. Rebuilt on load (cheap, by the build's own routines): the per-bin tables (centre
+//! slopes, masking facets) and the lookup (dense or hash) from the offsets and roots.
 //!
 //! The inverse map and the forest are stored rather than rebuilt because sorting the texels into the
 //! trees is most of the build; 𝓑 is stored because deriving it from 𝓑⁻¹ writes one sub-texel at a
@@ -25,6 +25,12 @@
 //!   then located exactly, to name it in the error.
 //!
 //! A file that passes is a bin map the builder could have produced.
+//!
+//! The load overlaps its checks with its reads: the reads stay on the calling thread (a
+//! `std::io::Read` need not be `Send`) while the per-bin tables, as soon as the offsets are read, and
+//! the forest walk, as soon as 𝓑⁻¹ is, run on rayon's pool ([`rayon::in_place_scope`]); 𝓑's
+//! fingerprint is taken chunk by chunk as 𝓑 is read. Errors are still reported in the order of a
+//! sequential load: the read and the checksum first, then the values.
 
 use super::forest::NO_TREE;
 use super::lookup::Table;
@@ -72,14 +78,15 @@ impl BinMap {
                 BinLookup::Hash => 1u32,
             })?;
             e.put(p.sigma_min)?;
+            // The small tables first, so that a load can check the forest while it reads 𝓑.
+            e.array(offsets.iter().map(|&o| [o]))?;
+            e.array(entries.iter().map(|&(_, root)| [root]))?;
+            e.array(self.nodes.iter().map(|&v| [v]))?;
             e.array(self.inverse.iter().map(|&k| [k]))?;
             match &self.bin_map {
                 BinIndex::U16(v) => e.array(v.iter().map(|&b| [b]))?,
                 BinIndex::U32(v) => e.array(v.iter().map(|&b| [b]))?,
             }
-            e.array(offsets.iter().map(|&o| [o]))?;
-            e.array(entries.iter().map(|&(_, root)| [root]))?;
-            e.array(self.nodes.iter().map(|&v| [v]))?;
             e.len(first)?;
             e.len(levels.len())?;
             for l in levels {
@@ -130,48 +137,59 @@ impl BinMap {
             )));
         }
         let nb = bins.len();
-        let inverse = flat(d.array::<u32, 1>("inverse", texels)?);
-        // The builder's storage choice (u16 when every bin fits).
-        let bin_map = if nb <= 1 << 16 {
-            BinIndex::U16(bytemuck::cast_vec(d.array::<u16, 1>("bin map", texels)?))
-        } else {
-            BinIndex::U32(flat(d.array::<u32, 1>("bin map", texels)?))
-        };
         let offsets = flat(d.array::<u32, 1>("offsets", nb + 1)?);
         let roots = flat(d.array::<u32, 1>("roots", nb)?);
         // Internal nodes hold at least 2 texels and those of one depth are disjoint, so a forest has
         // fewer than texels × (depth ≤ 64) nodes; the bound only limits the count before its check.
         let nodes = flat(d.array_up_to::<u32, 1>("forest", 128 * texels)?);
+        // Checked now (the forest walk slices 𝓑⁻¹ by the offsets), reported after the checksum.
+        let offsets_ok = check_offsets(&offsets, texels);
         let sizes = MomentPyramid::level_sizes(width, height);
         let first = MASKING_FIRST_LEVEL.min(sizes.len() - 1);
-        let stored_first = d.len("moments first level", usize::MAX)?;
-        let level_count = d.len("moment levels", sizes.len())?;
-        if stored_first != first || level_count != sizes.len() - first {
-            return Err(invalid(format!(
-                "moment chain from level {stored_first} with {level_count} levels; a {width}×{height} map \
-                 keeps levels {first}..{}",
-                sizes.len()
-            )));
-        }
-        let mut levels = Vec::with_capacity(level_count);
-        for &(w, h) in &sizes[first..] {
-            let (sw, sh) = (
-                d.len("moment level width", w)?,
-                d.len("moment level height", h)?,
-            );
-            if (sw, sh) != (w, h) {
-                return Err(invalid(format!(
-                    "moment level of {sw}×{sh} texels where the map's chain has {w}×{h}"
-                )));
-            }
-            let data = d.array::<f32, 5>("moments", w * h)?;
-            levels.push(MomentLevel {
-                width: w,
-                height: h,
-                data,
-            });
-        }
-        d.finish()?;
+        let z = multiset::random_point();
+        // The reads stay on this thread; the per-bin tables (from the offsets) and then the forest
+        // walk with the lists' fingerprint (from 𝓑⁻¹) run on the thread pool meanwhile, and 𝓑's
+        // fingerprint is taken chunk by chunk as 𝓑 is read.
+        let (mut tables, mut forest) = (None, None);
+        let read = rayon::in_place_scope(|outer| {
+            outer.spawn(|_| tables = Some(super::bin_tables(&bins, &offsets)));
+            let inverse = flat(d.array::<u32, 1>("inverse", texels)?);
+            let rest = rayon::in_place_scope(|inner| {
+                if offsets_ok.is_ok() {
+                    inner.spawn(|_| {
+                        forest = Some(check_forest(
+                            &inverse,
+                            &offsets,
+                            &roots,
+                            &nodes,
+                            [grid_w, grid_h],
+                            params.leaf_size,
+                            z,
+                        ));
+                    });
+                }
+                let mut assigned = Assignment::new(nb, z);
+                // The builder's storage choice (u16 when every bin fits).
+                let bin_map = if nb <= 1 << 16 {
+                    BinIndex::U16(bytemuck::cast_vec(d.array_with::<u16, 1>(
+                        "bin map",
+                        texels,
+                        |at, chunk| assigned.add(at, chunk.as_flattened()),
+                    )?))
+                } else {
+                    BinIndex::U32(flat(d.array_with::<u32, 1>(
+                        "bin map",
+                        texels,
+                        |at, chunk| assigned.add(at, chunk.as_flattened()),
+                    )?))
+                };
+                let levels = read_moments(&mut d, &sizes[first..], first)?;
+                d.finish()?;
+                Ok((bin_map, levels, assigned.finish()))
+            })?;
+            Ok::<_, crate::Error>((inverse, rest))
+        });
+        let (inverse, (bin_map, levels, assigned)) = read?;
         let m = 2.0 * MAX_SLOPE;
         for l in &levels {
             store::check_range(&l.data, "moments", |c| match c {
@@ -180,32 +198,12 @@ impl BinMap {
                 _ => (-m * m, m * m),
             })?;
         }
-        check_offsets(&offsets, inverse.len())?;
-        // The forest walk (with the lists' fingerprint), 𝓑's fingerprint and the per-bin tables
-        // (which need only the offsets) are independent.
-        let z = multiset::random_point();
-        let ((lists, assigned), (facets, center_slope)) = rayon::join(
-            || {
-                rayon::join(
-                    || {
-                        check_forest(
-                            &inverse,
-                            &offsets,
-                            &roots,
-                            &nodes,
-                            [grid_w, grid_h],
-                            params.leaf_size,
-                            z,
-                        )
-                    },
-                    || assignment_fingerprint(&bin_map, nb, z),
-                )
-            },
-            || super::bin_tables(&bins, &offsets),
-        );
-        if lists? != assigned? {
+        offsets_ok?;
+        let lists = forest.expect("the forest walk ran: the offsets are valid")?;
+        if lists != assigned? {
             return Err(disagreement(&inverse, &offsets, &bin_map));
         }
+        let (facets, center_slope) = tables.expect("the tables task ran");
         Ok(BinMap {
             width,
             height,
@@ -256,35 +254,88 @@ fn pair(k: u32, b: usize, nb: usize) -> u64 {
     k as u64 * nb as u64 + b as u64
 }
 
-/// The fingerprint at `z` of the pairs (k, 𝓑(k)) over every sub-texel k, chunks in parallel; an
-/// error if some 𝓑(k) is not a bin (its pair would alias another sub-texel's).
-fn assignment_fingerprint(bin_map: &BinIndex, nb: usize, z: u64) -> Result<u64> {
-    const CHUNK: usize = 1 << 16;
-    fn chunks<T: Copy + Into<u64> + Sync>(v: &[T], nb: usize, z: u64) -> Result<u64> {
-        v.par_chunks(CHUNK)
-            .enumerate()
-            .map(|(c, chunk)| {
-                if let Some(t) = chunk.iter().position(|&b| b.into() >= nb as u64) {
-                    let k = c * CHUNK + t;
-                    return Err(invalid(format!(
-                        "bin map[{k}] = {} is not a bin (there are {nb})",
-                        chunk[t].into()
-                    )));
-                }
-                let base = (c * CHUNK) as u32;
-                Ok(multiset::product(
-                    z,
-                    chunk
-                        .iter()
-                        .enumerate()
-                        .map(|(t, &b)| pair(base + t as u32, b.into() as usize, nb)),
-                ))
-            })
-            .try_reduce(|| 1, |a, b| Ok(multiset::combine(a, b)))
+/// The coarse moment chain of the masking lobe: its first level and level count (which must be
+/// `first` and `sizes.len()`), then each level's size (which must be `sizes`' ) and moments.
+fn read_moments(
+    d: &mut Decoder<'_>,
+    sizes: &[(usize, usize)],
+    first: usize,
+) -> Result<Vec<MomentLevel>> {
+    let stored_first = d.len("moments first level", usize::MAX)?;
+    let level_count = d.len("moment levels", first + sizes.len())?;
+    if stored_first != first || level_count != sizes.len() {
+        return Err(invalid(format!(
+            "moment chain from level {stored_first} with {level_count} levels; the map keeps \
+             levels {first}..{}",
+            first + sizes.len()
+        )));
     }
-    match bin_map {
-        BinIndex::U16(v) => chunks(v, nb, z),
-        BinIndex::U32(v) => chunks(v, nb, z),
+    let mut levels = Vec::with_capacity(level_count);
+    for &(w, h) in sizes {
+        let (sw, sh) = (
+            d.len("moment level width", w)?,
+            d.len("moment level height", h)?,
+        );
+        if (sw, sh) != (w, h) {
+            return Err(invalid(format!(
+                "moment level of {sw}×{sh} texels where the map's chain has {w}×{h}"
+            )));
+        }
+        let data = d.array::<f32, 5>("moments", w * h)?;
+        levels.push(MomentLevel {
+            width: w,
+            height: h,
+            data,
+        });
+    }
+    Ok(levels)
+}
+
+/// The fingerprint at `z` of the pairs (k, 𝓑(k)) over every sub-texel k, taken chunk by chunk as 𝓑
+/// is read; the first 𝓑(k) that is not a bin (its pair would alias another sub-texel's) is kept
+/// as the error.
+struct Assignment {
+    bins: usize,
+    z: u64,
+    print: u64,
+    bad: Option<crate::Error>,
+}
+
+impl Assignment {
+    fn new(bins: usize, z: u64) -> Assignment {
+        Assignment {
+            bins,
+            z,
+            print: 1,
+            bad: None,
+        }
+    }
+
+    /// The sub-texels `at`, `at` + 1, … with bins `chunk`.
+    fn add<T: Copy + Into<u64>>(&mut self, at: usize, chunk: &[T]) {
+        if self.bad.is_some() {
+            return;
+        }
+        let nb = self.bins as u64;
+        if let Some(t) = chunk.iter().position(|&b| b.into() >= nb) {
+            self.bad = Some(invalid(format!(
+                "bin map[{}] = {} is not a bin (there are {nb})",
+                at + t,
+                chunk[t].into()
+            )));
+            return;
+        }
+        let p = multiset::product(
+            self.z,
+            (at as u32..)
+                .zip(chunk)
+                .map(|(k, &b)| pair(k, b.into() as usize, self.bins)),
+        );
+        self.print = multiset::combine(self.print, p);
+    }
+
+    fn finish(self) -> Result<u64> {
+        self.bad.map_or(Ok(self.print), Err)
     }
 }
 

@@ -502,7 +502,9 @@ impl BeckmannMixture {
                 progress,
             ),
         };
-        Ok(Self::assemble(width, height, grid, spacing, params, lobes, None))
+        Ok(Self::assemble(
+            width, height, grid, spacing, params, lobes, None,
+        ))
     }
 
     /// The mixture of stored parts (crate-private; see `store.rs`): validates `params`, derives the

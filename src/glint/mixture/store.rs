@@ -130,7 +130,9 @@ impl BeckmannMixture {
                 e.len(self.levels.len())?;
                 for l in &self.levels {
                     let n = l.error[0].len();
-                    e.array((0..n).map(|i| std::array::from_fn::<f32, N_RES, _>(|r| l.error[r][i])))?;
+                    e.array(
+                        (0..n).map(|i| std::array::from_fn::<f32, N_RES, _>(|r| l.error[r][i])),
+                    )?;
                 }
                 return Ok(());
             }
