@@ -137,7 +137,8 @@ fn chart(path: &std::path::Path, rows: &[Row], n: usize) -> common::Res<()> {
         .collect();
     let lo = all.iter().copied().fold(f64::INFINITY, f64::min) / 2.0;
     let hi = all.iter().copied().fold(0.0, f64::max) * 2.0;
-    let (w, h) = (900u32, 120 + 90 * rows.len() as u32);
+    // One row band per model and one more at the bottom for the legend.
+    let (w, h) = (900u32, 120 + 90 * (rows.len() as u32 + 1));
     let mut buf = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
@@ -151,11 +152,11 @@ fn chart(path: &std::path::Path, rows: &[Row], n: usize) -> common::Res<()> {
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(210)
-            .build_cartesian_2d((lo..hi).log_scale(), -0.6..k - 0.4)?;
+            .build_cartesian_2d((lo..hi).log_scale(), -1.6..k - 0.4)?;
         let names: Vec<&str> = rows.iter().map(|r| r.name).collect();
         c.configure_mesh()
             .x_desc("milliseconds")
-            .y_labels(rows.len().max(1))
+            .y_labels(5 * (rows.len() + 2))
             .y_label_formatter(&|y| {
                 let i = y.round();
                 if (y - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {

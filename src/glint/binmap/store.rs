@@ -255,7 +255,8 @@ fn pair(k: u32, b: usize, nb: usize) -> u64 {
 }
 
 /// The coarse moment chain of the masking lobe: its first level and level count (which must be
-/// `first` and `sizes.len()`), then each level's size (which must be `sizes`' ) and moments.
+/// `first` and `sizes.len()`), then each level's size (which must be the one in `sizes`) and its
+/// moments.
 fn read_moments(
     d: &mut Decoder<'_>,
     sizes: &[(usize, usize)],
