@@ -1,5 +1,5 @@
-//! Inverse bin map (Atanasov 2020): build on an arbitrary small map with arbitrary bin counts and leaf
-//! sizes, patch (plain and smoothed) through an arbitrary footprint, query and sample.
+//! Inverse bin map (Atanasov 2020): build on an arbitrary small map with arbitrary bin counts, leaf
+//! sizes and sub-texel resolutions, patch (plain and smoothed) through an arbitrary footprint, query and sample.
 #![no_main]
 
 use arbitrary::Arbitrary;
@@ -13,6 +13,9 @@ struct Input {
     map: MapInput,
     bins_per_axis: u8,
     leaf_size: u8,
+    /// Sub-texel resolution s (issue 17); out-of-range values (0, > `MAX_SUBDIVISIONS`) must be
+    /// refused by the builder.
+    subdivisions: u8,
     hashed: bool,
     sigma_min: f32,
     smoothing_alpha: f32,
@@ -31,6 +34,7 @@ fuzz_target!(|input: Input| {
             BinLookup::Dense
         },
         sigma_min: input.sigma_min,
+        subdivisions: input.subdivisions as usize,
     };
     let Ok(bin_map) = BinMap::build(&map, params) else {
         return;

@@ -12,13 +12,13 @@ fuzz_target!(|data: &[u8]| {
     let input = StoreInput::parse(data);
     let bytes = input.bytes();
     if let Ok(map) = BinMap::load(&mut bytes.as_slice()) {
-        let mut again = Vec::new();
-        map.save(&mut again).unwrap();
-        check_resave(&bytes, &again, |f| {
-            let mut out = Vec::new();
-            BinMap::load(&mut &f[..]).unwrap().save(&mut out).unwrap();
-            out
-        });
+        // A file that loads is re-saved byte for byte, or upgraded to the current version.
+        check_resave(
+            &bytes,
+            &map,
+            |m, w| m.save(w),
+            |f| BinMap::load(&mut &f[..]),
+        );
         let footprint = input.footprint.build();
         for patch in [map.patch(&footprint), map.patch_smoothed(&footprint, 0.1)] {
             check_ndf(&patch, &input.probe);
