@@ -6,8 +6,8 @@
 //! functions over a dense grid. No `mul_add`: without `target-cpu` flags it becomes a slow software
 //! call, so every polynomial is a plain Horner scheme.
 //!
-//! `exp`, `ln` and `sin_cos` are std's on purpose. Inlined Cephes-style `f32` versions were tried
-//! (2026-11, issue #2) and measured slower on x86-64 Linux: glibc picks FMA variants of `expf`,
+//! `exp`, `ln` and `sin_cos` are std's on purpose. Inlined Cephes-style `f32` versions measure
+//! slower on x86-64 Linux: glibc picks FMA variants of `expf`,
 //! `logf` and `sincosf` at load time (≈ 3.5–4 ns per call here against 6–7 ns for the inlined
 //! SSE2 polynomials, whose Horner chains cannot use FMA without `target-cpu` flags). Only `atan2`
 //! is replaced, by [`atan2_pos`], where an approximation is enough (≈ 4 ns against 12 ns).
@@ -40,7 +40,7 @@ pub(crate) fn finite_f32(v: f64) -> f32 {
 /// comparison on the bits: the positive finite nonzero floats are exactly the bit patterns
 /// 1..=0x7F7F_FFFF (negative ones have the sign bit set, +∞ and NaN lie above). LLVM compiles the two
 /// float comparisons to two compares and a mask; this is one integer compare (measured ~10 % of the
-/// Beckmann G1 hot path, issue 18).
+/// Beckmann G1 hot path).
 #[inline(always)]
 pub(crate) fn is_positive_finite(x: f32) -> bool {
     x.to_bits().wrapping_sub(1) < 0x7F7F_FFFF
@@ -123,8 +123,8 @@ pub(crate) fn erfcx_small(x: f32) -> f32 {
 /// The Chebyshev-fitted exponent P(t) of Numerical Recipes' `erfcc`: erfc(x) = t e^(−x² + P(t)).
 #[inline(always)]
 pub(crate) fn erfc_exponent(t: f32) -> f32 {
-    // Horner's scheme: an Estrin split was tried (issue 18) and raised erfc's measured error from
-    // < 5·10⁻⁷ to 5.15·10⁻⁷ (the terms alternate in sign near t ≈ 0.7), so it was not kept.
+    // Horner's scheme: an Estrin split raises erfc's measured error from < 5·10⁻⁷ to 5.15·10⁻⁷ (the
+    // terms alternate in sign near t ≈ 0.7).
     -1.265_512_2
         + t * (1.000_023_7
             + t * (0.374_091_96
@@ -145,8 +145,8 @@ pub(crate) fn erfc_exponent(t: f32) -> f32 {
 /// # Reference
 /// \[Press1992\] §6.2, `erfcc`.
 #[inline]
-// Since 2026-11 the crate's code uses e^(−x²)·`erfcx_pos` directly (see `erf_impl`); `erfc` stays as
-// the tested reference form.
+// The crate's code uses e^(−x²)·`erfcx_pos` directly (see `erf_impl`); `erfc` is the tested
+// reference form.
 #[cfg_attr(not(test), allow(dead_code))]
 pub(crate) fn erfc(x: f32) -> f32 {
     if x.is_nan() {

@@ -6,7 +6,35 @@
 //! P-NDF D_P(ω_h) (Chermain 2019, eq. 8) is an [`Ndf`] that any microfacet BRDF consumes:
 //! `MicrofacetBrdf::new(model.patch(&footprint), fresnel)`.
 //!
-//! More in `docs/glint.md`.
+//! More in `docs/glint.md`; the module layout and the data flow of a query in `docs/architecture.md`.
+//!
+//! ## Where things are
+//!
+//! - **Models**, each a public module that owns its build parameters, its per-query options and its
+//!   `DEFAULT_*` constants: [`mixture`] (the Beckmann mixture of \[Chermain2019\]), [`binmap`] (the
+//!   inverse bin map of \[Atanasov2020\]), [`position_normal`] (the position-normal Gaussians of
+//!   \[Yan2016\], the baseline). Their model and patch types are re-exported here, with
+//!   [`GlintModel`], which holds any of them at run time.
+//! - **Inputs** (re-exported here): [`NormalMap`] and the procedural maps, image decoding,
+//!   [`Footprint`].
+//! - **Truths** (re-exported here): [`binned_pndf`], [`convolved_pndf`], [`tv_distance`],
+//!   [`FootprintBrdf`] and the [`HemisphereBins`] they are tabulated on.
+//!
+//! ## Adding a model
+//!
+//! 1. A folder `src/glint/<model>/` whose `mod.rs` holds the model type, its parameters, its
+//!    per-query options and their `DEFAULT_*` constants; the model implements [`GlintNdf`] (its
+//!    patch takes its buffers from the scratch with `GlintScratch`'s crate-private `slot::<T>()`, so
+//!    the scratch needs no field for it) and the crate-private `Stored` trait of `io/format.rs`
+//!    (`save` / `load` in the crate's file format).
+//! 2. One line per registry: the model's file-format `Kind` code (`io/format.rs`), its line in the
+//!    `glint_models!` registry (`model.rs`: the [`GlintModel`] and [`GlintPatch`] variants, the
+//!    [`GlintOptions`] field, save/load dispatch), its `serde` line (`io/serde.rs`), and
+//!    `pub mod` plus the re-export of its model and patch types here.
+//! 3. The registry's completeness test (tests/glint_registry.rs) lists an example of every
+//!    registered model and fails until the new one is there: it saves and loads each through
+//!    [`GlintModel`], round-trips each through `serde`, and checks that a patch built in a warm
+//!    scratch allocates nothing.
 //!
 //! ## Texel space (every glint model relies on this)
 //!
@@ -51,80 +79,60 @@
 //! [`FootprintBrdf`] / [`footprint_brdf`] give the two references of a footprint's BRDF (the exact
 //! P-BRDF of eq. 7 with the true P-NDF, and normal-mapped shading averaged over the footprint).
 
-mod binmap;
-mod bins;
-mod cdf;
-mod footprint;
-#[cfg(feature = "image")]
-mod image_io;
-mod mixture;
+pub mod binmap;
+mod io;
+mod kernels;
+pub mod mixture;
 mod model;
-mod moments;
-mod multiset;
-mod normal_map;
-mod position_normal;
-mod procedural;
-mod reference;
+pub mod position_normal;
 mod scratch;
-#[cfg(feature = "serde")]
-mod serde_impl;
-mod slope_tree;
-mod store;
+mod surface;
+mod truth;
 
-pub use binmap::{
-    BinLookup, BinMap, BinMapMemory, BinMapParams, BinMapPatch, DEFAULT_BINS_PER_AXIS,
-    DEFAULT_LEAF_SIZE, DEFAULT_LOOKUP, DEFAULT_MASKING_SIGMA_MIN, DEFAULT_SUBDIVISIONS,
-    EXACT_MASKING_TEXELS, MASKING_FIRST_LEVEL, MAX_SUBDIVISIONS, QueryStats,
+pub use binmap::{BinMap, BinMapPatch};
+pub use mixture::{BeckmannMixture, MixturePatch};
+pub use model::{GlintModel, GlintOptions, GlintPatch};
+pub use position_normal::{PositionNormalBrdf, PositionNormalMap, PositionNormalPatch};
+pub use scratch::GlintScratch;
+pub use surface::{
+    BrushedParams, FlakesParams, Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MAX_SLOPE,
+    MIN_WIDTH_TEXELS, NormalMap, NormalRepair, ScratchedParams, TangentConvention, brushed, bumpy,
+    flakes, moments_mean_covariance, scratched,
 };
-pub use bins::HemisphereBins;
-pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 #[cfg(feature = "image")]
-pub use image_io::{
+pub use surface::{
     DEFAULT_LENGTH_TOLERANCE, FloatEncoding, ImageDecoding, ImageOptions, MAX_IMPLAUSIBLE_FRACTION,
     RAW_EVIDENCE_BELOW,
 };
-pub use mixture::{
-    BeckmannMixture, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES, DEFAULT_LOD_RESOLUTION,
-    DEFAULT_LOD_TOLERANCE, DEFAULT_MASKING, DEFAULT_SAMPLES, DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL,
-    DEFAULT_SPACING, DEFAULT_WEIGHT_SIGMAS, LOD_RESOLUTIONS, MAX_TRUNCATION_SIGMAS, MIN_SPACING,
-    MaskingMode, MixtureMemory, MixtureParams, MixturePatch, PatchOptions,
-};
-pub use mixture::{DEFAULT_SUPERSAMPLING, MAX_SUPERSAMPLING, MomentMethod};
-pub use mixture::{LobeStorage, MIN_COMPACT_SIGMA};
-pub use model::{GlintModel, GlintPatch};
-pub use normal_map::{
-    MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
-};
-pub use position_normal::{
-    DEFAULT_MASKING_ALPHA, EXACT_MASKING_ELEMENTS, PositionNormalBrdf, PositionNormalMap,
-    PositionNormalMemory, PositionNormalParams, PositionNormalPatch,
-};
-pub use procedural::{
-    BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
-};
-pub use reference::{
+pub use truth::{
     BinMasses, BinnedPndf, DEFAULT_MAX_QUADRATURE, DEFAULT_QUADRATURE_TOLERANCE, FootprintBrdf,
-    JITTERS, Kernel, REFERENCE_BATCHES, adaptive_bin_masses, bin_masses, binned_pndf,
-    convolved_pndf, footprint_brdf, naive_brdf, tv_distance,
+    HemisphereBins, JITTERS, Kernel, REFERENCE_BATCHES, adaptive_bin_masses, bin_masses,
+    binned_pndf, convolved_pndf, footprint_brdf, naive_brdf, tv_distance,
 };
-pub use scratch::GlintScratch;
 
 use crate::ndf::Ndf;
 
 /// A precomputed glint representation of one normal map.
 ///
-/// Implemented by the glint models (Beckmann mixture, inverse bin map, position-normal Gaussians).
-/// Building the representation is the expensive, once-per-map step; [`GlintNdf::patch`] is the
-/// per-shading-point step, and the returned patch answers per-direction queries (`d`, `lambda`,
-/// `projected_area`, sampling) cheaply. The patch is an [`Ndf`] in the local frame of the geometric
-/// surface (z = ω_g), normalised like every NDF of the crate: ∫ D_P(m) (m·ω_g) dm = 1.
+/// Implemented by the glint models (Beckmann mixture, inverse bin map, position-normal Gaussians)
+/// and by [`GlintModel`], which holds any of them. Building the representation is the expensive,
+/// once-per-map step; [`GlintNdf::patch_with`] is the per-shading-point step, and the returned patch
+/// answers per-direction queries (`d`, `lambda`, `projected_area`, sampling) cheaply. The patch is an
+/// [`Ndf`] in the local frame of the geometric surface (z = ω_g), normalised like every NDF of the
+/// crate: ∫ D_P(m) (m·ω_g) dm = 1.
+///
+/// Every query goes through one path, [`GlintNdf::patch_with`]: the footprint, the model's per-query
+/// [`Options`](GlintNdf::Options) (level of detail, masking, smoothing; each model's own type, with
+/// its `DEFAULT_*` constants in the model's module), and optionally a per-thread [`GlintScratch`]
+/// that lends the patch its buffers. [`GlintNdf::patch`] and [`GlintNdf::patch_in`] are the same with
+/// the model's [`options`](GlintNdf::options).
 ///
 /// # Example
 ///
 /// The shape of an implementation (here a toy model whose every patch is the same smooth lobe):
 ///
 /// ```
-/// use brdf::glint::{Footprint, GlintNdf, NormalMap};
+/// use brdf::glint::{Footprint, GlintNdf, GlintScratch, NormalMap};
 /// use brdf::ndf::Ndf;
 /// use brdf::{Vec2, Vec3};
 ///
@@ -138,7 +146,13 @@ use crate::ndf::Ndf;
 /// struct Toy { map: NormalMap }
 /// impl GlintNdf for Toy {
 ///     type Patch<'a> = Patch<'a>;
-///     fn patch(&self, footprint: &Footprint) -> Patch<'_> {
+///     type Options = ();
+///     fn patch_with<'a>(
+///         &'a self,
+///         footprint: &Footprint,
+///         _options: &(),
+///         _scratch: Option<&'a mut GlintScratch>,
+///     ) -> Patch<'a> {
 ///         // Per-footprint work happens here, once, in texel units of the map.
 ///         let (_centre, _cov) = footprint.gaussian_texels(self.map.width(), self.map.height());
 ///         Patch { model: self, weight_sum: 1.0 }
@@ -158,21 +172,41 @@ pub trait GlintNdf {
     where
         Self: 'a;
 
-    /// The P-NDF of the surface seen through one ray footprint:
-    /// D_P(ω_h) = ∫ δ(ω_n(u) − ω_h) k_P(u) du (\[Chermain2019\] eq. 8), as approximated by the model.
-    /// May allocate the patch's working buffers; see [`GlintNdf::patch_in`].
-    fn patch(&self, footprint: &Footprint) -> Self::Patch<'_>;
+    /// Per-query options of the patches (level of detail, masking, smoothing); `Default` gives the
+    /// model's documented `DEFAULT_*` values.
+    type Options: Clone + Default + std::fmt::Debug;
 
-    /// The same patch, with its working buffers lent by a caller's [`GlintScratch`] (one per render
-    /// thread) and given back when the patch drops: once the scratch has grown to the largest
-    /// footprint, building and querying a patch performs no heap allocation. Bit-identical results
-    /// to [`GlintNdf::patch`]. The default ignores the scratch (for models that need none).
+    /// The options [`GlintNdf::patch`] and [`GlintNdf::patch_in`] use. The default implementation
+    /// returns `Self::Options::default()`; a model built with options of its own returns those.
+    fn options(&self) -> Self::Options {
+        Self::Options::default()
+    }
+
+    /// The P-NDF of the surface seen through one ray footprint:
+    /// D_P(ω_h) = ∫ δ(ω_n(u) − ω_h) k_P(u) du (\[Chermain2019\] eq. 8), as approximated by the model
+    /// with `options`. With a `scratch` (one per render thread), the patch borrows its working
+    /// buffers from it and gives them back when it drops: once the scratch has grown to the largest
+    /// footprint, building and querying a patch performs no heap allocation (tests/alloc.rs).
+    /// Without one, the patch allocates its own. Results are bit-identical either way.
+    fn patch_with<'a>(
+        &'a self,
+        footprint: &Footprint,
+        options: &Self::Options,
+        scratch: Option<&'a mut GlintScratch>,
+    ) -> Self::Patch<'a>;
+
+    /// [`GlintNdf::patch_with`] with the model's [`options`](GlintNdf::options), allocating.
+    fn patch(&self, footprint: &Footprint) -> Self::Patch<'_> {
+        self.patch_with(footprint, &self.options(), None)
+    }
+
+    /// [`GlintNdf::patch_with`] with the model's [`options`](GlintNdf::options) and the buffers of
+    /// a caller's [`GlintScratch`].
     fn patch_in<'a>(
         &'a self,
         footprint: &Footprint,
         scratch: &'a mut GlintScratch,
     ) -> Self::Patch<'a> {
-        let _ = scratch;
-        self.patch(footprint)
+        self.patch_with(footprint, &self.options(), Some(scratch))
     }
 }

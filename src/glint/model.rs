@@ -1,143 +1,179 @@
-//! Any glint model behind one type: what a renderer's material list holds at run time.
+//! Any glint model behind one type: what a renderer's material list holds at run time, and the one
+//! registry of the crate's glint models.
 //!
 //! [`GlintNdf`] has a generic associated patch type, so it is not a trait object; a renderer that
 //! chooses the model per material at run time (from a scene file, say) holds a [`GlintModel`]
 //! instead, usually behind an `Arc` shared by the materials that use the same map. Its patch,
 //! [`GlintPatch`], is an [`Ndf`] like every model's patch, so the one-line glint BRDF stays
 //! `MicrofacetBrdf::new(model.patch(&footprint), fresnel)`.
+//!
+//! The `glint_models!` invocation at the end of this file is the registry: one line per model
+//! generates its [`GlintModel`] and [`GlintPatch`] variants, its [`GlintOptions`] field, the `From`
+//! conversion, and the save / load dispatch (which requires the model to implement the crate's file
+//! format).
 
-use super::{
-    BeckmannMixture, BinMap, BinMapPatch, Footprint, GlintNdf, GlintScratch, MixturePatch,
-    PositionNormalMap, PositionNormalPatch,
-};
+use super::io::format::{self, Kind, Stored};
+use super::{BeckmannMixture, BinMap, Footprint, GlintNdf, GlintScratch, PositionNormalMap};
+use crate::error::{Error, Result};
 use crate::ndf::Ndf;
 use glam::{Vec2, Vec3};
+use std::io::{Read, Write};
 
-/// One of the crate's glint models, chosen at run time.
-///
-/// # Example
-/// ```
-/// use std::sync::Arc;
-/// use brdf::bxdf::{Bxdf, MicrofacetBrdf};
-/// use brdf::fresnel::SchlickFresnel;
-/// use brdf::glint::{BinMap, BinMapParams, Footprint, GlintModel, GlintNdf, GlintScratch};
-/// use brdf::{Vec2, Vec3};
-///
-/// let map = brdf::glint::scratched(64, 64, Default::default(), 7)?;
-/// let materials: Vec<Arc<GlintModel>> =
-///     vec![Arc::new(BinMap::build(&map, BinMapParams::default())?.into())];
-/// let mut scratch = GlintScratch::default(); // one per render thread
-/// let fp = Footprint::isotropic_texels(Vec2::new(0.3, 0.7), 25.0, 64, 64);
-/// let brdf = MicrofacetBrdf::new(
-///     materials[0].patch_in(&fp, &mut scratch),
-///     SchlickFresnel::new(Vec3::splat(0.9))?,
-/// );
-/// let f = brdf.eval(Vec3::new(0.3, 0.0, 0.954), Vec3::new(-0.3, 0.0, 0.954));
-/// assert!(f.is_finite());
-/// # Ok::<(), brdf::Error>(())
-/// ```
-#[derive(Clone, Debug)]
-#[non_exhaustive]
-pub enum GlintModel {
-    /// The Beckmann mixture of \[Chermain2019\] (its patch options as built).
-    Mixture(BeckmannMixture),
-    /// The inverse bin map of \[Atanasov2020\], one bin's resolution.
-    BinMap(BinMap),
-    /// The inverse bin map with every bin's mass spread by a Beckmann lobe of roughness `alpha`
-    /// ([`BinMap::patch_smoothed`]).
-    SmoothedBinMap {
-        /// The bin map.
-        map: BinMap,
-        /// Beckmann roughness of the per-bin lobe.
-        alpha: f32,
-    },
-    /// The position-normal Gaussians of \[Yan2016\] (the baseline).
-    PositionNormal(PositionNormalMap),
-}
-
-impl From<BeckmannMixture> for GlintModel {
-    fn from(m: BeckmannMixture) -> Self {
-        GlintModel::Mixture(m)
-    }
-}
-
-impl From<BinMap> for GlintModel {
-    fn from(m: BinMap) -> Self {
-        GlintModel::BinMap(m)
-    }
-}
-
-impl From<PositionNormalMap> for GlintModel {
-    fn from(m: PositionNormalMap) -> Self {
-        GlintModel::PositionNormal(m)
-    }
-}
-
-impl GlintModel {
-    /// The model's name, for logs and charts.
-    pub fn name(&self) -> &'static str {
-        match self {
-            GlintModel::Mixture(_) => "Beckmann mixture",
-            GlintModel::BinMap(_) => "bin map",
-            GlintModel::SmoothedBinMap { .. } => "smoothed bin map",
-            GlintModel::PositionNormal(_) => "position-normal",
+/// Generates [`GlintModel`], [`GlintPatch`], [`GlintOptions`] and their impls from one line per
+/// model: `Variant(ModelType), options_field, "display name";`.
+macro_rules! glint_models {
+    ($( $(#[$doc:meta])* $variant:ident($model:ty), $field:ident, $name:literal; )+) => {
+        /// One of the crate's glint models, chosen at run time.
+        ///
+        /// # Example
+        /// ```
+        /// use std::sync::Arc;
+        /// use brdf::bxdf::{Bxdf, MicrofacetBrdf};
+        /// use brdf::fresnel::SchlickFresnel;
+        /// use brdf::glint::binmap::BinMapParams;
+        /// use brdf::glint::{BinMap, Footprint, GlintModel, GlintNdf, GlintScratch};
+        /// use brdf::{Vec2, Vec3};
+        ///
+        /// let map = brdf::glint::scratched(64, 64, Default::default(), 7)?;
+        /// let materials: Vec<Arc<GlintModel>> =
+        ///     vec![Arc::new(BinMap::build(&map, BinMapParams::default())?.into())];
+        /// let mut scratch = GlintScratch::default(); // one per render thread
+        /// let fp = Footprint::isotropic_texels(Vec2::new(0.3, 0.7), 25.0, 64, 64);
+        /// let brdf = MicrofacetBrdf::new(
+        ///     materials[0].patch_in(&fp, &mut scratch),
+        ///     SchlickFresnel::new(Vec3::splat(0.9))?,
+        /// );
+        /// let f = brdf.eval(Vec3::new(0.3, 0.0, 0.954), Vec3::new(-0.3, 0.0, 0.954));
+        /// assert!(f.is_finite());
+        /// # Ok::<(), brdf::Error>(())
+        /// ```
+        #[derive(Clone, Debug)]
+        #[non_exhaustive]
+        pub enum GlintModel {
+            $( $(#[$doc])* $variant($model), )+
         }
-    }
-}
 
-impl GlintNdf for GlintModel {
-    type Patch<'a> = GlintPatch<'a>;
-
-    fn patch(&self, footprint: &Footprint) -> GlintPatch<'_> {
-        match self {
-            GlintModel::Mixture(m) => GlintPatch::Mixture(m.patch(footprint)),
-            GlintModel::BinMap(m) => GlintPatch::BinMap(m.patch(footprint)),
-            GlintModel::SmoothedBinMap { map, alpha } => {
-                GlintPatch::BinMap(map.patch_smoothed(footprint, *alpha))
-            }
-            GlintModel::PositionNormal(m) => GlintPatch::PositionNormal(m.patch(footprint)),
+        /// The patch of a [`GlintModel`]: the P-NDF of one footprint, whichever model made it.
+        #[derive(Clone, Debug)]
+        #[non_exhaustive]
+        pub enum GlintPatch<'a> {
+            $(
+                #[doc = concat!("The patch of a [`GlintModel::", stringify!($variant), "`].")]
+                $variant(<$model as GlintNdf>::Patch<'a>),
+            )+
         }
-    }
 
-    fn patch_in<'a>(
-        &'a self,
-        footprint: &Footprint,
-        scratch: &'a mut GlintScratch,
-    ) -> GlintPatch<'a> {
-        match self {
-            GlintModel::Mixture(m) => GlintPatch::Mixture(m.patch_in(footprint, scratch)),
-            GlintModel::BinMap(m) => GlintPatch::BinMap(m.patch_in(footprint, scratch)),
-            GlintModel::SmoothedBinMap { map, alpha } => {
-                GlintPatch::BinMap(map.patch_smoothed_in(footprint, *alpha, scratch))
+        /// Per-query options of a [`GlintModel`]'s patches: one field per model, each that model's
+        /// own options type; a patch uses the field of its model. `Default` gives every model's
+        /// documented defaults; [`GlintNdf::options`] of a [`GlintModel`] gives its model's own
+        /// options in its field.
+        #[derive(Clone, Debug, Default)]
+        #[non_exhaustive]
+        pub struct GlintOptions {
+            $(
+                #[doc = concat!("Options of [`GlintModel::", stringify!($variant), "`] patches.")]
+                pub $field: <$model as GlintNdf>::Options,
+            )+
+        }
+
+        $(
+            impl From<$model> for GlintModel {
+                fn from(m: $model) -> Self {
+                    GlintModel::$variant(m)
+                }
             }
-            GlintModel::PositionNormal(m) => {
-                GlintPatch::PositionNormal(m.patch_in(footprint, scratch))
+        )+
+
+        impl GlintModel {
+            /// The names of the registered models, in registry order (for logs, charts and
+            /// completeness tests).
+            pub const NAMES: &'static [&'static str] = &[$($name),+];
+
+            /// The model's name, for logs and charts.
+            pub fn name(&self) -> &'static str {
+                match self {
+                    $( GlintModel::$variant(_) => $name, )+
+                }
+            }
+
+            /// Writes the model in the crate's file format (docs/format.md): the same bytes as the
+            /// model's own `save`.
+            ///
+            /// # Errors
+            /// [`Error::Stream`].
+            pub fn save(&self, w: &mut impl Write) -> Result<()> {
+                match self {
+                    $( GlintModel::$variant(m) => <$model as Stored>::save_to(m, w), )+
+                }
+            }
+
+            /// Reads whichever glint model a file holds (written by [`GlintModel::save`] or by a
+            /// model's own `save`), with every check of that model's `load`.
+            ///
+            /// # Errors
+            /// [`Error::WrongModelKind`] for a file of no glint model (a normal map, say), and every
+            /// error of the model's `load`.
+            pub fn load(r: &mut impl Read) -> Result<Self> {
+                let (head, code) = format::peek_kind(r)?;
+                let mut whole = (&head[..]).chain(r);
+                $(
+                    if <$model as Stored>::KINDS.iter().any(|&k| k as u32 == code) {
+                        return <$model as Stored>::load_from(&mut whole).map(GlintModel::$variant);
+                    }
+                )+
+                Err(Error::WrongModelKind {
+                    expected: "glint model".into(),
+                    found: Kind::name(code),
+                })
             }
         }
-    }
-}
 
-/// The patch of a [`GlintModel`]: the P-NDF of one footprint, whichever model made it.
-#[derive(Clone, Debug)]
-#[non_exhaustive]
-pub enum GlintPatch<'a> {
-    /// A [`MixturePatch`].
-    Mixture(MixturePatch<'a>),
-    /// A [`BinMapPatch`] (plain or smoothed).
-    BinMap(BinMapPatch<'a>),
-    /// A [`PositionNormalPatch`].
-    PositionNormal(PositionNormalPatch<'a>),
-}
+        impl GlintNdf for GlintModel {
+            type Patch<'a> = GlintPatch<'a>;
+            type Options = GlintOptions;
 
-/// Forwards one `Ndf` method to the variant's patch.
-macro_rules! forward {
-    ($self:ident, $p:ident => $e:expr) => {
-        match $self {
-            GlintPatch::Mixture($p) => $e,
-            GlintPatch::BinMap($p) => $e,
-            GlintPatch::PositionNormal($p) => $e,
+            fn options(&self) -> GlintOptions {
+                let mut options = GlintOptions::default();
+                match self {
+                    $( GlintModel::$variant(m) => options.$field = m.options(), )+
+                }
+                options
+            }
+
+            fn patch_with<'a>(
+                &'a self,
+                footprint: &Footprint,
+                options: &GlintOptions,
+                scratch: Option<&'a mut GlintScratch>,
+            ) -> GlintPatch<'a> {
+                match self {
+                    $(
+                        GlintModel::$variant(m) => {
+                            GlintPatch::$variant(m.patch_with(footprint, &options.$field, scratch))
+                        }
+                    )+
+                }
+            }
+        }
+
+        /// Forwards one `Ndf` method to the variant's patch.
+        macro_rules! forward {
+            ($self_:ident, $p:ident => $e:expr) => {
+                match $self_ {
+                    $( GlintPatch::$variant($p) => $e, )+
+                }
+            };
         }
     };
+}
+
+glint_models! {
+    /// The Beckmann mixture of \[Chermain2019\] ([`crate::glint::mixture`]).
+    Mixture(BeckmannMixture), mixture, "Beckmann mixture";
+    /// The inverse bin map of \[Atanasov2020\] ([`crate::glint::binmap`]).
+    BinMap(BinMap), bin_map, "bin map";
+    /// The position-normal Gaussians of \[Yan2016\], the baseline ([`crate::glint::position_normal`]).
+    PositionNormal(PositionNormalMap), position_normal, "position-normal";
 }
 
 impl Ndf for GlintPatch<'_> {

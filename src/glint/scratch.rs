@@ -7,6 +7,7 @@
 //! densities perform no heap allocation. One [`GlintScratch`] per thread serves every glint model (it
 //! is `Send`, so a renderer keeps one in each worker's thread-local state or arena).
 
+use std::any::Any;
 use std::sync::{Mutex, OnceLock};
 
 /// Reusable buffers for the patches of every glint model (see the module docs).
@@ -15,9 +16,13 @@ use std::sync::{Mutex, OnceLock};
 /// (about 12 + 32 bytes per lobe of the largest mixture footprint, 24 + 32 per element of the
 /// largest position-normal footprint). `Default` is empty and allocates nothing.
 ///
+/// Each model keeps its own buffer type in one slot, found by type (a short scan of at most one
+/// slot per model), so a model registers nothing here.
+///
 /// # Example
 /// ```
-/// use brdf::glint::{BeckmannMixture, Footprint, GlintNdf, GlintScratch, MixtureParams};
+/// use brdf::glint::mixture::MixtureParams;
+/// use brdf::glint::{BeckmannMixture, Footprint, GlintNdf, GlintScratch};
 /// use brdf::ndf::Ndf;
 /// use brdf::{Vec2, Vec3};
 ///
@@ -33,9 +38,25 @@ use std::sync::{Mutex, OnceLock};
 /// ```
 #[derive(Debug, Default)]
 pub struct GlintScratch {
-    pub(crate) mixture: crate::glint::mixture::MixtureScratch,
-    pub(crate) bin_map: crate::glint::binmap::BinMapScratch,
-    pub(crate) position_normal: crate::glint::position_normal::PositionNormalScratch,
+    slots: Vec<Box<dyn Any + Send>>,
+}
+
+impl GlintScratch {
+    /// The buffers of type `T` (created empty on first request): each model asks for its own type.
+    pub(crate) fn slot<T: Default + Send + 'static>(&mut self) -> &mut T {
+        let i = match self.slots.iter().position(|s| s.is::<T>()) {
+            Some(i) => i,
+            None => {
+                self.slots.push(Box::<T>::default());
+                self.slots.len() - 1
+            }
+        };
+        match self.slots[i].downcast_mut::<T>() {
+            Some(t) => t,
+            // Slot i holds a `T`: it was found or pushed as one just above.
+            None => unreachable!("scratch slot of the wrong type"),
+        }
+    }
 }
 
 /// Buffers `T` lent to one patch: taken from the caller's scratch (or fresh) at construction,

@@ -339,15 +339,15 @@ fn visible_area_zs(z: f32, s: f32) -> f32 {
 /// The x slope has density ∝ e^(−x²)(1 − x tan θ) on x < cot θ, whose CDF in b = erf(x) is
 /// F(b) ∝ 1 + b + tan θ e^(−x²)/√π. F is inverted by Halley's method in b (F'(b) ∝ 1 − x tan θ,
 /// F''(b) ∝ −tan θ (√π/2) e^(x²); cubic convergence), safeguarded by bisection on
-/// [−1, erf(cot θ)], from a first iterate interpolated in a table of exact roots ([`guess_q`]; the
-/// fitted guess b₀ = c − (1 + c)(1 − u)^(1 + θ(−0.876 + θ(0.4265 − 0.0594θ))) of Jakob 2014 before).
+/// [−1, erf(cot θ)], from a first iterate interpolated in a table of exact roots ([`guess_q`], in
+/// place of the fitted guess b₀ = c − (1 + c)(1 − u)^(1 + θ(−0.876 + θ(0.4265 − 0.0594θ))) of Jakob 2014).
 /// It stops when the CDF error is below 3·10⁻⁶ (after at most 12 steps), or when Halley's predicted
 /// error after a step is below a tenth of that ([`HALLEY_SAFETY`]): a displacement of at most
 /// 3·10⁻⁶ of the probability mass, below the f32 noise of the CDF's evaluation at grazing angles and
 /// far below what a 10⁶-sample chi-square test resolves. Over 120 θ × 1001 u
 /// (`tests::visible_slope_inversion_error`): 1.03 evaluations of erf⁻¹ and `exp` per sample, max
 /// |F − u| 3.1·10⁻⁶, mean 5.3·10⁻⁸ (Jakob's guess with the same iteration: 2.31, 3.1·10⁻⁶,
-/// 3.5·10⁻⁷; the Newton iteration with a 10⁻⁵ rule used before 2026-11: 2.78, 1.0·10⁻⁵). The y slope
+/// 3.5·10⁻⁷; Newton's iteration from Jakob's guess with a 10⁻⁵ rule: 2.78, 1.0·10⁻⁵). The y slope
 /// is Gaussian and independent: erf⁻¹(2u₂ − 1).
 ///
 /// # Reference
@@ -377,8 +377,7 @@ fn guess_q(theta: f32, u: f32) -> f32 {
 }
 
 /// The x slope of [`sample_visible_slope_std`] and the number of CDF evaluations it took; `HALLEY`
-/// false gives the Newton iteration from Jakob's guess used before 2026-11 (kept for the comparison
-/// in the tests). `safety` scales the unverified-step rule ([`HALLEY_SAFETY`]; 0 verifies every step).
+/// false gives Newton's iteration from Jakob's guess (the alternative the tests compare against). `safety` scales the unverified-step rule ([`HALLEY_SAFETY`]; 0 verifies every step).
 #[inline(always)]
 fn visible_slope_x<const HALLEY: bool>(
     cot_theta: f32,
@@ -760,9 +759,9 @@ mod tests {
         // Newton stopped at |F − u| ≤ 10⁻⁵ in the f32 evaluation of F; the f32 F itself is off by
         // a few 10⁻⁷ (erf, exp and the sum 1 + b + … rounded), and the returned slope is erf⁻¹ of
         // the last iterate (Giles' erfinv, relative 4·10⁻⁷, times the density ≤ 1.2 / total).
-        // Measured 1.008e-5 for Newton (the method used before 2026-11).
+        // Measured 1.008e-5 for Newton.
         assert!(worst[0].0 <= 1.2e-5, "{:?}", worst[0]);
-        // Halley's method (used since) must be at least as accurate, in the worst case and on average.
+        // Halley's method (the one used) must be at least as accurate, in the worst case and on average.
         assert!(
             worst[1].0 <= worst[0].0 * 1.000_001,
             "{:?} vs {:?}",

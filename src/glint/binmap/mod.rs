@@ -28,11 +28,10 @@ mod store;
 pub use forest::QueryStats;
 pub use lookup::BinLookup;
 pub use patch::BinMapPatch;
-pub(crate) use patch::BinMapScratch;
 
-use super::moments::MomentPyramid;
 use crate::error::{Error, Result};
 use crate::frame::{normal_to_slope, slope_to_normal};
+use crate::glint::surface::MomentPyramid;
 use crate::glint::{Footprint, GlintNdf, GlintScratch, HemisphereBins, NormalMap};
 use forest::{NO_TREE, TreeView};
 use glam::{Vec2, Vec3};
@@ -111,6 +110,32 @@ impl Default for BinMapParams {
             lookup: DEFAULT_LOOKUP,
             sigma_min: DEFAULT_MASKING_SIGMA_MIN,
             subdivisions: DEFAULT_SUBDIVISIONS,
+        }
+    }
+}
+
+/// Default [`PatchOptions::smoothing_alpha`]: 0, the one-bin angular resolution of
+/// \[Atanasov2020\].
+pub const DEFAULT_SMOOTHING_ALPHA: f32 = 0.0;
+
+/// Per-query options of a bin-map patch (the [`GlintNdf::Options`] of [`BinMap`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PatchOptions {
+    /// Beckmann roughness α of a lobe that spreads every bin's mass about the bin's centre
+    /// direction (slope σ = α/√2): D(h) = Σ_j mass_j D_j(h) (see [`BinMapPatch`]). 0 keeps the
+    /// one-bin resolution; a value that is not finite and > 0 means 0; α is raised to at least
+    /// [`crate::ndf::MIN_ALPHA`].
+    ///
+    /// # Reference
+    /// The smoothing follows the idea of the authors' later full paper (a Beckmann lobe per bin);
+    /// \[Atanasov2020\] itself has one-bin angular resolution.
+    pub smoothing_alpha: f32,
+}
+
+impl Default for PatchOptions {
+    fn default() -> Self {
+        PatchOptions {
+            smoothing_alpha: DEFAULT_SMOOTHING_ALPHA,
         }
     }
 }
@@ -424,8 +449,8 @@ fn check_params(params: &BinMapParams) -> Result<HemisphereBins> {
 /// Each point lies inside its own sub-texel, and the s² points of a texel fall in s² distinct
 /// strata of width 1/s² along x and along y (an n-rooks, "rotated grid" pattern; for s = 2 the
 /// points (⅜, ⅛), (⅞, ⅜), (⅛, ⅝), (⅝, ⅞)). The uniform grid of sub-texel centres has only s distinct
-/// coordinates per axis, so a map whose normals vary along one axis (brushed, scratched) was sampled
-/// s times per texel across it instead of s²: at s = 2, 255² bins, this pattern halves the TV distance
+/// coordinates per axis, so a map whose normals vary along one axis (brushed, scratched) would be
+/// sampled s times per texel across it instead of s²: at s = 2, 255² bins, this pattern halves the TV distance
 /// to the ground truth on the brushed map at 256 texels (0.123 → 0.063) for a 1.16× loss on the
 /// isotropic bumpy map (docs/results.md, "Memory, grazing cost and load"). s = 1: the texel centre.
 fn subtexel_point(i: usize, j: usize, s: usize) -> Vec2 {
@@ -618,48 +643,6 @@ impl BinMap {
         }
     }
 
-    /// The patch of a footprint, with the bin-resolution P-NDF ([`BinMapPatch`]). Allocates its
-    /// buffers; [`BinMap::patch_in`] reuses a caller's.
-    pub fn patch(&self, footprint: &Footprint) -> BinMapPatch<'_> {
-        BinMapPatch::new(self, footprint, None, None)
-    }
-
-    /// [`BinMap::patch`] with the patch's buffers borrowed from `scratch`: after one warm-up call of
-    /// a size at least as large, neither this call nor any [`Ndf`](crate::ndf::Ndf) method of the
-    /// patch allocates (tests/alloc.rs). The patch is the same as [`BinMap::patch`]'s.
-    pub fn patch_in<'a>(
-        &'a self,
-        footprint: &Footprint,
-        scratch: &'a mut GlintScratch,
-    ) -> BinMapPatch<'a> {
-        BinMapPatch::new(self, footprint, None, Some(&mut scratch.bin_map))
-    }
-
-    /// The patch of a footprint whose every bin's mass is spread by a Beckmann lobe of roughness
-    /// `alpha` (slope σ = α/√2) centred on the bin's centre direction:
-    /// D(h) = Σ_j mass_j D_j(h) (see [`BinMapPatch`]). A non-finite or non-positive `alpha` gives
-    /// the unsmoothed patch; α is raised to at least [`crate::ndf::MIN_ALPHA`].
-    ///
-    /// # Reference
-    /// The smoothing follows the idea of the authors' later full paper (a Beckmann lobe per bin);
-    /// \[Atanasov2020\] itself has one-bin angular resolution.
-    pub fn patch_smoothed(&self, footprint: &Footprint, alpha: f32) -> BinMapPatch<'_> {
-        let alpha = (alpha.is_finite() && alpha > 0.0).then(|| alpha.max(crate::ndf::MIN_ALPHA));
-        BinMapPatch::new(self, footprint, alpha, None)
-    }
-
-    /// [`BinMap::patch_smoothed`] with the buffers borrowed from `scratch` (see
-    /// [`BinMap::patch_in`]).
-    pub fn patch_smoothed_in<'a>(
-        &'a self,
-        footprint: &Footprint,
-        alpha: f32,
-        scratch: &'a mut GlintScratch,
-    ) -> BinMapPatch<'a> {
-        let alpha = (alpha.is_finite() && alpha > 0.0).then(|| alpha.max(crate::ndf::MIN_ALPHA));
-        BinMapPatch::new(self, footprint, alpha, Some(&mut scratch.bin_map))
-    }
-
     fn tree_view(&self) -> TreeView<'_> {
         TreeView {
             inverse: &self.inverse,
@@ -673,19 +656,19 @@ impl BinMap {
 
 impl GlintNdf for BinMap {
     type Patch<'a> = BinMapPatch<'a>;
+    type Options = PatchOptions;
 
-    /// [`BinMap::patch`].
-    fn patch(&self, footprint: &Footprint) -> BinMapPatch<'_> {
-        BinMap::patch(self, footprint)
-    }
-
-    /// [`BinMap::patch_in`].
-    fn patch_in<'a>(
+    /// The patch of a footprint ([`BinMapPatch`]): the bin-resolution P-NDF, or with
+    /// [`PatchOptions::smoothing_alpha`] > 0 every bin's mass spread by a Beckmann lobe.
+    fn patch_with<'a>(
         &'a self,
         footprint: &Footprint,
-        scratch: &'a mut GlintScratch,
+        options: &PatchOptions,
+        scratch: Option<&'a mut GlintScratch>,
     ) -> BinMapPatch<'a> {
-        BinMap::patch_in(self, footprint, scratch)
+        let alpha = options.smoothing_alpha;
+        let alpha = (alpha.is_finite() && alpha > 0.0).then(|| alpha.max(crate::ndf::MIN_ALPHA));
+        BinMapPatch::new(self, footprint, alpha, scratch.map(|s| s.slot()))
     }
 }
 

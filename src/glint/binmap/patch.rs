@@ -132,8 +132,7 @@ pub struct BinMapPatch<'a> {
     sigma: Option<f64>,
 }
 
-/// The bin map's share of [`GlintScratch`](crate::glint::GlintScratch), for [`BinMap::patch_in`] and
-/// [`BinMap::patch_smoothed_in`]: the footprint's periodic images and, for footprints with exact
+/// The bin map's slot of a [`GlintScratch`](crate::glint::GlintScratch): the footprint's periodic images and, for footprints with exact
 /// masking terms, its bins (or smoothing lobes). The buffers grow to the largest footprint seen and
 /// are then reused, so patches allocate nothing. A patch borrows the scratch for its lifetime.
 #[derive(Default, Debug)]
@@ -144,7 +143,7 @@ pub(crate) struct BinMapScratch {
     lobes: Vec<(f32, SlopeGaussian)>,
 }
 
-/// A buffer owned by the patch ([`BinMap::patch`]) or borrowed from a `BinMapScratch`.
+/// A buffer owned by the patch or borrowed from a `BinMapScratch`.
 #[derive(Debug)]
 enum Buf<'a, T> {
     Owned(Vec<T>),
@@ -592,7 +591,7 @@ fn cos_weighted_area(x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
     if area <= 0.0 {
         return 0.0;
     }
-    let mean = crate::glint::bins::mean_max_square(
+    let mean = crate::glint::truth::mean_max_square(
         2.0 * x0 - 1.0,
         2.0 * x1 - 1.0,
         2.0 * y0 - 1.0,

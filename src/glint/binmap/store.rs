@@ -18,7 +18,7 @@
 //!   builder's partition);
 //! - 𝓑 and 𝓑⁻¹ describe the same assignment: the multiset of pairs (k, b) over the lists of 𝓑⁻¹
 //!   equals the multiset of pairs (k, 𝓑(k)) over the sub-texels, compared by a randomised
-//!   fingerprint ([`crate::glint::multiset`]). The right side holds every sub-texel once, so equal
+//!   fingerprint ([`crate::glint::io::multiset`]). The right side holds every sub-texel once, so equal
 //!   multisets make 𝓑⁻¹ a permutation of the sub-texels that lists each one in the bin 𝓑 gives it.
 //!   A file whose 𝓑 and 𝓑⁻¹ disagree passes with probability at most n / (2⁶¹ − 1) for n
 //!   sub-texels (below 2⁻³⁷ at 2048², s = 2) over the loader's random draw; a disagreement found is
@@ -37,9 +37,9 @@ use super::lookup::Table;
 use super::{BinIndex, BinLookup, BinMap, BinMapParams, MASKING_FIRST_LEVEL, check_params};
 use crate::Result;
 use crate::glint::MAX_SLOPE;
-use crate::glint::moments::{MomentLevel, MomentPyramid};
-use crate::glint::multiset;
-use crate::glint::store::{self, Decoder, Kind, invalid};
+use crate::glint::io::format::{self, Decoder, Kind, Stored, invalid};
+use crate::glint::io::multiset;
+use crate::glint::surface::{MomentLevel, MomentPyramid};
 use rayon::prelude::*;
 use std::io::{Read, Write};
 
@@ -67,7 +67,7 @@ impl BinMap {
             offsets.push(offsets[offsets.len() - 1] + len);
         }
         let (first, levels) = self.moments.parts();
-        store::save(w, Kind::BinMap, |e| {
+        format::save(w, Kind::BinMap, |e| {
             e.len(self.width)?;
             e.len(self.height)?;
             e.len(p.bins_per_axis)?;
@@ -126,7 +126,7 @@ impl BinMap {
         };
         let refused = |e: crate::Error| invalid(format!("stored bin map refused: {e}"));
         let bins = check_params(&params).map_err(refused)?;
-        crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))
+        crate::glint::surface::texel_count(width, height, width.saturating_mul(height))
             .map_err(refused)?;
         let s = params.subdivisions;
         let (grid_w, grid_h) = (width * s, height * s);
@@ -192,7 +192,7 @@ impl BinMap {
         let (inverse, (bin_map, levels, assigned)) = read?;
         let m = 2.0 * MAX_SLOPE;
         for l in &levels {
-            store::check_range(&l.data, "moments", |c| match c {
+            format::check_range(&l.data, "moments", |c| match c {
                 0 | 1 => (-m, m),
                 2 | 3 => (0.0, m * m),
                 _ => (-m * m, m * m),
@@ -219,6 +219,16 @@ impl BinMap {
             facets,
             moments: MomentPyramid::from_parts(first, levels),
         })
+    }
+}
+
+impl Stored for BinMap {
+    const KINDS: &'static [Kind] = &[Kind::BinMap];
+    fn save_to(&self, mut w: &mut dyn Write) -> Result<()> {
+        self.save(&mut w)
+    }
+    fn load_from(mut r: &mut dyn Read) -> Result<Self> {
+        Self::load(&mut r)
     }
 }
 

@@ -14,7 +14,7 @@
 //! error that vectorises (std's `exp` is a library call per lane); V_P's ramp term G(−t) is
 //! [`ramp_neg_lanes`], one fitted exponent and one such exponential (no `erfc` call).
 
-use crate::glint::slope_tree::{SlopeTree, contains};
+use crate::glint::kernels::slope_tree::{SlopeTree, contains};
 use crate::ndf::SlopeGaussian;
 use glam::{Vec2, Vec3};
 

@@ -36,7 +36,7 @@
 use super::blocks::{J_SCALE, LANES, LobeBlock, SIDE};
 use super::hierarchy::lobe_box;
 use super::levels::{LevelRef, LobeLevel};
-use crate::glint::slope_tree::{SlopeTree, level_sizes};
+use crate::glint::kernels::slope_tree::{SlopeTree, level_sizes};
 use crate::ndf::SlopeGaussian;
 use glam::Vec2;
 use half::f16;

@@ -8,7 +8,7 @@
 //! lobes' own boxes) is not stored: queries descend to level 2, whose nodes are the lobe blocks
 //! (blocks.rs), and test each lane's box there; [`lobe_box`] gives the boxes the tree is built from.
 
-use crate::glint::slope_tree::level_sizes;
+use crate::glint::kernels::slope_tree::level_sizes;
 use crate::ndf::SlopeGaussian;
 
 /// The slope box of one lobe: mean ± k (√Σxx, √Σyy), the axis-aligned box of the ellipse

@@ -47,7 +47,7 @@
 
 use super::blocks::LobeBlocks;
 use super::hierarchy::lobe_box;
-use crate::glint::slope_tree::SlopeTree;
+use crate::glint::kernels::slope_tree::SlopeTree;
 use crate::ndf::SlopeGaussian;
 
 use super::LOD_RESOLUTIONS;

@@ -27,10 +27,9 @@ mod store;
 
 pub use build_filter::DEFAULT_SUPERSAMPLING;
 pub use patch::MixturePatch;
-pub(crate) use patch::MixtureScratch;
 
 use crate::error::{Error, Result, positive};
-use crate::glint::slope_tree::SlopeTree;
+use crate::glint::kernels::slope_tree::SlopeTree;
 use crate::glint::{Footprint, GlintNdf, NormalMap};
 use crate::ndf::SlopeGaussian;
 use blocks::LobeBlocks;
@@ -521,7 +520,7 @@ impl BeckmannMixture {
         errors: Option<Vec<[Vec<f32>; levels::N_RES]>>,
     ) -> Result<Self> {
         params.validate()?;
-        crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))?;
+        crate::glint::surface::texel_count(width, height, width.saturating_mul(height))?;
         let (grid, spacing) = lobe_grid(width, height, &params)?;
         if lobes.len() != grid[0] * grid[1] {
             return Err(Error::InvalidSize {
@@ -774,27 +773,25 @@ impl BeckmannMixture {
         }
         self.level_ref(l).error_at(k, 0)
     }
-
-    /// The patch of a footprint with explicit options (masking mode, level of detail).
-    pub fn patch_with(&self, footprint: &Footprint, options: PatchOptions) -> MixturePatch<'_> {
-        MixturePatch::new(self, footprint, options)
-    }
 }
 
 impl GlintNdf for BeckmannMixture {
     type Patch<'a> = MixturePatch<'a>;
+    type Options = PatchOptions;
 
-    /// The P-NDF of a footprint with the options of [`MixtureParams::patch`].
-    fn patch(&self, footprint: &Footprint) -> MixturePatch<'_> {
-        MixturePatch::new(self, footprint, self.params.patch)
+    /// The options the mixture was built with, [`MixtureParams::patch`].
+    fn options(&self) -> PatchOptions {
+        self.params.patch
     }
 
-    /// [`GlintNdf::patch`] with the per-slot buffers lent by `scratch`.
-    fn patch_in<'a>(
+    /// The P-NDF of a footprint ([`MixturePatch`]) with explicit options (masking mode, level of
+    /// detail), its per-slot buffers lent by `scratch` if any.
+    fn patch_with<'a>(
         &'a self,
         footprint: &Footprint,
-        scratch: &'a mut crate::glint::GlintScratch,
+        options: &PatchOptions,
+        scratch: Option<&'a mut crate::glint::GlintScratch>,
     ) -> MixturePatch<'a> {
-        MixturePatch::new_in(self, footprint, self.params.patch, Some(scratch))
+        MixturePatch::new_in(self, footprint, *options, scratch)
     }
 }

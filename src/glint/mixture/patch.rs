@@ -17,9 +17,9 @@ use super::{BeckmannMixture, MaskingMode, PatchOptions, build::kernel_sigma};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
-use crate::glint::cdf::{invert_cdf, pick_streaming};
+use crate::glint::kernels::cdf::{invert_cdf, pick_streaming};
+use crate::glint::kernels::slope_tree::contains;
 use crate::glint::scratch::{Lent, Loan};
-use crate::glint::slope_tree::contains;
 use crate::math::{finite_f32, finite_or_zero};
 use crate::ndf::{DEFAULT_SIGMA_MIN, Ndf, SIGMA_MIN_FLOOR, SlopeGaussian};
 use glam::{Vec2, Vec3};
@@ -431,7 +431,10 @@ impl<'a> MixturePatch<'a> {
         scratch: Option<&'a mut GlintScratch>,
     ) -> MixturePatch<'a> {
         let (slots, lobes) = match scratch {
-            Some(s) => (Some(&mut s.mixture.slots), Some(&mut s.mixture.lobes)),
+            Some(s) => {
+                let m = s.slot::<MixtureScratch>();
+                (Some(&mut m.slots), Some(&mut m.lobes))
+            }
             None => (None, None),
         };
         let fp = FootprintLobes::new(mixture, footprint);

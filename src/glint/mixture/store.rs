@@ -18,8 +18,8 @@ use super::levels::{N_RES, level_grids};
 use super::{BeckmannMixture, LobeStorage, MaskingMode, MixtureParams, PatchOptions};
 use crate::Result;
 use crate::glint::MAX_SLOPE;
-use crate::glint::slope_tree::{SlopeTree, level_sizes, parent_row};
-use crate::glint::store::{self, Decoder, Kind};
+use crate::glint::io::format::{self, Decoder, Kind, Stored};
+use crate::glint::kernels::slope_tree::{SlopeTree, level_sizes, parent_row};
 use crate::ndf::SlopeGaussian;
 use rayon::prelude::*;
 use std::io::{Read, Write};
@@ -109,7 +109,7 @@ impl BeckmannMixture {
             LobeStorage::Full => Kind::BeckmannMixture,
             LobeStorage::Compact => Kind::BeckmannMixtureCompact,
         };
-        store::save(w, kind, |e| {
+        format::save(w, kind, |e| {
             e.len(self.width)?;
             e.len(self.height)?;
             e.put(p.spacing)?;
@@ -187,7 +187,7 @@ impl BeckmannMixture {
             0 => MaskingMode::Exact,
             1 => MaskingMode::Approximate,
             m => {
-                return Err(store::invalid(format!(
+                return Err(format::invalid(format!(
                     "masking mode {m} (0 or 1 expected)"
                 )));
             }
@@ -212,9 +212,9 @@ impl BeckmannMixture {
             },
             ..MixtureParams::default()
         };
-        let refused = |e: crate::Error| store::invalid(format!("stored mixture refused: {e}"));
+        let refused = |e: crate::Error| format::invalid(format!("stored mixture refused: {e}"));
         params.validate().map_err(refused)?;
-        crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))
+        crate::glint::surface::texel_count(width, height, width.saturating_mul(height))
             .map_err(refused)?;
         let ([nx, ny], _) = super::lobe_grid(width, height, &params).map_err(refused)?;
         if params.storage == LobeStorage::Compact {
@@ -232,7 +232,7 @@ impl BeckmannMixture {
             let grids = level_grids(nx, ny);
             let n = d.len("levels", usize::MAX)?;
             if n != grids.len() {
-                return Err(store::invalid(format!(
+                return Err(format::invalid(format!(
                     "levels = {n} but the lobe grid {nx}×{ny} has {} levels of detail above the lobes",
                     grids.len()
                 )));
@@ -251,6 +251,16 @@ impl BeckmannMixture {
     }
 }
 
+impl Stored for BeckmannMixture {
+    const KINDS: &'static [Kind] = &[Kind::BeckmannMixture, Kind::BeckmannMixtureCompact];
+    fn save_to(&self, mut w: &mut dyn Write) -> Result<()> {
+        self.save(&mut w)
+    }
+    fn load_from(mut r: &mut dyn Read) -> Result<Self> {
+        Self::load(&mut r)
+    }
+}
+
 /// The rest of a compact mixture's file (after the parameters): the levels' frames, blocks and
 /// merge-error codes (docs/format.md, kind 5), then the checksum, then the values.
 fn load_compact(
@@ -266,7 +276,7 @@ fn load_compact(
     grids.extend(level_grids(grid[0], grid[1]));
     let n = d.len("levels", usize::MAX)?;
     if n != grids.len() {
-        return Err(store::invalid(format!(
+        return Err(format::invalid(format!(
             "levels = {n} but the lobe grid {}×{} has {} levels of detail",
             grid[0],
             grid[1],
@@ -292,7 +302,7 @@ fn load_compact(
     let mut levels = Vec::with_capacity(parts.len());
     for ((frames, blocks, errors), &[w, h]) in parts.into_iter().zip(&grids) {
         if let Some(f) = frames.iter().find(|f| !(f[0] <= f[2] && f[1] <= f[3])) {
-            return Err(store::invalid(format!("frames: box {f:?} has lo > hi")));
+            return Err(format::invalid(format!("frames: box {f:?} has lo > hi")));
         }
         let level = compact::assemble(
             w,
@@ -302,7 +312,7 @@ fn load_compact(
             errors.into_iter().map(|e| e[0]).collect(),
         );
         level.check(box_k, MAX_SLOPE).map_err(|e| {
-            store::invalid(format!("level {} of {}: {e}", levels.len(), grids.len()))
+            format::invalid(format!("level {} of {}: {e}", levels.len(), grids.len()))
         })?;
         levels.push(level);
     }
@@ -315,8 +325,8 @@ fn load_compact(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::glint::kernels::slope_tree::reference_levels;
     use crate::glint::mixture::hierarchy::LobePyramid;
-    use crate::glint::slope_tree::reference_levels;
 
     /// Moments of every kind a file can hold: ordinary lobes, means of ±0 (the box unions take
     /// min/max of ±0, whose result depends on the order), degenerate and clamped covariances.

@@ -22,13 +22,15 @@ mod store;
 
 pub use brdf::{DEFAULT_MASKING_ALPHA, PositionNormalBrdf};
 pub use patch::{EXACT_MASKING_ELEMENTS, PositionNormalPatch};
-/// The position-normal part of [`crate::glint::GlintScratch`].
-pub(crate) type PositionNormalScratch = patch::Slots;
 
 use crate::error::{Error, Result, positive};
-use crate::glint::slope_tree::SlopeTree;
-use crate::glint::{Footprint, GlintNdf, GlintScratch, MAX_TRUNCATION_SIGMAS, NormalMap};
+use crate::glint::kernels::slope_tree::SlopeTree;
+use crate::glint::{Footprint, GlintNdf, GlintScratch, NormalMap};
 use glam::{Mat2, Vec2};
+
+/// Largest accepted truncation of the position weights, in standard deviations
+/// ([`PositionNormalParams::weight_sigmas`]): 10, which keeps the enumerated region bounded.
+pub const MAX_WEIGHT_SIGMAS: f32 = 10.0;
 
 /// σ_h / h = 1/√(8 ln 2) (see [`PositionNormalMap::SIGMA_H_PER_SPACING`]).
 pub(crate) const SIGMA_H_PER_SPACING: f64 = 0.424_660_900_144_009_5;
@@ -41,7 +43,7 @@ pub struct PositionNormalParams {
     pub sampling_rate: usize,
     /// Intrinsic roughness σ_r: slope standard deviation of each element (in [10⁻⁴, 1]).
     pub sigma_r: f32,
-    /// Truncation of the position weights, in σ (in [2, [`MAX_TRUNCATION_SIGMAS`]]).
+    /// Truncation of the position weights, in σ (in [2, [`MAX_WEIGHT_SIGMAS`]]).
     pub weight_sigmas: f32,
     /// Truncation of the element slope densities, in σ per axis (> 0).
     pub slope_sigmas: f32,
@@ -104,13 +106,13 @@ impl PositionNormalParams {
                          densities leave the f32 range)",
             });
         }
-        if !(self.weight_sigmas >= 2.0 && self.weight_sigmas <= MAX_TRUNCATION_SIGMAS) {
+        if !(self.weight_sigmas >= 2.0 && self.weight_sigmas <= MAX_WEIGHT_SIGMAS) {
             return Err(Error::InvalidParameter {
                 name: "weight_sigmas",
                 value: self.weight_sigmas as f64,
                 reason: "must be in [2, 10]: >= 2 so that the element nearest to any footprint \
                          centre, at Mahalanobis distance <= 1.67, is always kept; <= 10 \
-                         (MAX_TRUNCATION_SIGMAS) so that the enumerated region stays bounded",
+                         (MAX_WEIGHT_SIGMAS) so that the enumerated region stays bounded",
             });
         }
         positive("slope_sigmas", self.slope_sigmas)?;
@@ -122,6 +124,27 @@ impl PositionNormalParams {
             });
         }
         Ok(())
+    }
+}
+
+/// Per-query options of a position-normal patch (the [`GlintNdf::Options`] of
+/// [`PositionNormalMap`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PatchOptions {
+    /// The level of detail: the footprint is shrunk about its centre until `weight_sigmas` ·
+    /// σ_footprint ≤ this many texels (`f32::INFINITY` keeps the exact footprint whatever its size;
+    /// values not > 0, NaN included, shrink the footprint to its centre). `Default` gives
+    /// [`PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS`]; [`GlintNdf::patch`] uses the map's
+    /// [`PositionNormalParams::max_query_texels`]. docs/position_normal.md gives the cost against
+    /// accuracy.
+    pub max_query_texels: f32,
+}
+
+impl Default for PatchOptions {
+    fn default() -> Self {
+        PatchOptions {
+            max_query_texels: PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS,
+        }
     }
 }
 
@@ -211,7 +234,7 @@ impl PositionNormalMap {
         elements: Vec<[f32; 6]>,
     ) -> Result<Self> {
         params.validate()?;
-        crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))?;
+        crate::glint::surface::texel_count(width, height, width.saturating_mul(height))?;
         let grid = element_grid(width, height, &params)?;
         if elements.len() != grid[0] * grid[1] {
             return Err(Error::InvalidSize {
@@ -293,18 +316,6 @@ impl PositionNormalMap {
     }
 
     /// Bytes held by the elements and the hierarchy.
-    /// The patch of a footprint with an explicit level of detail: the query cap `max_query_texels`
-    /// (texels, `weight_sigmas` · σ_footprint ≤ cap) in place of the map's
-    /// [`PositionNormalParams::max_query_texels`]; `f32::INFINITY` keeps the exact footprint. See
-    /// [`PositionNormalPatch::with_cap`] and docs/position_normal.md for the cost against accuracy.
-    pub fn patch_with_cap(
-        &self,
-        footprint: &Footprint,
-        max_query_texels: f32,
-    ) -> PositionNormalPatch<'_> {
-        PositionNormalPatch::with_cap(self, footprint, max_query_texels, None)
-    }
-
     pub fn memory(&self) -> PositionNormalMemory {
         PositionNormalMemory {
             elements: self.elements.len(),
@@ -316,18 +327,23 @@ impl PositionNormalMap {
 
 impl GlintNdf for PositionNormalMap {
     type Patch<'a> = PositionNormalPatch<'a>;
+    type Options = PatchOptions;
 
-    /// The position-normal P-NDF of a footprint ([`PositionNormalPatch::new`]).
-    fn patch(&self, footprint: &Footprint) -> PositionNormalPatch<'_> {
-        PositionNormalPatch::new(self, footprint)
+    /// The map's own query cap, [`PositionNormalParams::max_query_texels`].
+    fn options(&self) -> PatchOptions {
+        PatchOptions {
+            max_query_texels: self.params.max_query_texels,
+        }
     }
 
-    /// [`GlintNdf::patch`] with the per-element buffers lent by `scratch`.
-    fn patch_in<'a>(
+    /// The position-normal P-NDF of a footprint ([`PositionNormalPatch`]) under the query cap of
+    /// `options`.
+    fn patch_with<'a>(
         &'a self,
         footprint: &Footprint,
-        scratch: &'a mut GlintScratch,
+        options: &PatchOptions,
+        scratch: Option<&'a mut GlintScratch>,
     ) -> PositionNormalPatch<'a> {
-        PositionNormalPatch::new_in(self, footprint, Some(scratch))
+        PositionNormalPatch::new(self, footprint, options.max_query_texels, scratch)
     }
 }

@@ -12,9 +12,9 @@ use super::{PositionNormalMap, SIGMA_H_PER_SPACING};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
-use crate::glint::cdf::{invert_cdf, pick_streaming};
+use crate::glint::kernels::cdf::{invert_cdf, pick_streaming};
+use crate::glint::kernels::slope_tree::contains;
 use crate::glint::scratch::Loan;
-use crate::glint::slope_tree::contains;
 use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
@@ -252,17 +252,11 @@ pub struct PositionNormalPatch<'a> {
 pub const EXACT_MASKING_ELEMENTS: usize = 4096;
 
 impl<'a> PositionNormalPatch<'a> {
-    /// The P-NDF of `footprint` (see the type's docs). Total: any footprint works; cost
-    /// O(elements within `weight_sigmas` of the footprint).
-    pub fn new(map: &'a PositionNormalMap, footprint: &Footprint) -> PositionNormalPatch<'a> {
-        Self::new_in(map, footprint, None)
-    }
-
-    /// [`PositionNormalPatch::new`] with an explicit level of detail: the query cap `max_query_texels`
-    /// in place of the map's [`PositionNormalParams::max_query_texels`](super::PositionNormalParams)
-    /// (`f32::INFINITY`: the exact footprint whatever its size; values not > 0, NaN included, shrink the
-    /// footprint to its centre). No allocation (the samplers' buffers are built on first use).
-    pub fn with_cap(
+    /// The P-NDF of `footprint` (see the type's docs) under the query cap `max_query_texels`
+    /// ([`PatchOptions::max_query_texels`](super::PatchOptions)), with its per-element buffers lent
+    /// by `scratch` if any. Total: any footprint works; cost O(elements within `weight_sigmas` of
+    /// the capped footprint). No allocation (the samplers' buffers are built on first use).
+    pub(super) fn new(
         map: &'a PositionNormalMap,
         footprint: &Footprint,
         max_query_texels: f32,
@@ -273,16 +267,6 @@ impl<'a> PositionNormalPatch<'a> {
             Geometry::new(map, footprint, max_query_texels),
             scratch,
         )
-    }
-
-    /// [`PositionNormalPatch::new`] with its per-element buffers lent by `scratch` (given back when
-    /// the patch drops): no heap allocation once the scratch has grown to the footprint's size.
-    pub fn new_in(
-        map: &'a PositionNormalMap,
-        footprint: &Footprint,
-        scratch: Option<&'a mut GlintScratch>,
-    ) -> PositionNormalPatch<'a> {
-        Self::with_cap(map, footprint, map.params.max_query_texels, scratch)
     }
 
     fn build(
@@ -316,7 +300,7 @@ impl<'a> PositionNormalPatch<'a> {
             mean_slope: Vec2::new(moments[0], moments[1]),
             moments,
             moments_lobe,
-            slots: Loan::new(scratch.map(|s| &mut s.position_normal)),
+            slots: Loan::new(scratch.map(|s| s.slot())),
         }
     }
 

@@ -7,7 +7,7 @@
 use super::{PositionNormalMap, PositionNormalParams};
 use crate::Result;
 use crate::glint::MAX_SLOPE;
-use crate::glint::store::{self, Decoder, Kind};
+use crate::glint::io::format::{self, Decoder, Kind, Stored};
 use std::io::{Read, Write};
 
 impl PositionNormalMap {
@@ -18,7 +18,7 @@ impl PositionNormalMap {
     /// [`crate::Error::Stream`] if the writer fails.
     pub fn save(&self, w: &mut impl Write) -> Result<()> {
         let p = &self.params;
-        store::save(w, Kind::PositionNormalMap, |e| {
+        format::save(w, Kind::PositionNormalMap, |e| {
             e.len(self.width)?;
             e.len(self.height)?;
             e.len(p.sampling_rate)?;
@@ -52,9 +52,9 @@ impl PositionNormalMap {
             slope_sigmas: d.get("slope_sigmas")?,
             max_query_texels: d.get("max_query_texels")?,
         };
-        let refused = |e: crate::Error| store::invalid(format!("stored map refused: {e}"));
+        let refused = |e: crate::Error| format::invalid(format!("stored map refused: {e}"));
         params.validate().map_err(refused)?;
-        crate::glint::normal_map::texel_count(width, height, width.saturating_mul(height))
+        crate::glint::surface::texel_count(width, height, width.saturating_mul(height))
             .map_err(refused)?;
         let [nx, ny] = super::element_grid(width, height, &params).map_err(refused)?;
         // Built elements: interpolated slopes (≤ MAX_SLOPE up to rounding) and central differences of
@@ -71,5 +71,15 @@ impl PositionNormalMap {
             )?;
         d.finish()?;
         PositionNormalMap::from_parts(width, height, params, elements).map_err(refused)
+    }
+}
+
+impl Stored for PositionNormalMap {
+    const KINDS: &'static [Kind] = &[Kind::PositionNormalMap];
+    fn save_to(&self, mut w: &mut dyn Write) -> Result<()> {
+        self.save(&mut w)
+    }
+    fn load_from(mut r: &mut dyn Read) -> Result<Self> {
+        Self::load(&mut r)
     }
 }

@@ -6,9 +6,9 @@
 //! # Reference
 //! \[Chermain2019\] §3 (slope representation, interpolated normals); \[Dupuy2013\] (slope moments, mipmaps).
 
-use super::moments::MomentPyramid;
-use super::store::{self, Kind};
 use crate::frame::{normal_to_slope, slope_to_normal};
+use crate::glint::io::format::{self, Kind};
+use crate::glint::surface::MomentPyramid;
 use crate::{Error, Result};
 use glam::{Vec2, Vec3};
 use std::sync::OnceLock;
@@ -462,7 +462,7 @@ impl NormalMap {
     /// # Errors
     /// [`Error::Stream`] if the writer fails.
     pub fn save(&self, w: &mut impl std::io::Write) -> Result<()> {
-        store::save(w, Kind::NormalMap, |e| {
+        format::save(w, Kind::NormalMap, |e| {
             e.len(self.width)?;
             e.len(self.height)?;
             e.array(self.slopes.iter().map(|s| s.to_array()))
@@ -478,17 +478,17 @@ impl NormalMap {
     /// for a size that is zero, too large or does not match the slope count, and for slopes that
     /// [`NormalMap::from_slopes`] refuses (non-finite or above [`MAX_SLOPE`]).
     pub fn load_binary(r: &mut impl std::io::Read) -> Result<NormalMap> {
-        let mut d = store::Decoder::open(r, Kind::NormalMap)?;
+        let mut d = format::Decoder::open(r, Kind::NormalMap)?;
         let width = d.len("width", i32::MAX as usize)?;
         let height = d.len("height", i32::MAX as usize)?;
         let n = width.checked_mul(height).ok_or_else(|| {
-            store::invalid(format!("width × height = {width} × {height} overflows"))
+            format::invalid(format!("width × height = {width} × {height} overflows"))
         })?;
         let slopes = d.array::<f32, 2>("slopes", n)?;
         d.finish()?;
         let slopes = slopes.into_iter().map(Vec2::from_array).collect();
         NormalMap::from_slopes(width, height, slopes)
-            .map_err(|e| store::invalid(format!("stored normal map refused: {e}")))
+            .map_err(|e| format::invalid(format!("stored normal map refused: {e}")))
     }
 }
 

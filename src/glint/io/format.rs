@@ -37,7 +37,8 @@ const HEADER_BYTES: usize = 24;
 /// much per read), so a lying length costs at most one chunk beyond the bytes actually present.
 const CHUNK_BYTES: usize = 1 << 16;
 
-/// The model stored in a file.
+/// The model stored in a file: the format's registry of kind codes (one line per stored type; the
+/// codes are part of the format, docs/format.md).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Kind {
     /// [`crate::glint::NormalMap`].
@@ -48,12 +49,13 @@ pub(crate) enum Kind {
     PositionNormalMap = 3,
     /// [`crate::glint::BinMap`].
     BinMap = 4,
-    /// [`crate::glint::BeckmannMixture`] in compact storage ([`crate::glint::LobeStorage::Compact`]).
+    /// [`crate::glint::BeckmannMixture`] in compact storage
+    /// ([`crate::glint::mixture::LobeStorage::Compact`]).
     BeckmannMixtureCompact = 5,
 }
 
 impl Kind {
-    fn name(code: u32) -> String {
+    pub(crate) fn name(code: u32) -> String {
         match code {
             1 => "NormalMap".into(),
             2 => "BeckmannMixture".into(),
@@ -63,6 +65,31 @@ impl Kind {
             c => format!("unknown kind {c}"),
         }
     }
+}
+
+/// A type kept in the crate's file format, implemented by each stored model in its own module: the
+/// run-time [`GlintModel`](crate::glint::GlintModel) saves and loads through it.
+pub(crate) trait Stored: Sized {
+    /// The kinds the loader reads (a file of another kind is not this type's).
+    const KINDS: &'static [Kind];
+    /// Writes the whole file (the type's `save`).
+    fn save_to(&self, w: &mut dyn Write) -> Result<()>;
+    /// Reads a whole file (the type's `load`).
+    fn load_from(r: &mut dyn Read) -> Result<Self>;
+}
+
+/// Bytes of the header up to and including the kind code.
+pub(crate) const KIND_END: usize = 16;
+
+/// Reads the first [`KIND_END`] bytes of a file and returns them with the kind code they hold (the
+/// magic and version are checked later, by the loader the bytes are handed back to).
+///
+/// # Errors
+/// [`Error::Truncated`], [`Error::Stream`].
+pub(crate) fn peek_kind(r: &mut dyn Read) -> Result<([u8; KIND_END], u32)> {
+    let mut head = [0u8; KIND_END];
+    read_exact(r, &mut head, "the header")?;
+    Ok((head, u32::get(&head[12..])))
 }
 
 /// The file checksum: four interleaved 64-bit multiply-rotate lanes over little-endian 64-bit words.

@@ -32,7 +32,9 @@
 //! # Reference
 //! \[Chermain2019\] eq. 2 (the lobe), eq. 8 (P-NDF), §5.2.2 (σ_ε = 0.01).
 
-use super::{BinnedPndf, Kernel, REFERENCE_BATCHES, kernel_position, merge_histograms, summarise};
+use super::binned::{
+    BinnedPndf, Kernel, REFERENCE_BATCHES, kernel_position, merge_histograms, summarise,
+};
 use crate::error::{Error, Result};
 use crate::glint::{Footprint, HemisphereBins, NormalMap};
 use crate::ndf::Ndf;
@@ -271,10 +273,10 @@ impl BinnedPndf {
     /// Total variation ½ Σ_b |M(b) − mass(b)| between a model's bin masses (e.g. from
     /// [`adaptive_bin_masses`] on the same bins) and this reference; `None` if the lengths differ.
     pub fn tv_to_masses(&self, masses: &[f64]) -> Option<f64> {
-        (masses.len() == self.mass.len()).then(|| {
+        (masses.len() == self.mass().len()).then(|| {
             0.5 * masses
                 .iter()
-                .zip(&self.mass)
+                .zip(self.mass())
                 .map(|(a, b)| (a - b).abs())
                 .sum::<f64>()
         })

@@ -9,7 +9,7 @@
 //! Self-describing text formats (JSON) store the bytes as an array of numbers: correct, but ~4× the
 //! binary size; use a binary serde format or the files themselves for large maps.
 
-use super::{BeckmannMixture, BinMap, NormalMap, PositionNormalMap};
+use crate::glint::{BeckmannMixture, BinMap, GlintModel, NormalMap, PositionNormalMap};
 use serde::de::{Deserializer, Error as _, SeqAccess, Visitor};
 use serde::ser::{Error as _, Serializer};
 use serde::{Deserialize, Serialize};
@@ -66,3 +66,4 @@ serde_via_file!(NormalMap, NormalMap::load_binary);
 serde_via_file!(BeckmannMixture, BeckmannMixture::load);
 serde_via_file!(PositionNormalMap, PositionNormalMap::load);
 serde_via_file!(BinMap, BinMap::load);
+serde_via_file!(GlintModel, GlintModel::load);

@@ -318,8 +318,7 @@ pub(crate) fn reference_levels(nx: usize, ny: usize, leaf: Vec<[f32; 4]>) -> Vec
 mod tests {
     use super::*;
 
-    /// The walk as it was before it started below the root: from the root, every level's box
-    /// tested. The reference of `walk_matches_the_walk_from_the_root`.
+    /// The plain walk: from the root, every level's box tested. The reference of `walk_matches_the_walk_from_the_root`.
     fn for_each_node_from_root(
         tree: &SlopeTree,
         stop: usize,

@@ -1,0 +1,11 @@
+//! Storage of built maps (crate-private, but the format is public: docs/format.md).
+//!
+//! - format.rs: the checksummed binary file format, its header, [`Kind`](format::Kind) codes,
+//!   encoder and bounded decoder, shared by every stored type's `save` / `load`.
+//! - multiset.rs: a randomised multiset fingerprint (the bin map's load check of 𝓑 against 𝓑⁻¹).
+//! - serde.rs: `Serialize` / `Deserialize` through the file bytes (feature `serde`).
+
+pub(crate) mod format;
+pub(crate) mod multiset;
+#[cfg(feature = "serde")]
+mod serde;

@@ -1,0 +1,31 @@
+//! What every glint model is built from and queried with: the normal map (its slopes, its
+//! bilinearly interpolated surface and the mip chain of its slope moments), the procedural maps, the
+//! image decoder, and the ray footprint.
+//!
+//! - normal_map.rs: [`NormalMap`], the tiled grid of per-texel slopes and the interpolated surface.
+//! - moments.rs: the mip chain of slope moments behind [`NormalMap::moments`] and friends.
+//! - procedural.rs: the seeded generators [`scratched`], [`brushed`], [`bumpy`], [`flakes`].
+//! - image_io.rs: decoding PNG / EXR normal maps (feature `image`).
+//! - footprint.rs: [`Footprint`], a ray footprint as a parallelogram and a Gaussian.
+
+mod footprint;
+#[cfg(feature = "image")]
+mod image_io;
+mod moments;
+mod normal_map;
+mod procedural;
+
+pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
+#[cfg(feature = "image")]
+pub use image_io::{
+    DEFAULT_LENGTH_TOLERANCE, FloatEncoding, ImageDecoding, ImageOptions, MAX_IMPLAUSIBLE_FRACTION,
+    RAW_EVIDENCE_BELOW,
+};
+pub(crate) use moments::{MomentLevel, MomentPyramid};
+pub(crate) use normal_map::texel_count;
+pub use normal_map::{
+    MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
+};
+pub use procedural::{
+    BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
+};

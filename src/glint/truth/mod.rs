@@ -1,0 +1,25 @@
+//! The ground truths every glint model is judged by, and the bins they are tabulated on.
+//!
+//! - [`HemisphereBins`] (bins.rs): an equal-area binning of the hemisphere.
+//! - The Dirac truth (binned.rs): [`binned_pndf`], the P-NDF of the interpolated normal map through a
+//!   footprint, binned, and [`tv_distance`] of a model to it.
+//! - The σ_ε-convolved truth (convolved.rs): [`convolved_pndf`], the same P-NDF widened by the
+//!   material's micro-roughness lobe, and the adaptive per-bin quadrature of a model's D
+//!   ([`adaptive_bin_masses`]) that both truths are compared with.
+//! - The footprint BRDF references (footprint_brdf.rs): [`FootprintBrdf`] / [`footprint_brdf`], the
+//!   exact P-BRDF of the interpolated map (reference (a)) and normal-mapped shading averaged over the
+//!   footprint (reference (b)), and [`naive_brdf`] at one position.
+
+mod binned;
+mod bins;
+mod convolved;
+mod footprint_brdf;
+
+pub use binned::{BinnedPndf, Kernel, REFERENCE_BATCHES, binned_pndf, tv_distance};
+pub use bins::HemisphereBins;
+pub(crate) use bins::mean_max_square;
+pub use convolved::{
+    BinMasses, DEFAULT_MAX_QUADRATURE, DEFAULT_QUADRATURE_TOLERANCE, JITTERS, adaptive_bin_masses,
+    bin_masses, convolved_pndf,
+};
+pub use footprint_brdf::{FootprintBrdf, footprint_brdf, naive_brdf};
