@@ -9,12 +9,12 @@
 //!   (the inverse bin map 𝓑⁻¹), builds one kd-tree per list longer than the leaf size L, packed into
 //!   one `u32` array, and a lookup bin → list ([`BinLookup`]: dense offsets or a hash table of the
 //!   non-empty bins).
-//! - [`BinMap::patch`] turns a [`Footprint`] into a [`BinMapPatch`], an [`Ndf`](crate::ndf::Ndf) whose
+//! - [`GlintNdf::patch_with`] turns a [`Footprint`] into a [`BinMapPatch`], an [`Ndf`](crate::ndf::Ndf) whose
 //!   D(h) = mass_j / (|H| · c̄_j) for the bin j ∋ h, where mass_j = Σ_k I_{H_j}(t_k) |A ∩ T_k| / |A| is
 //!   found through the bin's tree (whole nodes inside A count at once, boundary texels get their exact
-//!   clipped area) and c̄_j is the bin's mean cosine. [`BinMap::patch_smoothed`] spreads every bin's
-//!   mass with a Beckmann lobe. [`BinMap::patch_in`] builds the same patch in a caller's reusable
-//!   [`GlintScratch`](crate::glint::GlintScratch) (no allocation per shading point).
+//!   clipped area) and c̄_j is the bin's mean cosine. With
+//!   [`PatchOptions::smoothing_alpha`] > 0 it spreads every bin's mass with a Beckmann lobe; with a
+//!   caller's reusable [`GlintScratch`] it allocates nothing per shading point.
 //!
 //! The conventions (mean cosine, periodic images, masking lobe, samplers) and the measurements are in
 //! docs/binmap.md.

@@ -68,7 +68,7 @@ const SMOOTH_TAIL: f64 = 1e-6;
 /// s = 1) and t_k their normals; |A ∩ T_k| sums over the periodic images of T_k (the map tiles), so
 /// footprints crossing the border or larger than the map are exact.
 ///
-/// **Smoothed variant** ([`BinMap::patch_smoothed`]): D(h) = Σ_j mass_j D_j(h) with D_j the
+/// **Smoothed variant** ([`PatchOptions::smoothing_alpha`](super::PatchOptions) > 0): D(h) = Σ_j mass_j D_j(h) with D_j the
 /// Beckmann lobe of slope σ = α/√2 centred on the slope of bin j's centre (D_j = P22_j / cos⁴θ,
 /// ∫ D_j cos = 1), over the bins whose centre slope lies within 5.26 σ of h's slope (≤ 10⁻⁶ of each
 /// lobe left out). Cost per evaluation: O(lobes of the footprint) for footprints with exact masking
@@ -1154,6 +1154,7 @@ impl SmoothingKernel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::glint::GlintNdf;
     use rand::{RngExt, SeedableRng};
 
     /// The smoothed D over the footprint's listed lobes against the window of bins with forest
@@ -1165,7 +1166,13 @@ mod tests {
         let bm = BinMap::build(&map, super::super::BinMapParams::default()).unwrap();
         for (area, alpha) in [(16.0f32, 0.05f32), (64.0, 0.1), (1024.0, 0.02)] {
             let fp = Footprint::isotropic_texels(Vec2::new(0.3, 0.7), area, 64, 64);
-            let patch = bm.patch_smoothed(&fp, alpha);
+            let patch = bm.patch_with(
+                &fp,
+                &super::super::PatchOptions {
+                    smoothing_alpha: alpha,
+                },
+                None,
+            );
             let e = patch.exact.as_ref().unwrap();
             assert!(e.bins.as_slice().is_empty() && !e.lobes.as_slice().is_empty());
             let sigma = patch.sigma.unwrap();

@@ -1,7 +1,7 @@
 //! The patch of a footprint: the closed-form position-normal P-NDF of \[Yan2016\] §5, evaluated
 //! through the slope-box quadtree, exact (or moment-bounded) masking terms, and exact samplers.
 //!
-//! Per-footprint work (done once in [`PositionNormalPatch::new`]): the footprint in element units
+//! Per-footprint work (done once when the patch is built): the footprint in element units
 //! (clamped to the query cap), the effective position Gaussian Σ_eff = Σ_P + σ_h² I, the conditional
 //! position covariance Σ_u = (Σ_P⁻¹ + σ_h⁻² I)⁻¹ = σ_h² I − σ_h⁴ Σ_eff⁻¹, the rectangle of elements
 //! that can be within `weight_sigmas` of the footprint, their total weight and the P-NDF's first and
@@ -248,7 +248,7 @@ pub struct PositionNormalPatch<'a> {
 
 /// Largest patch (number of elements kept) whose masking terms use the exact V(w) = Σ W_i V_i(w);
 /// larger patches use Scarf's moment bound (O(1) per direction instead of O(elements)). 4096, the
-/// bin map's [`EXACT_MASKING_TEXELS`](crate::glint::EXACT_MASKING_TEXELS) at one element per texel.
+/// bin map's [`EXACT_MASKING_TEXELS`](crate::glint::binmap::EXACT_MASKING_TEXELS) at one element per texel.
 pub const EXACT_MASKING_ELEMENTS: usize = 4096;
 
 impl<'a> PositionNormalPatch<'a> {

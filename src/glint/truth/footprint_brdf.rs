@@ -190,7 +190,7 @@ impl FootprintBrdf {
 }
 
 /// Both references of [`FootprintBrdf`] for `footprint` on `map`, from `samples` positions drawn
-/// from `kernel` (an m × m jittered stratification of the unit square mapped as [`binned_pndf`]
+/// from `kernel` (an m × m jittered stratification of the unit square mapped as [`binned_pndf`](super::binned_pndf)
 /// maps it, m = max(1, ⌊√samples⌋); the slope at each position is [`NormalMap::slope_at_texel`]).
 ///
 /// Deterministic for a given `seed`; sequential (call it per pixel from parallel code). Cost:
