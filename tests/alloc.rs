@@ -6,10 +6,8 @@ mod support;
 
 use brdf::bxdf::{Bxdf, MicrofacetBrdf};
 use brdf::fresnel::SchlickFresnel;
-use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintModel, GlintNdf, GlintScratch,
-    MaskingMode, MixtureParams, PatchOptions, PositionNormalMap, PositionNormalParams,
-};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{Footprint, GlintModel, GlintNdf, GlintOptions, GlintScratch, PositionNormalMap};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -49,9 +47,15 @@ fn allocations() -> usize {
 }
 
 /// One shading point as a renderer does it: patch, BRDF, a few samples, evaluations and pdfs.
-fn shade(model: &GlintModel, scratch: &mut GlintScratch, fp: &Footprint, k: usize) -> f32 {
+fn shade(
+    model: &GlintModel,
+    options: &GlintOptions,
+    scratch: &mut GlintScratch,
+    fp: &Footprint,
+    k: usize,
+) -> f32 {
     let fresnel = SchlickFresnel::new(Vec3::splat(0.9)).unwrap();
-    let brdf = MicrofacetBrdf::new(model.patch_in(fp, scratch), fresnel);
+    let brdf = MicrofacetBrdf::new(model.patch_with(fp, options, Some(scratch)), fresnel);
     let wo = support::dir(10.0 + 7.0 * (k % 11) as f64, 37.0 * k as f64);
     let mut acc = 0.0;
     for j in 0..4 {
@@ -75,30 +79,8 @@ fn shade(model: &GlintModel, scratch: &mut GlintScratch, fp: &Footprint, k: usiz
 #[test]
 fn shading_allocates_nothing_after_warm_up() {
     let map = brdf::glint::flakes(64, 64, Default::default(), 3).unwrap();
-    let mixture = |masking| {
-        let params = MixtureParams {
-            samples: 16,
-            patch: PatchOptions {
-                masking,
-                ..PatchOptions::default()
-            },
-            ..MixtureParams::default()
-        };
-        BeckmannMixture::build(&map, params).unwrap()
-    };
-    let bin_map = BinMap::build(&map, BinMapParams::default()).unwrap();
-    let models: Vec<GlintModel> = vec![
-        mixture(MaskingMode::Exact).into(),
-        mixture(MaskingMode::Approximate).into(),
-        bin_map.clone().into(),
-        GlintModel::SmoothedBinMap {
-            map: bin_map,
-            alpha: 0.05,
-        },
-        PositionNormalMap::build(&map, PositionNormalParams::default())
-            .unwrap()
-            .into(),
-    ];
+    // Every registered model, each storage, masking mode and smoothing (tests/support/registry.rs).
+    let examples = support::registry::examples(&map);
     let footprints: Vec<Footprint> = [0.3f32, 4.0, 50.0, 700.0, 3000.0]
         .iter()
         .enumerate()
@@ -107,22 +89,19 @@ fn shading_allocates_nothing_after_warm_up() {
             Footprint::isotropic_texels(c, a, 64, 64)
         })
         .collect();
-    for model in &models {
+    for ex in &examples {
+        let (model, options) = (&ex.model, &ex.options);
         let mut scratch = GlintScratch::default();
         // Warm-up: the largest footprint first grows every buffer to its size.
-        let mut sink = shade(model, &mut scratch, &footprints[4], 0);
+        let mut sink = shade(model, options, &mut scratch, &footprints[4], 0);
         let before = allocations();
         for k in 0..40 {
-            sink += shade(model, &mut scratch, &footprints[k % footprints.len()], k);
+            let fp = &footprints[k % footprints.len()];
+            sink += shade(model, options, &mut scratch, fp, k);
         }
         let n = allocations() - before;
         assert!(sink.is_finite());
-        assert_eq!(
-            n,
-            0,
-            "{}: {n} allocations in 40 shading points",
-            model.name()
-        );
+        assert_eq!(n, 0, "{}: {n} allocations in 40 shading points", ex.label);
     }
 }
 

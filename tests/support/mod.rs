@@ -6,6 +6,7 @@
 pub mod chi2;
 pub mod format;
 pub mod quadrature;
+pub mod registry;
 pub mod totality;
 
 use rand::SeedableRng;
