@@ -10,7 +10,9 @@
 //! Run: `cargo bench --bench binmap -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 //! (a group: append its name, e.g. `binmap_d_2048`).
 
-use brdf::glint::{BinLookup, BinMap, BinMapParams, Footprint, GlintScratch, bumpy};
+use brdf::glint::GlintNdf;
+use brdf::glint::binmap::{BinLookup, BinMapParams};
+use brdf::glint::{BinMap, Footprint, GlintScratch, bumpy};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
@@ -137,7 +139,13 @@ fn smoothed(c: &mut Criterion) {
     g.throughput(Throughput::Elements(1024));
     let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), 256.0, SIZE, SIZE);
     for alpha in [0.01f32, 0.02, 0.05, 0.1] {
-        let patch = bm.patch_smoothed(&fp, alpha);
+        let patch = bm.patch_with(
+            &fp,
+            &brdf::glint::binmap::PatchOptions {
+                smoothing_alpha: alpha,
+            },
+            None,
+        );
         let hs: Vec<Vec3> = (0..1024).map(|k| patch.sample_normal(r2(k))).collect();
         g.bench_with_input(BenchmarkId::from_parameter(alpha), &hs, |b, hs| {
             b.iter(|| hs.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
@@ -150,7 +158,13 @@ fn smoothed(c: &mut Criterion) {
     g.throughput(Throughput::Elements(1024));
     for area in [64.0f32, 1024.0, 4096.0, 16384.0] {
         let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, SIZE, SIZE);
-        let patch = bm.patch_smoothed(&fp, 0.1);
+        let patch = bm.patch_with(
+            &fp,
+            &brdf::glint::binmap::PatchOptions {
+                smoothing_alpha: 0.1,
+            },
+            None,
+        );
         let hs: Vec<Vec3> = (0..1024).map(|k| patch.sample_normal(r2(k))).collect();
         g.bench_with_input(BenchmarkId::from_parameter(area), &hs, |b, hs| {
             b.iter(|| hs.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())

@@ -6,7 +6,8 @@
 //!
 //! Run: `cargo bench --bench position_normal -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 
-use brdf::glint::{Footprint, GlintNdf, PositionNormalMap, PositionNormalParams, bumpy};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{Footprint, GlintNdf, PositionNormalMap, bumpy};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};

@@ -3,7 +3,9 @@
 #![no_main]
 
 use arbitrary::Arbitrary;
-use brdf::glint::{BinLookup, BinMap, BinMapParams};
+use brdf::glint::BinMap;
+use brdf::glint::GlintNdf;
+use brdf::glint::binmap::{BinLookup, BinMapParams};
 use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
 use brdf_fuzz::{FootprintInput, MapInput, Probe, check_bxdf, check_ndf};
 use libfuzzer_sys::fuzz_target;
@@ -43,7 +45,13 @@ fuzz_target!(|input: Input| {
     let patch = bin_map.patch(&footprint);
     check_ndf(&patch, &input.probe);
     check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), &input.probe);
-    let smoothed = bin_map.patch_smoothed(&footprint, input.smoothing_alpha);
+    let smoothed = bin_map.patch_with(
+        &footprint,
+        &brdf::glint::binmap::PatchOptions {
+            smoothing_alpha: input.smoothing_alpha,
+        },
+        None,
+    );
     check_ndf(&smoothed, &input.probe);
     check_bxdf(&MicrofacetBrdf::new(&smoothed, NoFresnel), &input.probe);
 });

@@ -3,9 +3,8 @@
 #![no_main]
 
 use arbitrary::Arbitrary;
-use brdf::glint::{
-    BeckmannMixture, GlintNdf, LobeStorage, MaskingMode, MixtureParams, PatchOptions,
-};
+use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::{BeckmannMixture, GlintNdf};
 use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
 use brdf_fuzz::{FootprintInput, MapInput, Probe, check_bxdf, check_ndf};
 use libfuzzer_sys::fuzz_target;

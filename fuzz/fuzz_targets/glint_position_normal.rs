@@ -3,7 +3,8 @@
 #![no_main]
 
 use arbitrary::Arbitrary;
-use brdf::glint::{GlintNdf, PositionNormalBrdf, PositionNormalMap, PositionNormalParams};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{GlintNdf, PositionNormalBrdf, PositionNormalMap};
 use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
 use brdf_fuzz::{FootprintInput, MapInput, Probe, check_bxdf, check_ndf};
 use libfuzzer_sys::fuzz_target;

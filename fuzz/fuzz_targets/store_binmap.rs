@@ -4,6 +4,7 @@
 #![no_main]
 
 use brdf::glint::BinMap;
+use brdf::glint::GlintNdf;
 use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
 use brdf_fuzz::{StoreInput, check_bxdf, check_ndf, check_resave};
 use libfuzzer_sys::fuzz_target;
@@ -20,7 +21,16 @@ fuzz_target!(|data: &[u8]| {
             |f| BinMap::load(&mut &f[..]),
         );
         let footprint = input.footprint.build();
-        for patch in [map.patch(&footprint), map.patch_smoothed(&footprint, 0.1)] {
+        for patch in [
+            map.patch(&footprint),
+            map.patch_with(
+                &footprint,
+                &brdf::glint::binmap::PatchOptions {
+                    smoothing_alpha: 0.1,
+                },
+                None,
+            ),
+        ] {
             check_ndf(&patch, &input.probe);
             check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), &input.probe);
         }
