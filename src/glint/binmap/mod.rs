@@ -40,7 +40,7 @@ use rayon::prelude::*;
 
 /// Default bins per axis n: 255 (B = n² = 65 025 bins of 9.7·10⁻⁵ sr, about 0.56° across; 𝓑 still
 /// fits `u16`). Chosen with [`DEFAULT_SUBDIVISIONS`] from accuracy against memory on the procedural
-/// maps (docs/results.md, "The bin map, finished"): against the talk's car-paint setting 127² it
+/// maps (docs/results.md, "Inverse bin map (Atanasov 2020)"): against the talk's car-paint setting 127² it
 /// lowers the TV distance to the ground truth at ≥ 256 texels on brushed, scratched and flakes
 /// (1.3-2.3×) and raises it 1.2× on the smooth bumpy map, for 0.5 B/texel more at 2048² (the
 /// per-bin tables: 3.4 MB per map whatever its size). 127 remains the talk's setting.
@@ -56,7 +56,7 @@ pub const DEFAULT_MASKING_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
 /// Default sub-texel resolution s: each texel is binned as s × s sub-texels of the interpolated
 /// surface (normals at n-rooks points, see [`BinMap::build`]). 2 was chosen with
 /// [`DEFAULT_BINS_PER_AXIS`] from accuracy against memory on the procedural maps (docs/results.md,
-/// "The bin map, finished" and "Memory, grazing cost and load"): with 255² bins, at ≥ 256 texels,
+/// "Inverse bin map (Atanasov 2020)" and "Memory per model"): with 255² bins, at ≥ 256 texels,
 /// the TV distance to the ground truth is 2.1-4.2× below the talk's map (s = 1, 127²) on bumpy,
 /// brushed and scratched for 2.8× its memory (29.2 B/texel at 2048²); s = 3 costs 62.9 B/texel,
 /// over the 42 B/texel budget whatever the integer widths (docs/binmap.md).
@@ -452,7 +452,7 @@ fn check_params(params: &BinMapParams) -> Result<HemisphereBins> {
 /// coordinates per axis, so a map whose normals vary along one axis (brushed, scratched) would be
 /// sampled s times per texel across it instead of s²: at s = 2, 255² bins, this pattern halves the TV distance
 /// to the ground truth on the brushed map at 256 texels (0.123 → 0.063) for a 1.16× loss on the
-/// isotropic bumpy map (docs/results.md, "Memory, grazing cost and load"). s = 1: the texel centre.
+/// isotropic bumpy map (docs/results.md, "Inverse bin map (Atanasov 2020)"). s = 1: the texel centre.
 fn subtexel_point(i: usize, j: usize, s: usize) -> Vec2 {
     let (a, b) = (i % s, j % s);
     let sf = s as f32;
