@@ -169,9 +169,9 @@ fn brewster_angle_is_half_the_s_reflectance() {
     }
 }
 
-/// Regression (issue 18): an index-matched interface (η = 1) has no interface to reflect from,
-/// F = 0 at every angle, grazing incidence (±0) and cosines whose square underflows included;
-/// `dielectric(0.0, 1.0)` used to return 1.
+/// An index-matched interface (η = 1) has no interface to reflect from: F = 0 at every angle,
+/// grazing incidence (±0) and cosines whose square underflows included (`dielectric(0.0, 1.0)` once
+/// returned 1).
 #[test]
 fn index_matched_dielectric_reflects_nothing() {
     let mut cosines = vec![
@@ -390,7 +390,7 @@ fn dielectric_matches_the_complex_reference() {
             let got = dielectric(c, eta) as f64;
             if c == 0.0 {
                 // Grazing: the reference is 0/0 for η = 1, where the crate gives the limit of the
-                // index-matched interface, 0 (issue 18); every other η gives the limit 1.
+                // index-matched interface, 0; every other η gives the limit 1.
                 assert_eq!(got, if eta == 1.0 { 0.0 } else { 1.0 }, "η {eta}");
                 continue;
             }

@@ -148,8 +148,8 @@ fn glint_over_base_conserves_energy_and_agrees_with_itself() {
 /// Why not the anisotropic coat at 89°: at φo = 30° its reflected lobe is a sliver 2-3 cells wide in
 /// φ at the horizon, and the harness's 6 × 6 Gauss-Legendre rule per cell mis-integrates it — the bare
 /// `MicrofacetBrdf` (no layering) fails there the same way (χ² = 3977 for 3085 dof; Beckmann 4:1
-/// worse), while the NDF-level grid of tests/ndf_centred.rs, which warps the lobe onto the cells,
-/// passes. Recorded as a harness limit in the closing note of issue #13.
+/// worse), while the NDF-level grid of tests/ndf_centred_sampling.rs, which warps the lobe onto the cells,
+/// passes: a limit of the harness, not of the sampler.
 #[test]
 fn chi_square_of_the_layered_sampler() {
     let schlick = SchlickFresnel::new(Vec3::splat(0.04)).unwrap();

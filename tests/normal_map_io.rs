@@ -16,9 +16,7 @@ const W: usize = 8;
 const H: usize = 5;
 
 fn tmp_dir() -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("normal_map_io");
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    support::tmp_dir("normal_map_io")
 }
 
 /// Unit normals with |slope| components up to `r` (random tilts in every azimuth).
@@ -117,7 +115,7 @@ fn raw_exr_needs_the_raw_option_and_the_default_refuses_it() {
 
 #[test]
 fn encoded_exr_read_as_raw_is_refused() {
-    // The case: colours in [0, 1] taken as vectors give normals tilted toward (+x, +y), slopes
+    // Colours in [0, 1] taken as vectors give normals tilted toward (+x, +y), slopes
     // around (−0.5, −0.5); the lengths (≈ 1.22 for flat texels) give it away.
     let n = normals(W * H, 0.3, 3);
     let path = write_exr("encoded_as_raw.exr", &n, colour);

@@ -199,7 +199,7 @@ fn weight_and_eval_estimators_agree() {
     }
 }
 
-/// The full grid of the issue, printed as markdown rows for docs/results.md: per map, model and
+/// The full grid of maps, models and footprints, printed as markdown rows for docs/results.md: per map, model and
 /// footprint, the largest renderer's furnace over views 0 … 89.9° (weight estimator, height-correlated
 /// G2), beside the value the previous contract (`eval` = the patch-measure f_P, integrated with the
 /// geometric cosine) gives with today's masking terms, from the same samples: weight · cos θi / A(wi)

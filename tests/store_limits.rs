@@ -31,7 +31,7 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static A: Counting = Counting;
 
-/// The documented checksum (docs/format.md), shared with tests/store.rs.
+/// The documented checksum (docs/format.md), shared with tests/store_*.rs.
 #[path = "support/format.rs"]
 mod format;
 use format::reseal;

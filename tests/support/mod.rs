@@ -3,10 +3,17 @@
 //! Each integration test file includes this with `mod support;`; not every file uses every helper.
 #![allow(dead_code)]
 
+pub mod binmap;
+pub mod bxdf;
 pub mod chi2;
 pub mod format;
+pub mod ndf_centred;
+pub mod position_normal;
 pub mod quadrature;
 pub mod registry;
+pub mod robustness;
+pub mod slope_gaussian;
+pub mod store;
 pub mod totality;
 
 use rand::SeedableRng;
@@ -25,6 +32,23 @@ pub fn dir(theta_deg: f64, phi_deg: f64) -> glam::Vec3 {
         (t.sin() * p.sin()) as f32,
         t.cos() as f32,
     )
+}
+
+/// A map of white-noise slopes: per texel, x then y uniform in [−r, r] from `rng(seed)`.
+pub fn noise_map(width: usize, height: usize, r: f32, seed: u64) -> brdf::glint::NormalMap {
+    use rand::RngExt;
+    let mut rng = rng(seed);
+    let slopes = (0..width * height)
+        .map(|_| glam::Vec2::new(rng.random_range(-r..r), rng.random_range(-r..r)))
+        .collect();
+    brdf::glint::NormalMap::from_slopes(width, height, slopes).unwrap()
+}
+
+/// A temporary directory `name` under target/ for files a test writes.
+pub fn tmp_dir(name: &str) -> std::path::PathBuf {
+    let d = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    std::fs::create_dir_all(&d).unwrap();
+    d
 }
 
 /// The proptest configuration of every property suite: `cases` cases from a fixed seed, so that

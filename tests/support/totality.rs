@@ -1,4 +1,4 @@
-//! Totality checks shared by the robustness property tests (tests/robustness.rs) and the fuzz
+//! Totality checks shared by the robustness property tests (tests/robustness_*.rs) and the fuzz
 //! targets (fuzz/, which includes this file by path): what every evaluator of the crate promises on any
 //! input, valid or not. Each check panics with the offending value.
 //!

@@ -1,0 +1,81 @@
+//! Shared helpers of the store tests (tests/store_*.rs): small maps and saved files of every kind,
+//! query directions, and the offsets of the fields in a mixture file (docs/format.md).
+
+use super::format::reseal;
+use brdf::Vec3;
+use brdf::glint::{BeckmannMixture, LobeStorage, MixtureParams, NormalMap};
+
+/// White-noise slopes in [−0.6, 0.6]² (seed `n`): every lobe and element different.
+pub fn map(n: usize) -> NormalMap {
+    super::noise_map(n, n, 0.6, n as u64)
+}
+
+/// Directions for the queries: normal incidence, moderate, grazing, below the horizon.
+pub fn dirs() -> Vec<Vec3> {
+    let mut v = Vec::new();
+    for th in [0.0, 30.0, 60.0, 85.0, 89.9] {
+        for ph in [0.0, 75.0, 200.0] {
+            v.push(super::dir(th, ph));
+        }
+    }
+    v.push(Vec3::new(0.3, 0.1, -0.9).normalize());
+    v
+}
+
+/// The bytes `save` writes.
+pub fn saved(save: impl FnOnce(&mut Vec<u8>) -> brdf::Result<()>) -> Vec<u8> {
+    let mut v = Vec::new();
+    save(&mut v).unwrap();
+    v
+}
+
+/// A full mixture of the 6² map (8 QMC samples per lobe), saved.
+pub fn small_mixture_file() -> Vec<u8> {
+    let params = MixtureParams {
+        samples: 8,
+        ..MixtureParams::default()
+    };
+    let built = BeckmannMixture::build(&map(6), params).unwrap();
+    saved(|w| built.save(w))
+}
+
+/// A compact mixture of the 6² map, saved.
+pub fn small_compact_file() -> Vec<u8> {
+    let params = MixtureParams {
+        storage: LobeStorage::Compact,
+        ..MixtureParams::default()
+    };
+    let built = BeckmannMixture::build(&map(6), params).unwrap();
+    saved(|w| built.save(w))
+}
+
+/// Loads a mixture from bytes.
+pub fn load_mixture(bytes: &[u8]) -> brdf::Result<BeckmannMixture> {
+    BeckmannMixture::load(&mut &bytes[..])
+}
+
+/// A full mixture's version-3 file as version 2 wrote it: the payload cut after the lobes (no merge
+/// errors), the header's version and payload length set, re-sealed.
+pub fn as_version_2(file: &[u8]) -> Vec<u8> {
+    let lobes = u64::from_le_bytes(file[at::LOBE_COUNT..at::LOBES].try_into().unwrap()) as usize;
+    let end = at::LOBES + 20 * lobes;
+    let mut f = file[..end].to_vec();
+    f.extend_from_slice(&[0u8; 8]);
+    f[8..12].copy_from_slice(&2u32.to_le_bytes());
+    f[16..24].copy_from_slice(&((end - 24) as u64).to_le_bytes());
+    reseal(f)
+}
+
+/// Offsets in a mixture file (docs/format.md): header 24, width 24, height 32, spacing 40,
+/// sigma_min 44, samples 48, kernel_sigmas 56, weight_sigmas 60, slope_tail 64, masking 68,
+/// lod_lobes 72, lobe count 76, lobes 84.
+pub mod at {
+    pub const WIDTH: usize = 24;
+    pub const SPACING: usize = 40;
+    pub const MASKING: usize = 68;
+    pub const LOBE_COUNT: usize = 76;
+    pub const LOBES: usize = 84;
+    /// After the 36 lobes of the 6² map: the level count, then level 1's error count and records.
+    pub const LEVELS: usize = LOBES + 36 * 20;
+    pub const ERRORS: usize = LEVELS + 16;
+}
