@@ -19,10 +19,10 @@
 
 mod common;
 
+use brdf::glint::mixture::{DEFAULT_LOD_LOBES, MixtureParams, PatchOptions};
 use brdf::glint::{
-    BeckmannMixture, BrushedParams, DEFAULT_LOD_LOBES, FlakesParams, Footprint, HemisphereBins,
-    Kernel, MixtureParams, MixturePatch, PatchOptions, ScratchedParams, binned_pndf, brushed,
-    bumpy, flakes, scratched, tv_distance,
+    BeckmannMixture, BrushedParams, FlakesParams, Footprint, HemisphereBins, Kernel, MixturePatch,
+    ScratchedParams, binned_pndf, brushed, bumpy, flakes, scratched, tv_distance,
 };
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};

@@ -67,7 +67,8 @@ mod tests {
 
     use super::common::orb::*;
     use brdf::fresnel::{ConductorFresnel, Fresnel};
-    use brdf::glint::{BeckmannMixture, MaskingMode, MixtureParams, NormalMap, PatchOptions};
+    use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
+    use brdf::glint::{BeckmannMixture, NormalMap};
     use glam::{Vec2, Vec3};
     use indicatif::ProgressBar;
 

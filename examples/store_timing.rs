@@ -18,8 +18,11 @@
 
 mod common;
 
-use brdf::glint::{BeckmannMixture, BinMap, BinMapParams, LobeStorage, MixtureParams, NormalMap};
-use brdf::glint::{PositionNormalMap, PositionNormalParams, bumpy};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::{LobeStorage, MixtureParams};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, NormalMap};
+use brdf::glint::{PositionNormalMap, bumpy};
 use std::time::Instant;
 
 fn arg(name: &str) -> Option<usize> {

@@ -6,9 +6,10 @@ mod support;
 
 use brdf::Vec2;
 use brdf::frame::slope_to_normal;
+use brdf::glint::GlintNdf;
+use brdf::glint::binmap::{BinLookup, BinMapParams};
 use brdf::glint::{
-    BinLookup, BinMap, BinMapParams, BinMapPatch, Footprint, HemisphereBins, Kernel, binned_pndf,
-    bumpy, tv_distance,
+    BinMap, BinMapPatch, Footprint, HemisphereBins, Kernel, binned_pndf, bumpy, tv_distance,
 };
 use brdf::ndf::Ndf;
 use support::binmap::params;
@@ -57,9 +58,12 @@ fn smoothed_d_cos_integrates_to_one() {
     let bm = BinMap::build(&map, params(31, 16, BinLookup::Dense)).unwrap();
     let alpha = 0.15f32;
     let sigma = alpha as f64 / 2f64.sqrt();
-    let patch = bm.patch_smoothed(
+    let patch = bm.patch_with(
         &Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 64.0, 32, 32),
-        alpha,
+        &brdf::glint::binmap::PatchOptions {
+            smoothing_alpha: alpha,
+        },
+        None,
     );
     let step = sigma / 2.0;
     let ext = 2.0;
@@ -174,7 +178,17 @@ fn exact_masses_on_another_grid() {
     for (j, &got) in own.iter().enumerate() {
         assert!((got - patch.bin_mass(j)).abs() < 1e-12, "own bin {j}");
     }
-    assert!(bm.patch_smoothed(&fp, 0.1).masses_on(&fine).is_none());
+    assert!(
+        bm.patch_with(
+            &fp,
+            &brdf::glint::binmap::PatchOptions {
+                smoothing_alpha: 0.1
+            },
+            None
+        )
+        .masses_on(&fine)
+        .is_none()
+    );
     // (3) Non-aligned, at the default 127² bins.
     let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
     let patch = bm.patch(&fp);
@@ -221,7 +235,13 @@ fn accuracy_table() {
             let gauss = binned_pndf(map, &fp, Kernel::Gaussian, &bins, 4_000_000, 17);
             let para = binned_pndf(map, &fp, Kernel::Parallelogram, &bins, 4_000_000, 17);
             let patch = bm.patch(&fp);
-            let smooth = bm.patch_smoothed(&fp, 0.02);
+            let smooth = bm.patch_with(
+                &fp,
+                &brdf::glint::binmap::PatchOptions {
+                    smoothing_alpha: 0.02,
+                },
+                None,
+            );
             // 8 × 8 midpoints per reference bin: each 64²-bin covers ~4 of the bin map's 127² bins.
             let sub = 64;
             println!(

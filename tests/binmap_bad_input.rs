@@ -3,7 +3,8 @@
 
 mod support;
 
-use brdf::glint::{BinLookup, BinMap, BinMapParams, Footprint, GlintNdf, bumpy};
+use brdf::glint::binmap::{BinLookup, BinMapParams};
+use brdf::glint::{BinMap, Footprint, GlintNdf, bumpy};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 use support::binmap::params;
@@ -63,8 +64,20 @@ fn bad_input_is_total() {
     for fp in &footprints {
         for patch in [
             bm.patch(fp),
-            bm.patch_smoothed(fp, 0.2),
-            bm.patch_smoothed(fp, f32::NAN),
+            bm.patch_with(
+                fp,
+                &brdf::glint::binmap::PatchOptions {
+                    smoothing_alpha: 0.2,
+                },
+                None,
+            ),
+            bm.patch_with(
+                fp,
+                &brdf::glint::binmap::PatchOptions {
+                    smoothing_alpha: f32::NAN,
+                },
+                None,
+            ),
         ] {
             let s: f64 = (0..bm.bins().len()).map(|b| patch.bin_mass(b)).sum();
             // Masses of a clamped footprint still sum to 1 (f64 sums: 1e-9).

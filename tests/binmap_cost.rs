@@ -3,7 +3,9 @@
 
 mod support;
 
-use brdf::glint::{BinLookup, BinMap, BinMapParams, BinMapPatch, Footprint, bumpy};
+use brdf::glint::GlintNdf;
+use brdf::glint::binmap::{BinLookup, BinMapParams};
+use brdf::glint::{BinMap, BinMapPatch, Footprint, bumpy};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 use rand::RngExt;

@@ -6,8 +6,10 @@ mod support;
 
 use brdf::bxdf::Masking;
 use brdf::fresnel::NoFresnel;
+use brdf::glint::GlintNdf;
+use brdf::glint::binmap::BinMapParams;
 use brdf::glint::{
-    BinMap, BinMapParams, Footprint, HemisphereBins, NormalMap, ScratchedParams, bumpy, scratched,
+    BinMap, Footprint, HemisphereBins, NormalMap, ScratchedParams, bumpy, scratched,
 };
 use brdf::ndf::Ndf;
 use brdf::{MicrofacetBrdf, Vec2, Vec3};
@@ -36,7 +38,16 @@ fn white_furnace() {
             let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.61), area, w, h);
             for (label, patch) in [
                 ("bins", bm.patch(&fp)),
-                ("α=0.1", bm.patch_smoothed(&fp, 0.1)),
+                (
+                    "α=0.1",
+                    bm.patch_with(
+                        &fp,
+                        &brdf::glint::binmap::PatchOptions {
+                            smoothing_alpha: 0.1,
+                        },
+                        None,
+                    ),
+                ),
             ] {
                 if label != "bins" && area != 16.0 {
                     continue;
@@ -197,7 +208,16 @@ fn furnace_up_to_grazing_stays_below_one() {
                 map.width(),
                 map.height(),
             );
-            for patch in [bm.patch(&fp), bm.patch_smoothed(&fp, 0.1)] {
+            for patch in [
+                bm.patch(&fp),
+                bm.patch_with(
+                    &fp,
+                    &brdf::glint::binmap::PatchOptions {
+                        smoothing_alpha: 0.1,
+                    },
+                    None,
+                ),
+            ] {
                 for theta in [70.0, 85.0, 89.0, 89.9] {
                     for phi in [30.0, 210.0] {
                         let wo = support::dir(theta, phi);

@@ -4,7 +4,9 @@
 mod support;
 
 use brdf::Vec2;
-use brdf::glint::{BinLookup, BinMap, BinMapParams, Footprint, bumpy};
+use brdf::glint::GlintNdf;
+use brdf::glint::binmap::{BinLookup, BinMapParams};
+use brdf::glint::{BinMap, Footprint, bumpy};
 use brdf::ndf::Ndf;
 use rand::RngExt;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
@@ -87,9 +89,12 @@ fn chi_square_of_the_smoothed_sampler() {
     let map = bumpy(64, 64, 0.25, 4.0, 1).unwrap();
     let bm = BinMap::build(&map, params(15, 16, BinLookup::Dense)).unwrap();
     for (k, area) in [16.0f32, 1024.0].into_iter().enumerate() {
-        let patch = bm.patch_smoothed(
+        let patch = bm.patch_with(
             &Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, 64, 64),
-            0.1,
+            &brdf::glint::binmap::PatchOptions {
+                smoothing_alpha: 0.1,
+            },
+            None,
         );
         let mut chi = Chi2::new(format!("binmap_smoothed_{k}"), 2);
         chi.res_z = 50;
@@ -180,9 +185,12 @@ fn chi_square_of_the_smoothed_visible_sampler() {
     // 4·10⁵ draws, θo up to 89°. 15² bins keep the number of lobes small.
     let map = bumpy(64, 64, 0.25, 4.0, 1).unwrap();
     let bm = BinMap::build(&map, params(15, 16, BinLookup::Dense)).unwrap();
-    let patch = bm.patch_smoothed(
+    let patch = bm.patch_with(
         &Footprint::isotropic_texels(Vec2::new(0.37, 0.61), 16.0, 64, 64),
-        0.1,
+        &brdf::glint::binmap::PatchOptions {
+            smoothing_alpha: 0.1,
+        },
+        None,
     );
     let views = [(30.0, 210.0), (85.0, 210.0), (89.0, 210.0)];
     for (k, (theta, phi)) in views.into_iter().enumerate() {

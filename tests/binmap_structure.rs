@@ -9,9 +9,9 @@ mod support;
 
 use brdf::Vec2;
 use brdf::frame::slope_to_normal;
-use brdf::glint::{
-    BinLookup, BinMap, BinMapParams, BinMapPatch, Footprint, HemisphereBins, NormalMap,
-};
+use brdf::glint::GlintNdf;
+use brdf::glint::binmap::{BinLookup, BinMapParams};
+use brdf::glint::{BinMap, BinMapPatch, Footprint, HemisphereBins, NormalMap};
 use proptest::prelude::*;
 use rand::RngExt;
 use support::binmap::{params, test_maps};

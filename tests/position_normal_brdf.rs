@@ -5,9 +5,8 @@
 mod support;
 
 use brdf::fresnel::NoFresnel;
-use brdf::glint::{
-    Footprint, GlintNdf, NormalMap, PositionNormalBrdf, PositionNormalMap, PositionNormalParams,
-};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{Footprint, GlintNdf, NormalMap, PositionNormalBrdf, PositionNormalMap};
 use brdf::ndf::{Beckmann, Ndf};
 use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
 use rand::RngExt;

@@ -10,9 +10,8 @@
 
 mod support;
 
-use brdf::glint::{
-    Footprint, GlintNdf, NormalMap, PositionNormalMap, PositionNormalParams, PositionNormalPatch,
-};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{Footprint, GlintNdf, NormalMap, PositionNormalMap, PositionNormalPatch};
 use brdf::ndf::Ndf;
 use brdf::{Error, Vec2, Vec3};
 use support::position_normal::{build, noise, normal_of, waves};
@@ -370,13 +369,25 @@ fn query_cap_is_an_explicit_level_of_detail() {
     let fp = Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 1024.0, n, n);
     let sigma = (1024.0f64 / 12.0).sqrt();
     let default = pn.patch(&fp);
-    let same = pn.patch_with_cap(&fp, PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS);
+    let same = pn.patch_with(
+        &fp,
+        &brdf::glint::position_normal::PatchOptions {
+            max_query_texels: PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS,
+        },
+        None,
+    );
     assert_eq!(default.query_scale(), 1.0);
     assert_eq!(default.element_count(), same.element_count());
     let m = Vec3::new(0.1, -0.05, 1.0).normalize();
     assert_eq!(default.d(m).to_bits(), same.d(m).to_bits());
     // Cap 12 texels: σ → 4, scale 4 / 9.24 (f32 footprint covariance: 1e-5 relative).
-    let capped = pn.patch_with_cap(&fp, 12.0);
+    let capped = pn.patch_with(
+        &fp,
+        &brdf::glint::position_normal::PatchOptions {
+            max_query_texels: 12.0,
+        },
+        None,
+    );
     let want = 4.0 / sigma;
     assert!(
         (capped.query_scale() as f64 - want).abs() < 1e-5,
@@ -384,11 +395,23 @@ fn query_cap_is_an_explicit_level_of_detail() {
         capped.query_scale()
     );
     assert!(capped.element_count() < default.element_count());
-    let uncapped = pn.patch_with_cap(&fp, f32::INFINITY);
+    let uncapped = pn.patch_with(
+        &fp,
+        &brdf::glint::position_normal::PatchOptions {
+            max_query_texels: f32::INFINITY,
+        },
+        None,
+    );
     assert_eq!(uncapped.query_scale(), 1.0);
     assert_eq!(uncapped.element_count(), default.element_count());
     for cap in [0.0, -1.0, f32::NAN] {
-        let p = pn.patch_with_cap(&fp, cap);
+        let p = pn.patch_with(
+            &fp,
+            &brdf::glint::position_normal::PatchOptions {
+                max_query_texels: cap,
+            },
+            None,
+        );
         assert_eq!(p.query_scale(), 0.0);
         assert!(p.element_count() >= 1);
         assert!(p.d(m).is_finite() && p.lambda(m).is_finite());

@@ -5,9 +5,8 @@
 mod support;
 
 use brdf::fresnel::NoFresnel;
-use brdf::glint::{
-    Footprint, GlintNdf, PositionNormalBrdf, PositionNormalMap, PositionNormalParams,
-};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{Footprint, GlintNdf, PositionNormalBrdf, PositionNormalMap};
 use brdf::ndf::Ndf;
 use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
 use rand::RngExt;
@@ -147,7 +146,13 @@ fn lod_table() {
                 &[128.0]
             };
             for &cap in caps {
-                let patch = pn.patch_with_cap(&fp, cap);
+                let patch = pn.patch_with(
+                    &fp,
+                    &brdf::glint::position_normal::PatchOptions {
+                        max_query_texels: cap,
+                    },
+                    None,
+                );
                 let tv = tv_distance(&patch, &reference, 1);
                 let normals: Vec<Vec3> = (0..512)
                     .map(|k| {
@@ -166,7 +171,13 @@ fn lod_table() {
                 let reps = 10;
                 let t = Instant::now();
                 for _ in 0..reps {
-                    let p = pn.patch_with_cap(std::hint::black_box(&fp), cap);
+                    let p = pn.patch_with(
+                        std::hint::black_box(&fp),
+                        &brdf::glint::position_normal::PatchOptions {
+                            max_query_texels: cap,
+                        },
+                        None,
+                    );
                     std::hint::black_box(p.element_count());
                 }
                 let t_patch = t.elapsed().as_secs_f64() / reps as f64;

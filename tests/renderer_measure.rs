@@ -17,10 +17,10 @@ mod support;
 
 use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf};
 use brdf::fresnel::NoFresnel;
-use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintNdf, MaskingMode, MixtureParams,
-    NormalMap, PatchOptions, PositionNormalMap, PositionNormalParams,
-};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, Footprint, GlintNdf, NormalMap, PositionNormalMap};
 use brdf::ndf::Ndf;
 use brdf::warp;
 use brdf::{Vec2, Vec3};
@@ -119,7 +119,13 @@ impl Models {
         f("bin map", &self.bin_map.patch(fp));
         f(
             "bin map smoothed",
-            &self.bin_map.patch_smoothed(fp, SMOOTHING),
+            &self.bin_map.patch_with(
+                fp,
+                &brdf::glint::binmap::PatchOptions {
+                    smoothing_alpha: SMOOTHING,
+                },
+                None,
+            ),
         );
         f("position-normal", &self.position_normal.patch(fp));
     }
@@ -397,23 +403,32 @@ fn footprint_from_degenerate_surface_differentials_is_minimal() {
 // Materials a renderer holds at run time
 // ---------------------------------------------------------------------------------------------
 
-/// Every `GlintModel` variant's patch is bit-identical to its model's own patch, through `patch` and
-/// through `patch_in` with a reused scratch (queried after the scratch served larger and smaller
+/// Every `GlintModel` variant's patch (with per-query options: the bin map plain and smoothed) is
+/// bit-identical to its model's own patch, without a scratch and with a reused scratch (queried after the scratch served larger and smaller
 /// footprints), and the models share one `Vec<Arc<GlintModel>>`.
 #[test]
 fn glint_model_patches_equal_their_models_patches() {
-    use brdf::glint::{GlintModel, GlintScratch};
+    use brdf::glint::{GlintModel, GlintOptions, GlintScratch};
     use std::sync::Arc;
     let map = brdf::glint::scratched(32, 32, Default::default(), 5).unwrap();
     let models = Models::build(&map);
-    let materials: Vec<Arc<GlintModel>> = vec![
-        Arc::new(models.mixture_exact.clone().into()),
-        Arc::new(models.bin_map.clone().into()),
-        Arc::new(GlintModel::SmoothedBinMap {
-            map: models.bin_map.clone(),
-            alpha: SMOOTHING,
-        }),
-        Arc::new(models.position_normal.clone().into()),
+    let bin_map: Arc<GlintModel> = Arc::new(models.bin_map.clone().into());
+    let mut smoothed = bin_map.options();
+    smoothed.bin_map.smoothing_alpha = SMOOTHING;
+    // (material, per-query options): the smoothed bin map is the bin map with smoothing options.
+    let materials: Vec<(Arc<GlintModel>, GlintOptions)> = vec![
+        {
+            let m: Arc<GlintModel> = Arc::new(models.mixture_exact.clone().into());
+            let o = m.options();
+            (m, o)
+        },
+        (bin_map.clone(), bin_map.options()),
+        (bin_map, smoothed),
+        {
+            let m: Arc<GlintModel> = Arc::new(models.position_normal.clone().into());
+            let o = m.options();
+            (m, o)
+        },
     ];
     let mut scratch = GlintScratch::default();
     let mut rng = support::rng(41);
@@ -422,12 +437,18 @@ fn glint_model_patches_equal_their_models_patches() {
         let own: [&dyn Ndf; 4] = [
             &models.mixture_exact.patch(&fp),
             &models.bin_map.patch(&fp),
-            &models.bin_map.patch_smoothed(&fp, SMOOTHING),
+            &models.bin_map.patch_with(
+                &fp,
+                &brdf::glint::binmap::PatchOptions {
+                    smoothing_alpha: SMOOTHING,
+                },
+                None,
+            ),
             &models.position_normal.patch(&fp),
         ];
-        for (material, own) in materials.iter().zip(own) {
-            let via_patch = material.patch(&fp);
-            let via_scratch = material.patch_in(&fp, &mut scratch);
+        for ((material, options), own) in materials.iter().zip(own) {
+            let via_patch = material.patch_with(&fp, options, None);
+            let via_scratch = material.patch_with(&fp, options, Some(&mut scratch));
             for _ in 0..50 {
                 let wo = support::dir(rng.random_range(0.0..89.0), rng.random_range(0.0..360.0));
                 let m = support::dir(rng.random_range(0.0..60.0), rng.random_range(0.0..360.0));

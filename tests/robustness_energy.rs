@@ -6,10 +6,9 @@ mod support;
 
 use brdf::bxdf::{BlinnPhongNormalization, Masking, PhongNormalization, Sampling};
 use brdf::fresnel::NoFresnel;
-use brdf::glint::{
-    BeckmannMixture, BinMap, GlintNdf, MaskingMode, PatchOptions, PositionNormalMap,
-    PositionNormalParams,
-};
+use brdf::glint::mixture::{MaskingMode, PatchOptions};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, GlintNdf, PositionNormalMap};
 use brdf::ndf::{Beckmann, Ggx, Ndf};
 use brdf::{BlinnPhongLobe, Lambert, MicrofacetBrdf, Phong, Vec3};
 use proptest::prelude::*;
@@ -69,9 +68,9 @@ proptest! {
         let pn = PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap();
         let (mix, mix_approx, bins, smoothed, pnp) = (
             mixture.patch(&footprint),
-            mixture.patch_with(&footprint, approximate),
+            mixture.patch_with(&footprint, &approximate, None),
             bin_map.patch(&footprint),
-            bin_map.patch_smoothed(&footprint, smoothing),
+            bin_map.patch_with(&footprint, &brdf::glint::binmap::PatchOptions { smoothing_alpha: smoothing }, None),
             pn.patch(&footprint),
         );
         let patches: [(&str, &dyn Ndf); 5] = [

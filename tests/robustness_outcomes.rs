@@ -6,9 +6,11 @@ mod support;
 
 use brdf::bxdf::PhongNormalization;
 use brdf::fresnel::{ConductorFresnel, DielectricFresnel, SchlickFresnel};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::MixtureParams;
+use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, MixtureParams, NormalMap, NormalRepair,
-    PositionNormalMap, PositionNormalParams, TangentConvention,
+    BeckmannMixture, BinMap, NormalMap, NormalRepair, PositionNormalMap, TangentConvention,
 };
 use brdf::ndf::{Beckmann, BlinnPhong, Ggx, SlopeGaussian};
 use brdf::{Error, Lambert, Mat2, Phong, Vec2, Vec3};

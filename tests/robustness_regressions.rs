@@ -5,10 +5,10 @@ mod support;
 
 use brdf::bxdf::{BlinnPhongNormalization, Masking};
 use brdf::fresnel::NoFresnel;
-use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintNdf, MixtureParams, NormalMap,
-    PositionNormalMap, PositionNormalParams,
-};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::MixtureParams;
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, Footprint, GlintNdf, NormalMap, PositionNormalMap};
 use brdf::ndf::{Beckmann, Ggx, Ndf, SlopeGaussian};
 use brdf::{BlinnPhongLobe, Bxdf, Mat2, MicrofacetBrdf, Vec2, Vec3};
 use support::robustness::{albedo, assert_energy, err_naming, small_bins};
@@ -113,7 +113,16 @@ fn regression_glint_furnaces_at_grazing_angles() {
     let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.61), 64.0, 256, 256);
     let bin_map = BinMap::build(&bumpy, BinMapParams::default()).unwrap();
     let pn = PositionNormalMap::build(&bumpy, PositionNormalParams::default()).unwrap();
-    let (smoothed, pnp) = (bin_map.patch_smoothed(&fp, 0.1), pn.patch(&fp));
+    let (smoothed, pnp) = (
+        bin_map.patch_with(
+            &fp,
+            &brdf::glint::binmap::PatchOptions {
+                smoothing_alpha: 0.1,
+            },
+            None,
+        ),
+        pn.patch(&fp),
+    );
     for theta in [85.0, 89.0, 89.9] {
         let wo = support::dir(theta, 30.0);
         for (name, patch) in [

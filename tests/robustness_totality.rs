@@ -15,10 +15,9 @@ use brdf::bxdf::{
     BlinnPhongNormalization, Masking, OriginalPhongNormalization, PhongNormalization, Sampling,
 };
 use brdf::fresnel::{ConductorFresnel, DielectricFresnel, NoFresnel, SchlickFresnel};
-use brdf::glint::{
-    BeckmannMixture, BinMap, GlintNdf, MaskingMode, PositionNormalBrdf, PositionNormalMap,
-    PositionNormalParams,
-};
+use brdf::glint::mixture::MaskingMode;
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, GlintNdf, PositionNormalBrdf, PositionNormalMap};
 use brdf::ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
 use brdf::{BlinnPhongLobe, Bxdf, Lambert, MicrofacetBrdf, OriginalPhong, Phong, Vec2, Vec3};
 use proptest::prelude::*;
@@ -158,7 +157,7 @@ proptest! {
             check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), wo, wi, uc, u);
         }
         let bin_map = BinMap::build(&map, small_bins()).unwrap();
-        for patch in [bin_map.patch(&footprint), bin_map.patch_smoothed(&footprint, smoothing)] {
+        for patch in [bin_map.patch(&footprint), bin_map.patch_with(&footprint, &brdf::glint::binmap::PatchOptions { smoothing_alpha: smoothing }, None)] {
             check_ndf(&patch, wo, wi, uc, u);
             check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), wo, wi, uc, u);
         }

@@ -5,10 +5,10 @@
 
 mod support;
 
-use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintNdf, MixtureParams, NormalMap,
-    PositionNormalMap, PositionNormalParams,
-};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::MixtureParams;
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, Footprint, GlintNdf, NormalMap, PositionNormalMap};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 

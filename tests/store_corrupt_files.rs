@@ -5,10 +5,10 @@
 mod support;
 
 use brdf::Error;
-use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, MixtureParams, NormalMap, PositionNormalMap,
-    PositionNormalParams,
-};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::MixtureParams;
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, NormalMap, PositionNormalMap};
 use support::format::reseal;
 use support::store::{
     as_version_2, at, load_mixture, map, saved, small_compact_file, small_mixture_file,

@@ -7,7 +7,8 @@
 
 mod support;
 
-use brdf::glint::{BinMap, BinMapParams, Footprint, GlintNdf};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::{BinMap, Footprint, GlintNdf};
 use brdf::ndf::Ndf;
 use brdf::{Error, Vec2};
 use support::format::reseal;

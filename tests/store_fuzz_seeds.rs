@@ -3,10 +3,10 @@
 
 mod support;
 
-use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, LobeStorage, MixtureParams, PositionNormalMap,
-    PositionNormalParams,
-};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::{LobeStorage, MixtureParams};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, PositionNormalMap};
 use support::store::{map, saved};
 
 /// Writes the seed files of the store fuzz targets (small valid files of each kind):

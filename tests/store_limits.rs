@@ -5,7 +5,8 @@
 //! no other thread allocates meanwhile).
 
 use brdf::Error;
-use brdf::glint::{BeckmannMixture, MixtureParams, NormalMap};
+use brdf::glint::mixture::MixtureParams;
+use brdf::glint::{BeckmannMixture, NormalMap};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -79,7 +80,7 @@ fn lying_sizes_allocate_no_more_than_the_file_holds() {
     // A compact mixture (model kind 5) declaring a 32768² map: its level 0 needs 8192² frames
     // (1 GiB) and then 8192² blocks (10 GiB); 1 MiB of frames is present.
     let params = MixtureParams {
-        storage: brdf::glint::LobeStorage::Compact,
+        storage: brdf::glint::mixture::LobeStorage::Compact,
         ..params
     };
     let mut file = Vec::new();

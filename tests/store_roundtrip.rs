@@ -4,10 +4,10 @@
 
 mod support;
 
-use brdf::glint::{
-    BeckmannMixture, BinLookup, BinMap, BinMapParams, Footprint, GlintNdf, LobeStorage,
-    MaskingMode, MixtureParams, NormalMap, PatchOptions, PositionNormalMap, PositionNormalParams,
-};
+use brdf::glint::binmap::{BinLookup, BinMapParams};
+use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, Footprint, GlintNdf, NormalMap, PositionNormalMap};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 use support::store::{as_version_2, dirs, map, saved};
@@ -159,8 +159,8 @@ fn compact_mixture_round_trip_is_exact() {
         for (k, f) in footprints(n).iter().enumerate() {
             // The tolerance is not stored in files: both with the build's options.
             let (a, b) = (
-                built.patch_with(f, params.patch),
-                loaded.patch_with(f, params.patch),
+                built.patch_with(f, &params.patch, None),
+                loaded.patch_with(f, &params.patch, None),
             );
             levels.insert(a.level());
             assert_eq!(a.level(), b.level());
@@ -233,8 +233,20 @@ fn bin_map_round_trip_is_exact() {
             let what = format!("{lookup:?} fp {k}");
             assert_same_patch(&built.patch(f), &loaded.patch(f), &what);
             assert_same_patch(
-                &built.patch_smoothed(f, 0.1),
-                &loaded.patch_smoothed(f, 0.1),
+                &built.patch_with(
+                    f,
+                    &brdf::glint::binmap::PatchOptions {
+                        smoothing_alpha: 0.1,
+                    },
+                    None,
+                ),
+                &loaded.patch_with(
+                    f,
+                    &brdf::glint::binmap::PatchOptions {
+                        smoothing_alpha: 0.1,
+                    },
+                    None,
+                ),
                 &what,
             );
         }

@@ -1,9 +1,8 @@
 //! Shared helpers of the inverse bin map tests (tests/binmap_*.rs): build parameters with one element
 //! per texel and the small test maps.
 
-use brdf::glint::{
-    BinLookup, BinMapParams, FlakesParams, NormalMap, ScratchedParams, bumpy, flakes, scratched,
-};
+use brdf::glint::binmap::{BinLookup, BinMapParams};
+use brdf::glint::{FlakesParams, NormalMap, ScratchedParams, bumpy, flakes, scratched};
 
 /// Parameters with one element per texel (s = 1), so that element indices are texel indices.
 pub fn params(n: usize, leaf: usize, lookup: BinLookup) -> BinMapParams {

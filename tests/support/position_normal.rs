@@ -2,7 +2,8 @@
 //! default build, and the unit normal of a slope written independently in f64.
 
 use brdf::Vec3;
-use brdf::glint::{NormalMap, PositionNormalMap, PositionNormalParams};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{NormalMap, PositionNormalMap};
 
 /// White-noise slopes, uniform in [−a, a]², on an n × n map.
 pub fn noise(n: usize, a: f32, seed: u64) -> NormalMap {

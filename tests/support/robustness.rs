@@ -2,7 +2,9 @@
 //! for the inputs a caller could pass (directions, random numbers, α, maps, footprints), quick glint
 //! builds, the energy estimate with its bound, and constructor outcomes as text.
 
-use brdf::glint::{BinMapParams, Footprint, MaskingMode, MixtureParams, NormalMap, PatchOptions};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::{Footprint, NormalMap};
 use brdf::{Bxdf, Error, Vec2, Vec3};
 use proptest::prelude::*;
 

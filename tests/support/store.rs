@@ -3,7 +3,8 @@
 
 use super::format::reseal;
 use brdf::Vec3;
-use brdf::glint::{BeckmannMixture, LobeStorage, MixtureParams, NormalMap};
+use brdf::glint::mixture::{LobeStorage, MixtureParams};
+use brdf::glint::{BeckmannMixture, NormalMap};
 
 /// White-noise slopes in [−0.6, 0.6]² (seed `n`): every lobe and element different.
 pub fn map(n: usize) -> NormalMap {
