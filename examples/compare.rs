@@ -6,7 +6,7 @@
 //! `target/brdf-out/`) and prints the tables. `--quick`: 1024² maps (≈ minutes on 2 cores); without
 //! it, 2048² maps and 4× the ground-truth samples. Accuracy is the total variation to two truths:
 //! the P-NDF of the interpolated map (Dirac) and the same convolved with the material's σ_ε = 0.01
-//! micro-roughness. See `examples/common/compare.rs` for what is measured and how.
+//! micro-roughness. See `examples/common/compare/` for what is measured and how.
 
 mod common;
 

@@ -65,6 +65,7 @@ mod tests {
     //! Tiny renders (32² pixels, 64² maps) through every code path, checked against physics computed
     //! here independently of the renderer.
 
+    use super::common::orb::render::{MixtureVariant, render_glint};
     use super::common::orb::*;
     use brdf::fresnel::{ConductorFresnel, Fresnel};
     use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};

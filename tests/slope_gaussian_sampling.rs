@@ -15,6 +15,7 @@ use support::chi2::Chi2;
 use support::dir;
 use support::slope_gaussian::lobe;
 
+/// The chi-square family: 9 lobes × (1 normal sampler + 9 visible views).
 const CHI2_FAMILY: usize = 90;
 
 type LobeParams = (String, (f32, f32), f32, f32, f32);

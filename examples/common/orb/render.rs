@@ -1,0 +1,374 @@
+//! Rendering the orb: each glint model with one (or q × q) BRDF evaluations per pixel, the two
+//! footprint references as independent halves, naive sampling of the normal map, and
+//! [`render_all`], which builds every method and renders every row of the comparison.
+
+use super::OrbOptions;
+use super::scene::{Scene, ShadingPoint};
+use crate::common::Res;
+use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf};
+use brdf::fresnel::Fresnel;
+use brdf::glint::{
+    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintNdf, Kernel, MaskingMode, MixtureParams,
+    MixturePatch, NormalMap, PatchOptions, PositionNormalMap, PositionNormalParams, footprint_brdf,
+};
+use glam::{Vec2, Vec3};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// A linear RGB image (row major, row 0 at the top).
+#[derive(Clone, Debug)]
+pub struct Image {
+    /// Width and height in pixels.
+    pub size: u32,
+    /// Pixels.
+    pub pixels: Vec<Vec3>,
+}
+
+impl Image {
+    /// The mean of the channels of pixel k.
+    pub fn value(&self, k: usize) -> f64 {
+        let p = self.pixels[k];
+        (p.x as f64 + p.y as f64 + p.z as f64) / 3.0
+    }
+}
+
+fn progress_bar(show: bool, len: u64, msg: &str) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::new(len);
+    if let Ok(style) = ProgressStyle::with_template("{msg:>34} [{bar:30}] {pos}/{len} {elapsed}") {
+        pb.set_style(style.progress_chars("=> "));
+    }
+    pb.set_message(msg.to_string());
+    pb
+}
+
+/// Renders every pixel with `pixel(x, y)`, rows in parallel, with a progress bar.
+fn render_rows(size: u32, bar: &ProgressBar, pixel: impl Fn(u32, u32) -> Vec3 + Sync) -> Image {
+    let rows: Vec<Vec<Vec3>> = (0..size)
+        .into_par_iter()
+        .map(|y| {
+            let row = (0..size).map(|x| pixel(x, y)).collect();
+            bar.inc(1);
+            row
+        })
+        .collect();
+    Image {
+        size,
+        pixels: rows.concat(),
+    }
+}
+
+/// Renders the orb with a glint model: one BRDF evaluation per pixel at its centre, with the pixel's
+/// footprint ([`render_glint_evals`] with 1 evaluation).
+pub fn render_glint<G: GlintNdf + Sync>(scene: &Scene, model: &G, bar: &ProgressBar) -> Image {
+    render_glint_evals(scene, model, 1, bar)
+}
+
+/// Renders the orb with a glint model and q × q evaluations per pixel (q = ⌊√evals⌋, at least 1):
+/// sub-pixel j has its centre at the pixel centre's uv + ∂uv/∂x o_x + ∂uv/∂y o_y (o the sub-pixel
+/// centre's offset from the pixel centre, in pixels) and differentials ∂uv/∂x / q, ∂uv/∂y / q, so
+/// the q² sub-footprints tile the pixel's parallelogram, and their Gaussians together have the
+/// pixel Gaussian's covariance (Σ/q² + the offsets' variance (1 − 1/q²)/12 per pixel axis = 1/12).
+/// All sub-pixels share the pixel centre's frame, wo and wi (the linearised footprint the references
+/// use). The pixel is the mean of
+///
+/// L = eval(wo, wi) · cos θi · I / r², eval = `MicrofacetBrdf::new(model.patch(&fp), F)` with
+/// separable Smith masking (F G2 D_P / (4 A_P(wo) cos θi), the renderer's measure),
+///
+/// and 0 where the pixel centre misses the sphere.
+///
+/// # Reference
+/// \[Chermain2019\] eq. 7 (P-BRDF), §4.1 (footprint from ray differentials).
+pub fn render_glint_evals<G: GlintNdf + Sync>(
+    scene: &Scene,
+    model: &G,
+    evals: u32,
+    bar: &ProgressBar,
+) -> Image {
+    let q = ((evals.max(1) as f64).sqrt().floor() as u32).max(1);
+    render_rows(scene.size, bar, |x, y| glint_pixel(scene, model, x, y, q))
+}
+
+/// One pixel of [`render_glint_evals`] with q × q evaluations.
+pub fn glint_pixel<G: GlintNdf>(scene: &Scene, model: &G, x: u32, y: u32, q: u32) -> Vec3 {
+    let q = q.max(1);
+    let Some(sp) = scene.shading(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)) else {
+        return Vec3::ZERO;
+    };
+    let (dx, dy) = (sp.duv_dx / q as f32, sp.duv_dy / q as f32);
+    let mut sum = Vec3::ZERO;
+    for j in 0..q {
+        for i in 0..q {
+            let o = Vec2::new(
+                (i as f32 + 0.5) / q as f32 - 0.5,
+                (j as f32 + 0.5) / q as f32 - 0.5,
+            );
+            let uv = sp.uv + sp.duv_dx * o.x + sp.duv_dy * o.y;
+            let fp = Footprint::from_differentials(uv, dx, dy);
+            let brdf = MicrofacetBrdf::new(model.patch(&fp), scene.fresnel)
+                .with_masking(Masking::Separable);
+            // The renderer's measure: eval × the geometric cos θi.
+            let l = brdf.eval(sp.wo, sp.wi) * (sp.wi.z.max(0.0) * sp.irradiance);
+            if l.is_finite() {
+                sum += l;
+            }
+        }
+    }
+    sum / (q * q) as f32
+}
+
+/// Both footprint references of one pixel from `samples` positions of its Gaussian footprint k_P
+/// ([`footprint_brdf`]), as radiances: (exact P-BRDF (a), normal-mapped (b)). The pixel-centre
+/// frame, wo, wi and linear uv are used for every position, as the glint models use them.
+pub fn reference_pixel(
+    scene: &Scene,
+    map: &NormalMap,
+    sigma_eps: f32,
+    sp: &ShadingPoint,
+    samples: usize,
+    seed: u64,
+) -> (Vec3, Vec3) {
+    let r = footprint_brdf(
+        map,
+        &sp.footprint(),
+        Kernel::Gaussian,
+        sp.wo,
+        sp.wi,
+        sigma_eps,
+        samples,
+        seed,
+    );
+    let Some(h) = (sp.wo + sp.wi).try_normalize() else {
+        return (Vec3::ZERO, Vec3::ZERO);
+    };
+    // eval × the geometric cos θi × I / r², times Fresnel at the (shared) half vector.
+    let scale = scene.fresnel.eval(sp.wo.dot(h)) * (sp.wi.z.max(0.0) * sp.irradiance);
+    let finite = |v: Vec3| if v.is_finite() { v } else { Vec3::ZERO };
+    (
+        finite(scale * r.pbrdf() as f32),
+        finite(scale * r.normal_mapped() as f32),
+    )
+}
+
+/// The two references, each as two independent halves (their mean is the reference, their
+/// difference estimates its noise).
+pub struct References {
+    /// (a) the exact P-BRDF of the interpolated map, halves.
+    pub pbrdf: (Image, Image),
+    /// (b) conventional normal-mapped rendering, halves.
+    pub normal_mapped: (Image, Image),
+}
+
+/// Renders both references with `k × k` stratified positions of each pixel's Gaussian footprint
+/// per half (seeds `seed` and `seed + 1`).
+///
+/// # Reference
+/// \[Chermain2019\] eq. 7 (P-BRDF) and §5.2.2 (naive sampling of the normal map, σ_ε = 0.01).
+pub fn render_references(
+    scene: &Scene,
+    map: &NormalMap,
+    sigma_eps: f32,
+    k: u32,
+    seed: u64,
+    bar: &ProgressBar,
+) -> References {
+    let samples = (k * k) as usize;
+    let half = |s: u64| {
+        let pixels: Vec<(Vec3, Vec3)> = (0..scene.size)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                let row: Vec<(Vec3, Vec3)> = (0..scene.size)
+                    .map(|x| {
+                        let Some(sp) = scene.shading(Vec2::new(x as f32 + 0.5, y as f32 + 0.5))
+                        else {
+                            return (Vec3::ZERO, Vec3::ZERO);
+                        };
+                        let pixel = y as u64 * scene.size as u64 + x as u64;
+                        let seed = s.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ pixel;
+                        reference_pixel(scene, map, sigma_eps, &sp, samples, seed)
+                    })
+                    .collect();
+                bar.inc(1);
+                row
+            })
+            .collect();
+        let image = |f: fn(&(Vec3, Vec3)) -> Vec3| Image {
+            size: scene.size,
+            pixels: pixels.iter().map(f).collect(),
+        };
+        (image(|p| p.0), image(|p| p.1))
+    };
+    let (a0, b0) = half(seed);
+    let (a1, b1) = half(seed.wrapping_add(1));
+    bar.finish();
+    References {
+        pbrdf: (a0, a1),
+        normal_mapped: (b0, b1),
+    }
+}
+
+/// Naive sampling at `spp` positions per pixel of its Gaussian footprint: conventional normal-mapped
+/// rendering, the estimator whose limit is reference (b).
+pub fn render_naive(
+    scene: &Scene,
+    map: &NormalMap,
+    sigma_eps: f32,
+    spp: u32,
+    seed: u64,
+    bar: &ProgressBar,
+) -> Image {
+    render_rows(scene.size, bar, |x, y| {
+        let Some(sp) = scene.shading(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)) else {
+            return Vec3::ZERO;
+        };
+        let pixel = y as u64 * scene.size as u64 + x as u64;
+        let seed = (0xA5A5_0000 ^ seed).wrapping_mul(0xD1B5_4A32_D192_ED03) ^ pixel;
+        reference_pixel(scene, map, sigma_eps, &sp, spp as usize, seed).1
+    })
+}
+
+/// The pixel-wise mean of two images.
+pub fn mean_image(a: &Image, b: &Image) -> Image {
+    Image {
+        size: a.size,
+        pixels: a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .map(|(p, q)| 0.5 * (*p + *q))
+            .collect(),
+    }
+}
+
+/// A [`BeckmannMixture`] seen with fixed patch options (exact / approximate masking, level of
+/// detail), so that each variant is a [`GlintNdf`] of its own.
+pub struct MixtureVariant<'a> {
+    /// The mixture.
+    pub mixture: &'a BeckmannMixture,
+    /// The patch options of this variant.
+    pub options: PatchOptions,
+}
+
+impl GlintNdf for MixtureVariant<'_> {
+    type Patch<'b>
+        = MixturePatch<'b>
+    where
+        Self: 'b;
+
+    fn patch(&self, footprint: &Footprint) -> MixturePatch<'_> {
+        self.mixture.patch_with(footprint, self.options)
+    }
+}
+
+/// One rendered method: label, image, build and render times in seconds.
+pub struct Rendered {
+    /// Label.
+    pub label: String,
+    /// Image.
+    pub image: Image,
+    /// Precomputation time (s).
+    pub build_s: f64,
+    /// Render time (s).
+    pub render_s: f64,
+}
+
+/// Renders both references and every glint method available. Returns the references, their render
+/// time (s) and the methods' images (the naive equal-time row included when `naive_spp > 0`).
+pub fn render_all(opts: &OrbOptions, map: &NormalMap) -> Res<(References, f64, Vec<Rendered>)> {
+    let scene = Scene::new(opts.size, opts.tiles);
+    let rows = opts.size as u64;
+    let mut out = Vec::new();
+
+    let t = Instant::now();
+    let build_bar = progress_bar(opts.progress, 1000, "building the Beckmann mixture");
+    let progress = |f: f32| build_bar.set_position((f * 1000.0) as u64);
+    let params = MixtureParams {
+        sigma_min: opts.sigma_eps,
+        samples: opts.mixture_samples,
+        ..MixtureParams::default()
+    };
+    let mixture = BeckmannMixture::build_with_progress(map, params, Some(&progress))?;
+    build_bar.finish();
+    let mixture_build = t.elapsed().as_secs_f64();
+
+    let exact = MixtureVariant {
+        mixture: &mixture,
+        options: PatchOptions {
+            masking: MaskingMode::Exact,
+            ..PatchOptions::default()
+        },
+    };
+    let approximate = MixtureVariant {
+        mixture: &mixture,
+        options: PatchOptions {
+            masking: MaskingMode::Approximate,
+            ..PatchOptions::default()
+        },
+    };
+    let filtered = MixtureVariant {
+        mixture: &mixture,
+        options: PatchOptions {
+            masking: MaskingMode::Approximate,
+            lod_lobes: 0.0,
+            ..PatchOptions::default()
+        },
+    };
+    // The two other glint methods at their defaults, through the same `MicrofacetBrdf` (for the
+    // position-normal baseline this is its patch with the moments-lobe masking, not the published
+    // BRDF, so that every column differs only in the P-NDF and its masking).
+    let t = Instant::now();
+    let binmap = BinMap::build(map, BinMapParams::default())?;
+    let binmap_build = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let position_normal = PositionNormalMap::build(map, PositionNormalParams::default())?;
+    let position_normal_build = t.elapsed().as_secs_f64();
+    // The glint methods. Each is one line: a label, the build time, and the model (any GlintNdf).
+    let mut glint = |label: &str, build_s: f64, render: &dyn Fn(&ProgressBar) -> Image| {
+        let bar = progress_bar(opts.progress, rows, label);
+        let t = Instant::now();
+        let image = render(&bar);
+        bar.finish();
+        out.push(Rendered {
+            label: label.to_string(),
+            image,
+            build_s,
+            render_s: t.elapsed().as_secs_f64(),
+        });
+    };
+    glint("mixture, exact masking", mixture_build, &|b| {
+        render_glint(&scene, &exact, b)
+    });
+    glint("mixture, approx. masking", mixture_build, &|b| {
+        render_glint(&scene, &approximate, b)
+    });
+    glint("filtered lobe (LOD 0)", mixture_build, &|b| {
+        render_glint(&scene, &filtered, b)
+    });
+    glint("bin map (Atanasov 2020)", binmap_build, &|b| {
+        render_glint(&scene, &binmap, b)
+    });
+    glint("position-normal (Yan 2016)", position_normal_build, &|b| {
+        render_glint(&scene, &position_normal, b)
+    });
+    if opts.naive_spp > 0 {
+        let k = ((opts.naive_spp as f64).sqrt().round() as u32).max(1);
+        let label = format!("naive, {} spp", k * k);
+        glint(&label, 0.0, &|b| {
+            render_naive(&scene, map, opts.sigma_eps, k * k, opts.seed, b)
+        });
+    }
+
+    let k = (((opts.spp / 2).max(1) as f64).sqrt().round() as u32).max(1);
+    let bar = progress_bar(
+        opts.progress,
+        2 * rows,
+        &format!("references, 2 × {} spp", k * k),
+    );
+    let t = Instant::now();
+    let refs = render_references(&scene, map, opts.sigma_eps, k, opts.seed, &bar);
+    let ref_s = t.elapsed().as_secs_f64();
+    Ok((refs, ref_s, out))
+}
