@@ -19,6 +19,7 @@
 
 mod common;
 
+use brdf::glint::GlintNdf;
 use brdf::glint::mixture::{DEFAULT_LOD_LOBES, MixtureParams, PatchOptions};
 use brdf::glint::{
     BeckmannMixture, BrushedParams, FlakesParams, Footprint, HemisphereBins, Kernel, MixturePatch,
@@ -110,7 +111,7 @@ fn time_patch(mix: &BeckmannMixture, fp: &Footprint, options: PatchOptions) -> f
     let t = Instant::now();
     let mut n = 0usize;
     while t.elapsed().as_secs_f64() < 0.005 {
-        let p = mix.patch_with(fp, options);
+        let p = mix.patch_with(fp, &options, None);
         std::hint::black_box(p.level());
         n += 1;
     }
@@ -170,7 +171,7 @@ fn main() -> Res<()> {
             let truth = binned_pndf(map, &fp, Kernel::Gaussian, &bins, positions, 17);
             let patches: Vec<MixturePatch> = configs
                 .iter()
-                .map(|c| mix.patch_with(&fp, (c.options)(texels)))
+                .map(|c| mix.patch_with(&fp, &(c.options)(texels), None))
                 .collect();
             let normals: Vec<Vec3> = (0..512)
                 .map(|k| {

@@ -19,9 +19,11 @@
 
 use super::{Artifact, Chart, Res, Scale, Series, line_chart, r2, view};
 use brdf::fresnel::NoFresnel;
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintNdf, MaskingMode, MixtureParams,
-    NormalMap, PatchOptions, PositionNormalBrdf, PositionNormalMap, PositionNormalParams,
+    BeckmannMixture, BinMap, Footprint, GlintNdf, NormalMap, PositionNormalBrdf, PositionNormalMap,
 };
 use brdf::ndf::{Beckmann, Ggx, Ndf};
 use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
@@ -247,7 +249,7 @@ fn glint_rows(name: &str, map: &NormalMap, settings: &Settings) -> Res<Vec<Row>>
             masking: mode,
             ..PatchOptions::default()
         };
-        let patch = mixture.patch_with(&fp, options);
+        let patch = mixture.patch_with(&fp, &options, None);
         patch_rows(&format!("{name}: {label}"), &patch, settings, &mut rows);
     }
     let bin_map = BinMap::build(map, BinMapParams::default())?;
@@ -259,7 +261,13 @@ fn glint_rows(name: &str, map: &NormalMap, settings: &Settings) -> Res<Vec<Row>>
     );
     patch_rows(
         &format!("{name}: bin map (smoothed α=0.1)"),
-        &bin_map.patch_smoothed(&fp, 0.1),
+        &bin_map.patch_with(
+            &fp,
+            &brdf::glint::binmap::PatchOptions {
+                smoothing_alpha: 0.1,
+            },
+            None,
+        ),
         settings,
         &mut rows,
     );

@@ -9,9 +9,9 @@
 
 use super::pndf_images::{CENTER, disk_image_of, maps, sheet};
 use super::{Artifact, Res, save_rgb};
+use brdf::glint::mixture::MixtureParams;
 use brdf::glint::{
-    BeckmannMixture, Footprint, GlintNdf, HemisphereBins, Kernel, MixtureParams, binned_pndf,
-    tv_distance,
+    BeckmannMixture, Footprint, GlintNdf, HemisphereBins, Kernel, binned_pndf, tv_distance,
 };
 use brdf::ndf::Ndf;
 use std::path::Path;

@@ -13,10 +13,10 @@ use super::orb::{
     load_map, reference_noise, render_glint_evals, render_naive, render_references,
 };
 use super::{Artifact, Res, register_font, save_rgb};
-use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, GlintModel, MixtureParams, PatchOptions,
-    PositionNormalMap, PositionNormalParams,
-};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::{MixtureParams, PatchOptions};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, GlintModel, PositionNormalMap};
 use glam::Vec2;
 use indicatif::ProgressBar;
 use plotters::prelude::*;
@@ -83,7 +83,7 @@ struct Point {
     noise_a: f64,
 }
 
-const SIGMA_EPS: f32 = brdf::glint::DEFAULT_SIGMA_MIN;
+const SIGMA_EPS: f32 = brdf::glint::mixture::DEFAULT_SIGMA_MIN;
 const MAPS: [&str; 4] = ["scratched", "brushed", "bumpy", "flakes"];
 const EVALS: [u32; 3] = [1, 4, 16];
 

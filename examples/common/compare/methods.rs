@@ -7,10 +7,11 @@ use crate::common::Res;
 use brdf::MicrofacetBrdf;
 use brdf::bxdf::{Bxdf, Masking};
 use brdf::fresnel::NoFresnel;
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::{DEFAULT_LOD_LOBES, MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, DEFAULT_LOD_LOBES, Footprint, GlintNdf, MaskingMode,
-    MixtureParams, NormalMap, PatchOptions, PositionNormalBrdf, PositionNormalMap,
-    PositionNormalParams,
+    BeckmannMixture, BinMap, Footprint, GlintNdf, NormalMap, PositionNormalBrdf, PositionNormalMap,
 };
 use brdf::ndf::Ndf;
 use std::sync::Arc;
@@ -57,7 +58,7 @@ impl Method for Mixture {
         bytes as f64 / (w * h) as f64
     }
     fn with_patch(&self, footprint: &Footprint, f: &mut dyn FnMut(&(dyn Ndf + Sync))) {
-        f(&self.mix.patch_with(footprint, self.options))
+        f(&self.mix.patch_with(footprint, &self.options, None))
     }
 }
 
@@ -125,7 +126,11 @@ impl Method for BinMapMethod {
     fn with_patch(&self, footprint: &Footprint, f: &mut dyn FnMut(&(dyn Ndf + Sync))) {
         match self.smoothing {
             None => f(&self.map.patch(footprint)),
-            Some(a) => f(&self.map.patch_smoothed(footprint, a)),
+            Some(a) => f(&self.map.patch_with(
+                footprint,
+                &brdf::glint::binmap::PatchOptions { smoothing_alpha: a },
+                None,
+            )),
         }
     }
 }

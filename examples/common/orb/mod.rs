@@ -111,7 +111,7 @@ impl Default for OrbOptions {
             tiles: Vec2::new(8.0, 4.0),
             spp: 512,
             naive_spp: 16,
-            sigma_eps: brdf::glint::DEFAULT_SIGMA_MIN,
+            sigma_eps: brdf::glint::mixture::DEFAULT_SIGMA_MIN,
             seed: 7,
             mixture_samples: 64,
             progress: true,

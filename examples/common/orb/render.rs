@@ -7,9 +7,12 @@ use super::scene::{Scene, ShadingPoint};
 use crate::common::Res;
 use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf};
 use brdf::fresnel::Fresnel;
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintNdf, Kernel, MaskingMode, MixtureParams,
-    MixturePatch, NormalMap, PatchOptions, PositionNormalMap, PositionNormalParams, footprint_brdf,
+    BeckmannMixture, BinMap, Footprint, GlintNdf, Kernel, MixturePatch, NormalMap,
+    PositionNormalMap, footprint_brdf,
 };
 use glam::{Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -258,8 +261,19 @@ impl GlintNdf for MixtureVariant<'_> {
     where
         Self: 'b;
 
-    fn patch(&self, footprint: &Footprint) -> MixturePatch<'_> {
-        self.mixture.patch_with(footprint, self.options)
+    type Options = PatchOptions;
+
+    fn options(&self) -> PatchOptions {
+        self.options
+    }
+
+    fn patch_with<'b>(
+        &'b self,
+        footprint: &Footprint,
+        options: &PatchOptions,
+        scratch: Option<&'b mut brdf::glint::GlintScratch>,
+    ) -> MixturePatch<'b> {
+        self.mixture.patch_with(footprint, options, scratch)
     }
 }
 

@@ -6,9 +6,10 @@ use super::{Camera, Image, Material, PointLight, Scene, Sky, render};
 use crate::common::{Artifact, Res, save_rgb};
 use brdf::bxdf::MicrofacetBrdf;
 use brdf::fresnel::{ConductorFresnel, DielectricFresnel};
+use brdf::glint::mixture::{MixtureParams, PatchOptions};
 use brdf::glint::{
-    BeckmannMixture, FlakesParams, GlintModel, MixtureParams, NormalMap, NormalRepair,
-    PatchOptions, ScratchedParams, TangentConvention, flakes, scratched,
+    BeckmannMixture, FlakesParams, GlintModel, NormalMap, NormalRepair, ScratchedParams,
+    TangentConvention, flakes, scratched,
 };
 use brdf::{Ggx, Lambert, Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
