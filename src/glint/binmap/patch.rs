@@ -93,7 +93,7 @@ const SMOOTH_TAIL: f64 = 1e-6;
 /// moment mip chain at the footprint centre and radius ½√|A|, σ floored at `sigma_min`), whose
 /// first two slope moments approximate the footprint's (second moments raised by σ² for the
 /// smoothed variant). See docs/binmap.md and the white furnace in
-/// tests/binmap.rs. The lobe's V is replaced by Scarf's moment bound
+/// tests/binmap_furnace.rs. The lobe's V is replaced by Scarf's moment bound
 /// ([`BinMapPatch::moment_bound_visible_area`]) and A by its signed projected area, so Λ is
 /// conservative (a Gaussian's V can be below a spiky distribution's with the same moments).
 ///
@@ -768,7 +768,7 @@ impl<'a> ExactMasking<'a> {
 ///    sub-cell (a few k of them).
 ///
 /// An upper bound of V is a lower bound of G1 = A/V: the BRDF may lose a little energy at grazing
-/// angles but never creates any (the white furnace in tests/robustness.rs and tests/binmap.rs).
+/// angles but never creates any (the white furnace in tests/robustness_energy.rs and tests/binmap_furnace.rs).
 #[inline]
 fn visible_part(bins: &HemisphereBins, b: &PatchBin, w: Vec3, refine: bool) -> f32 {
     let f = &b.facet;
