@@ -10,10 +10,10 @@ mod support;
 use brdf::bxdf::Masking;
 use brdf::frame::slope_to_normal;
 use brdf::fresnel::NoFresnel;
+use brdf::glint::binmap::{BinLookup, BinMapParams};
 use brdf::glint::{
-    BinLookup, BinMap, BinMapParams, BinMapPatch, FlakesParams, Footprint, GlintNdf,
-    HemisphereBins, Kernel, NormalMap, ScratchedParams, binned_pndf, bumpy, flakes, scratched,
-    tv_distance,
+    BinMap, BinMapPatch, FlakesParams, Footprint, GlintNdf, HemisphereBins, Kernel, NormalMap,
+    ScratchedParams, binned_pndf, bumpy, flakes, scratched, tv_distance,
 };
 use brdf::ndf::Ndf;
 use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
@@ -21,6 +21,20 @@ use proptest::prelude::*;
 use rand::RngExt;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use support::chi2::Chi2;
+
+/// The smoothed patch through the one query path (`patch_with` and the bin map's options).
+trait Smoothed {
+    fn patch_smoothed(&self, fp: &Footprint, alpha: f32) -> BinMapPatch<'_>;
+}
+
+impl Smoothed for BinMap {
+    fn patch_smoothed(&self, fp: &Footprint, alpha: f32) -> BinMapPatch<'_> {
+        let options = brdf::glint::binmap::PatchOptions {
+            smoothing_alpha: alpha,
+        };
+        self.patch_with(fp, &options, None)
+    }
+}
 
 /// Parameters with one element per texel (s = 1), so that element indices are texel indices.
 fn params(n: usize, leaf: usize, lookup: BinLookup) -> BinMapParams {

@@ -6,7 +6,8 @@ mod support;
 
 use brdf::bxdf::{Bxdf, LayeredBrdf, MicrofacetBrdf};
 use brdf::fresnel::{ConductorFresnel, Fresnel, NoFresnel, SchlickFresnel};
-use brdf::glint::{BeckmannMixture, Footprint, GlintNdf, MixtureParams};
+use brdf::glint::mixture::MixtureParams;
+use brdf::glint::{BeckmannMixture, Footprint, GlintNdf};
 use brdf::ndf::{Ggx, Ndf};
 use brdf::{Vec2, Vec3};
 use rand::RngExt;

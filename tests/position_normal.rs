@@ -12,14 +12,29 @@
 mod support;
 
 use brdf::fresnel::NoFresnel;
+use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    Footprint, GlintNdf, NormalMap, PositionNormalBrdf, PositionNormalMap, PositionNormalParams,
-    PositionNormalPatch,
+    Footprint, GlintNdf, NormalMap, PositionNormalBrdf, PositionNormalMap, PositionNormalPatch,
 };
 use brdf::ndf::{Beckmann, Ndf};
 use brdf::{Bxdf, Error, MicrofacetBrdf, Vec2, Vec3};
 use rand::RngExt;
 use support::chi2::Chi2;
+
+/// A patch with an explicit query cap, through the one query path (`patch_with` and the model's
+/// options).
+trait WithCap {
+    fn patch_with_cap(&self, fp: &Footprint, cap: f32) -> PositionNormalPatch<'_>;
+}
+
+impl WithCap for PositionNormalMap {
+    fn patch_with_cap(&self, fp: &Footprint, cap: f32) -> PositionNormalPatch<'_> {
+        let options = brdf::glint::position_normal::PatchOptions {
+            max_query_texels: cap,
+        };
+        self.patch_with(fp, &options, None)
+    }
+}
 
 /// White-noise slopes, uniform in [−a, a]².
 fn noise(n: usize, a: f32, seed: u64) -> NormalMap {

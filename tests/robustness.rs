@@ -16,10 +16,12 @@ use brdf::bxdf::{
     BlinnPhongNormalization, Masking, OriginalPhongNormalization, PhongNormalization, Sampling,
 };
 use brdf::fresnel::{ConductorFresnel, DielectricFresnel, NoFresnel, SchlickFresnel};
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, BinMapParams, Footprint, GlintNdf, MaskingMode, MixtureParams,
-    NormalMap, NormalRepair, PatchOptions, PositionNormalBrdf, PositionNormalMap,
-    PositionNormalParams, TangentConvention,
+    BeckmannMixture, BinMap, BinMapPatch, Footprint, GlintNdf, NormalMap, NormalRepair,
+    PositionNormalBrdf, PositionNormalMap, TangentConvention,
 };
 use brdf::ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
 use brdf::{
@@ -27,6 +29,20 @@ use brdf::{
 };
 use proptest::prelude::*;
 use support::totality::{check_bxdf, check_ndf};
+
+/// The smoothed bin-map patch through the one query path (`patch_with` and the bin map's options).
+trait Smoothed {
+    fn patch_smoothed(&self, fp: &Footprint, alpha: f32) -> BinMapPatch<'_>;
+}
+
+impl Smoothed for BinMap {
+    fn patch_smoothed(&self, fp: &Footprint, alpha: f32) -> BinMapPatch<'_> {
+        let options = brdf::glint::binmap::PatchOptions {
+            smoothing_alpha: alpha,
+        };
+        self.patch_with(fp, &options, None)
+    }
+}
 
 // ---------------------------------------------------------------------------------------------
 // Strategies
@@ -400,7 +416,7 @@ proptest! {
         let pn = PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap();
         let (mix, mix_approx, bins, smoothed, pnp) = (
             mixture.patch(&footprint),
-            mixture.patch_with(&footprint, approximate),
+            mixture.patch_with(&footprint, &approximate, None),
             bin_map.patch(&footprint),
             bin_map.patch_smoothed(&footprint, smoothing),
             pn.patch(&footprint),

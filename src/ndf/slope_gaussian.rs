@@ -421,14 +421,20 @@ impl SlopeGaussian {
         (!ln_d.is_nan()).then_some(ln_d)
     }
 
-    /// ln(⟨wo, m⟩ D(m) / V(wo)) in `f64`, or `None` outside the visible support (including where D
-    /// itself rounds to 0 in `f32`: the pdf is 0 wherever [`Ndf::d`] is).
-    fn ln_pdf_visible(&self, wo: Vec3, m: Vec3) -> Option<f64> {
+    /// ln D_wo(m) = ln(⟨wo, m⟩ D(m) / V(wo)) in `f64`, or `None` outside the visible support
+    /// (m below the horizon, ⟨wo, m⟩ ≤ 0 as `wo.dot(m)` rounds it, invalid wo).
+    ///
+    /// Finite on the whole support, also where D and V both underflow `f32` (grazing views of a
+    /// lobe tilted away: the visible normals then lie tens of σ out), where [`Ndf::pdf_visible`]
+    /// is 0 because D is: for references and tests that follow the visible sampler into that tail.
+    pub fn ln_pdf_visible(&self, wo: Vec3, m: Vec3) -> Option<f64> {
+        self.ln_d_and_pdf_visible(wo, m).map(|(_, l)| l)
+    }
+
+    /// (ln D(m), ln D_wo(m)) in `f64` (see [`SlopeGaussian::ln_pdf_visible`]).
+    fn ln_d_and_pdf_visible(&self, wo: Vec3, m: Vec3) -> Option<(f64, f64)> {
         let t = self.view_terms(wo)?;
         let ln_d = self.ln_d(m)?;
-        if d_of_ln(ln_d) == 0.0 {
-            return None;
-        }
         let c = facing(wo, m);
         if c.is_nan() || c <= 0.0 {
             return None;
@@ -441,7 +447,7 @@ impl SlopeGaussian {
             return None;
         };
         let ln_pdf = c.ln() + ln_d - ln_v;
-        (!ln_pdf.is_nan()).then_some(ln_pdf)
+        (!ln_pdf.is_nan()).then_some((ln_d, ln_pdf))
     }
 }
 
@@ -553,18 +559,23 @@ impl Ndf for SlopeGaussian {
         ensure_facing(wo, m)
     }
 
-    /// D_wo(m) = ⟨wo, m⟩⁺ D(m) / V(wo), formed in `f64` logarithms so that it stays finite and
-    /// positive where D and V both underflow (grazing views of lobes tilted away).
+    /// D_wo(m) = ⟨wo, m⟩⁺ D(m) / V(wo), formed in `f64` logarithms so that it stays finite where V
+    /// underflows `f32` (grazing views of lobes tilted away).
     ///
-    /// 0 outside the visible set (m below the horizon or ⟨wo, m⟩ ≤ 0), wherever [`Ndf::d`] is 0 and
-    /// for invalid wo. Inside it,
-    /// values below `f32::MIN_POSITIVE` are returned as `f32::MIN_POSITIVE` (the density is positive
-    /// there; a caller testing pdf > 0 for "in the support" stays right) and values above `f32::MAX`
-    /// as `f32::MAX`.
+    /// 0 outside the visible set (m below the horizon or ⟨wo, m⟩ ≤ 0), for invalid wo, and wherever
+    /// [`Ndf::d`] is 0 (the density contract of every NDF: no density where D rounds to 0 in `f32`,
+    /// even where the `f64` density is positive, as tens of σ out at grazing views of a lobe tilted
+    /// away: the visible sampler may then return normals whose pdf is 0, and
+    /// [`SlopeGaussian::ln_pdf_visible`] gives their `f64` density). Elsewhere, values below
+    /// `f32::MIN_POSITIVE` are returned as `f32::MIN_POSITIVE` (the density is positive there; a
+    /// caller testing pdf > 0 for "in the support" stays right) and values above `f32::MAX` as
+    /// `f32::MAX`.
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
-        match self.ln_pdf_visible(wo, m) {
-            Some(l) => (l.exp() as f32).clamp(f32::MIN_POSITIVE, f32::MAX),
-            None => 0.0,
+        match self.ln_d_and_pdf_visible(wo, m) {
+            Some((ln_d, l)) if d_of_ln(ln_d) > 0.0 => {
+                (l.exp() as f32).clamp(f32::MIN_POSITIVE, f32::MAX)
+            }
+            _ => 0.0,
         }
     }
 }
