@@ -27,5 +27,6 @@ pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
 };
 pub use procedural::{
-    BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
+    BrushedParams, FlakesParams, MAX_CARVE_WORK_PER_TEXEL, MAX_GENERATED_TEXELS, MIN_CELL_TEXELS,
+    ScratchedParams, brushed, bumpy, flakes, scratched,
 };
