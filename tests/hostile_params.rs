@@ -399,3 +399,87 @@ proptest! {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Image decoding: a small file claiming a huge image
+// ---------------------------------------------------------------------------------------------
+
+/// CRC-32 (ISO-HDLC, as PNG chunks use), bitwise.
+#[cfg(feature = "image")]
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in bytes {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 {
+                (c >> 1) ^ 0xEDB8_8320
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
+}
+
+/// A valid w × 1 RGB PNG whose header is rewritten to claim w × `height` (the data stays one row).
+#[cfg(feature = "image")]
+fn png_claiming(w: u32, height: u32) -> Vec<u8> {
+    let img = image::RgbImage::from_pixel(w, 1, image::Rgb([128, 128, 255]));
+    let mut bytes = Vec::new();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .unwrap();
+    // Signature (8), IHDR length (4), "IHDR" (4), width (4), height (4) …, CRC after 13 data bytes.
+    bytes[20..24].copy_from_slice(&height.to_be_bytes());
+    let crc = crc32(&bytes[12..29]);
+    bytes[29..33].copy_from_slice(&crc.to_be_bytes());
+    bytes
+}
+
+/// The file: a ~1 KB PNG claiming 32 × 2²⁰ texels made the decoder allocate 128 MiB
+/// (under the image crate's 512 MiB limit). It is now refused from its header, naming the cap; a
+/// caller who wants such maps raises `ImageOptions::max_texels`.
+#[cfg(feature = "image")]
+#[test]
+fn image_claiming_millions_of_texels_is_refused_from_its_header() {
+    use brdf::glint::{DEFAULT_MAX_IMAGE_TEXELS, ImageOptions};
+    let bytes = png_claiming(32, 1 << 20);
+    assert!(bytes.len() < 2048, "{} bytes", bytes.len());
+    let e = NormalMap::from_image_bytes_with(&bytes, "claims 32×2^20", &ImageOptions::default())
+        .unwrap_err();
+    assert!(
+        matches!(e, Error::Image { .. }) && e.to_string().contains("max_texels"),
+        "{e}"
+    );
+    assert!(32 << 20 > DEFAULT_MAX_IMAGE_TEXELS);
+    // Within the cap the same header passes the check and the decoder reports the missing rows.
+    let small = png_claiming(32, 4);
+    let e = NormalMap::from_image_bytes_with(&small, "claims 32×4", &ImageOptions::default())
+        .unwrap_err();
+    assert!(!e.to_string().contains("max_texels"), "{e}");
+    // A genuine one-row map loads; a cap of 0 is refused.
+    let ok = png_claiming(32, 1);
+    NormalMap::from_image_bytes_with(&ok, "32×1", &ImageOptions::default()).unwrap();
+    let e = NormalMap::from_image_bytes_with(
+        &ok,
+        "32×1",
+        &ImageOptions {
+            max_texels: 0,
+            ..ImageOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("max_texels"), "{e}");
+    let e = NormalMap::from_image_bytes_with(
+        &ok,
+        "32×1",
+        &ImageOptions {
+            max_texels: 31,
+            ..ImageOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("max_texels"), "{e}");
+}

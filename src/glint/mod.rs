@@ -102,8 +102,8 @@ pub use surface::{
 };
 #[cfg(feature = "image")]
 pub use surface::{
-    DEFAULT_LENGTH_TOLERANCE, FloatEncoding, ImageDecoding, ImageOptions, MAX_IMPLAUSIBLE_FRACTION,
-    RAW_EVIDENCE_BELOW,
+    DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, ImageDecoding, ImageOptions,
+    MAX_IMPLAUSIBLE_FRACTION, RAW_EVIDENCE_BELOW,
 };
 pub use truth::{
     BinMasses, BinnedPndf, DEFAULT_MAX_QUADRATURE, DEFAULT_QUADRATURE_TOLERANCE, FootprintBrdf,
