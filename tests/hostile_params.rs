@@ -98,7 +98,7 @@ fn sweep(cases: u32, f: impl Fn(f32) -> Result<(), TestCaseError>) {
         f(v).unwrap();
     }
     TestRunner::new(support::proptest_config(cases))
-        .run(&any_f32(), |v| f(v))
+        .run(&any_f32(), f)
         .unwrap();
 }
 
@@ -453,7 +453,7 @@ fn image_claiming_millions_of_texels_is_refused_from_its_header() {
         matches!(e, Error::Image { .. }) && e.to_string().contains("max_texels"),
         "{e}"
     );
-    assert!(32 << 20 > DEFAULT_MAX_IMAGE_TEXELS);
+    const { assert!(32 << 20 > DEFAULT_MAX_IMAGE_TEXELS) };
     // Within the cap the same header passes the check and the decoder reports the missing rows.
     let small = png_claiming(32, 4);
     let e = NormalMap::from_image_bytes_with(&small, "claims 32×4", &ImageOptions::default())

@@ -17,10 +17,11 @@ use std::f32::consts::TAU;
 /// exact in `f32` for p ≥ ½, so `uc < p` and the mixture pdf p pdf_s + (1 − p) pdf_d agree.
 #[inline]
 pub(crate) fn lobe_probability(d: f32, s: f32) -> f32 {
-    if !(d + s > 0.0) {
+    let total = d + s;
+    if total.is_nan() || total <= 0.0 {
         return 0.5;
     }
-    let p = s / (d + s);
+    let p = s / total;
     if d > 0.0 && s > 0.0 {
         p.clamp(f32::EPSILON / 2.0, 1.0 - f32::EPSILON / 2.0)
     } else {
