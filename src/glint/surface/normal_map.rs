@@ -109,7 +109,8 @@ pub(crate) fn texel_count(width: usize, height: usize, len: usize) -> Result<usi
 /// The slope of one unit-ish normal, validated (finite, z > 0, |slope| ≤ MAX_SLOPE) after an optional
 /// z repair. `Err(reason)` says what is wrong.
 ///
-/// Any non-zero finite vector is accepted, however short or long: it is normalised by
+/// Any non-zero finite vector is accepted, however short or long: its slope −(x, y)/z does not
+/// depend on its length, and where the repair needs the unit vector it is normalised by
 /// [`normalize_robust`] (scaled by its largest component first, so that a length of 10⁻³⁰ or 10³⁰
 /// does not underflow or overflow its square). Under [`NormalRepair::ClampZ`] the slope magnitude is
 /// at most √(x² + y²) / min_z ≤ 1 / min_z ≤ [`MAX_SLOPE`] in exact arithmetic, and a rounding excess
@@ -121,9 +122,12 @@ pub(crate) fn repaired_slope(n: Vec3, repair: NormalRepair) -> std::result::Resu
     let Some(u) = normalize_robust(n) else {
         return Err("zero-length normal".to_string());
     };
+    // The slope −(x, y)/z does not depend on the length: it is taken from `n` itself (exact to one
+    // rounding) unless the repair raises z, which needs the unit vector.
     let (n, clamp) = match repair {
-        NormalRepair::Reject => (u, false),
-        NormalRepair::ClampZ(min_z) => (Vec3::new(u.x, u.y, u.z.max(min_z)), true),
+        NormalRepair::Reject => (n, false),
+        NormalRepair::ClampZ(min_z) if u.z < min_z => (Vec3::new(u.x, u.y, min_z), true),
+        NormalRepair::ClampZ(_) => (n, true),
     };
     if n.z <= 0.0 {
         return Err(format!(
