@@ -93,8 +93,10 @@ pub fn dielectric(cos_theta_i: f32, eta: f32) -> f32 {
 /// from outside.
 ///
 /// Degenerate cases: `cos_theta_i` is clamped into [0, 1] (light cannot arrive from inside a
-/// conductor; a negative cosine counts as grazing, F = 1); grazing incidence gives 1; a NaN cosine
-/// gives 0; per channel, η NaN, infinite or ≤ 0, or κ NaN, infinite or < 0, gives 0.
+/// conductor; a negative cosine counts as grazing, F = 1); grazing incidence gives 1, except for the
+/// index-matched channel η = 1, κ = 0, which gives 0 at every angle as [`dielectric`] does (there is
+/// no interface); a NaN cosine gives 0; per channel, η NaN, infinite or ≤ 0, or κ NaN, infinite or
+/// < 0, gives 0.
 ///
 /// # Reference
 /// \[BornWolf1999\], §14.2 (reflection at a metal: Fresnel's formulae with a complex index); the a², b²
@@ -122,14 +124,18 @@ pub fn conductor(cos_theta_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
     let t3 = a2_plus_b2 * cos2 + Vec3A::splat(sin2 * sin2);
     let t4 = t2 * sin2;
     let r = (t1 - t2) / (t1 + t2) * (t3 / (t3 + t4));
-    // NaN only from 0/0 at grazing incidence with a² + b² = 0 (κ = 0, η = 1) or from overflow of
-    // the squares for |η + iκ| ≳ 1e19: both have the limit 1.
+    // NaN only from 0/0 at grazing incidence with a² + b² = 0 (κ = 0, η = 1: index-matched, set to
+    // 0 below) or from overflow of the squares for |η + iκ| ≳ 1e19 (limit 1).
     let r = Vec3A::select(r.cmpeq(r), r, Vec3A::ONE);
     let r = r.max(Vec3A::ZERO).min(Vec3A::ONE);
+    // The index-matched channel (η = 1, κ = 0) reflects nothing; its formula is exactly 0 except
+    // for the 0/0 at grazing incidence mapped to 1 above.
+    let matched = eta.cmpeq(Vec3A::ONE) & k.cmpeq(Vec3A::ZERO);
     let valid = eta.cmpgt(Vec3A::ZERO)
         & eta.cmplt(Vec3A::INFINITY)
         & k.cmpge(Vec3A::ZERO)
         & k.cmplt(Vec3A::INFINITY)
+        & !matched
         & BVec3A::splat(!cos_theta_i.is_nan());
     Vec3::from(Vec3A::select(valid, r, Vec3A::ZERO))
 }
@@ -426,8 +432,10 @@ mod tests {
             conductor(-0.5, Vec3::splat(0.2), Vec3::splat(3.0)),
             Vec3::ONE
         );
-        // κ = 0, η = 1 at grazing incidence: 0/0 in the closed form, limit 1.
-        assert_eq!(conductor(0.0, Vec3::ONE, Vec3::ZERO), Vec3::ONE);
+        // κ = 0, η = 1 at grazing incidence: 0/0 in the closed form; the index-matched channel
+        // has no interface and reflects nothing, as the dielectric (η = 1) does.
+        assert_eq!(conductor(0.0, Vec3::ONE, Vec3::ZERO), Vec3::ZERO);
+        assert_eq!(dielectric(0.0, 1.0), 0.0);
         assert_eq!(schlick(Vec3::splat(0.04), 0.0), Vec3::ONE);
         assert_eq!(schlick(Vec3::splat(0.04), 1.0), Vec3::splat(0.04));
     }

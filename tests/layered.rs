@@ -146,11 +146,10 @@ fn glint_over_base_conserves_energy_and_agrees_with_itself() {
 /// Chi-square of the layered sampler against its pdf: an anisotropic analytic coat at three views
 /// and an isotropic one at 89°, and a glint coat (mixture patch of a few lobes) at two.
 ///
-/// Why not the anisotropic coat at 89°: at φo = 30° its reflected lobe is a sliver 2-3 cells wide in
-/// φ at the horizon, and the harness's 6 × 6 Gauss-Legendre rule per cell mis-integrates it — the bare
-/// `MicrofacetBrdf` (no layering) fails there the same way (χ² = 3977 for 3085 dof; Beckmann 4:1
-/// worse), while the NDF-level grid of tests/ndf_centred_sampling.rs, which warps the lobe onto the cells,
-/// passes: a limit of the harness, not of the sampler.
+/// The anisotropic coat at 89° is in tests/grazing_chi2.rs: at φo = 30° its reflected lobe is a
+/// sliver 2-3 cells wide in φ at the horizon, which a fixed 6 × 6 rule per cell mis-integrates
+/// (χ² = 3977 for 3085 dof, the bare `MicrofacetBrdf` too); the harness's adaptive rule
+/// (tests/support/chi2.rs) integrates it as a 48 × 48 rule does, and the sampler passes.
 #[test]
 fn chi_square_of_the_layered_sampler() {
     let schlick = SchlickFresnel::new(Vec3::splat(0.04)).unwrap();

@@ -70,8 +70,11 @@ proptest! {
 
         let v = g.sample_visible(wo, u);
         prop_assert!(v.z > 0.0 && (v.length() - 1.0).abs() < 1e-6, "{v}");
+        // Positive wherever D is (pdf_visible is 0 where D underflows f32; the f64 density is
+        // positive on the whole visible support).
         let p = g.pdf_visible(wo, v);
-        prop_assert!(p > 0.0 && p.is_finite(), "pdf_visible({wo}, {v}) = {p}");
+        prop_assert!(p.is_finite() && (p > 0.0) == (g.d(v) > 0.0), "pdf_visible({wo}, {v}) = {p}");
+        prop_assert!(g.ln_pdf_visible(wo, v).is_some_and(f64::is_finite), "{wo} {v}");
     }
 }
 

@@ -254,7 +254,14 @@ fn chi2_sample_visible() {
             }
             .run(
                 |_, u| Some(wh.to_omega(g.sample_visible(wo, u))),
-                |w| wh.pdf_omega(w, |m| g.pdf_visible(wo, m)),
+                // The f64 density: the f32 `pdf_visible` is 0 where D underflows f32, which the
+                // lobes viewed from behind (a ≈ −15) reach.
+                |w| {
+                    wh.pdf_omega(w, |m| {
+                        g.ln_pdf_visible(wo, m)
+                            .map_or(0.0, |l| (l.exp() as f32).min(f32::MAX))
+                    })
+                },
             )
             .err()
         })

@@ -6,7 +6,7 @@
 //! empirical form without masking or the 1/(4 cos cos) factor.
 
 use super::lambert::unit_rgb;
-use super::lobe::{cosine_power, sample_cosine_power};
+use super::lobe::{cosine_power, lobe_probability, sample_cosine_power};
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::{Error, Result, non_negative};
 use crate::frame::{half_vector, half_vector_cos, is_upper, reflect};
@@ -132,7 +132,7 @@ impl BlinnPhongLobe {
     fn p_spec(&self) -> f32 {
         let d = self.rho_d.element_sum() / 3.0;
         let s = self.rho_s.element_sum() / 3.0 * self.lobe_albedo_max;
-        if d + s > 0.0 { s / (d + s) } else { 0.5 }
+        lobe_probability(d, s)
     }
 }
 

@@ -9,6 +9,26 @@ use crate::frame::Frame;
 use glam::{Vec2, Vec3};
 use std::f32::consts::TAU;
 
+/// The probability s / (d + s) of choosing the specular lobe of a diffuse + specular mixture with
+/// weights d, s ≥ 0 (½ when both vanish, where f = 0 anyway), kept within
+/// [2⁻²⁴, 1 − 2⁻²⁴] when both are positive: s / (d + s) rounds to exactly 1 (or 0) in `f32` once
+/// one weight is below 6·10⁻⁸ of the other (the diffuse weight ρ_d (1 − F) of a Schlick-Fresnel
+/// Phong at cos θo = 10⁻⁷), and a lobe chosen with probability 0 has pdf 0 where f > 0. 1 − p is
+/// exact in `f32` for p ≥ ½, so `uc < p` and the mixture pdf p pdf_s + (1 − p) pdf_d agree.
+#[inline]
+pub(crate) fn lobe_probability(d: f32, s: f32) -> f32 {
+    let total = d + s;
+    if total.is_nan() || total <= 0.0 {
+        return 0.5;
+    }
+    let p = s / total;
+    if d > 0.0 && s > 0.0 {
+        p.clamp(f32::EPSILON / 2.0, 1.0 - f32::EPSILON / 2.0)
+    } else {
+        p
+    }
+}
+
 /// The lobe value max(0, c)^γ, with 0^0 = 0 so that the lobe's support is exactly c > 0.
 #[inline]
 pub(crate) fn cosine_power(c: f32, gamma: f32) -> f32 {

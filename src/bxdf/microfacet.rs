@@ -28,6 +28,36 @@
 //!
 //! The denominator of the second form equals A_o A_i (1 + Λ_o + Λ_i) ≥ 0 and stays positive when one
 //! of A_o, A_i vanishes while the corresponding V does not.
+//!
+//! ## Sample weights
+//! With visible-normal sampling the pdf of wi is D_wo(h) / (4 wo·h) with D_wo(h) = ⟨wo, h⟩ D(h) / V_o,
+//! so the weight f cos θi / pdf = F · M A_i V_o = F · V_o A_i / (V_o A_i + A_o (V_i − A_i)) ≤ F
+//! (height-correlated; F A_i / V_i ≤ F separable): F G2 / G1(wo), whatever h is. It holds in
+//! floating point only if the factor ⟨wo, h⟩ of the density and the Jacobian's wo·h are the same
+//! number. At grazing views a micronormal nearly perpendicular to wo reflects wo to wi ≈ −wo, and h
+//! rebuilt from wo + wi is then off by up to ~6·10⁻⁸ / (2 wo·m) radians (the rounding of wi against
+//! the tiny sum); wo·h, a difference of terms of size 1, is off by as much, so any other cosine
+//! (the accurate ‖wo + wi‖/2, say) disagrees with it by a factor that grows like 1/(wo·m)²: the
+//! weight reached 880 at cos θo = 10⁻⁷ and 8.8·10¹⁵ at 10⁻²⁰ for Beckmann before this was written
+//! so. The Jacobian therefore uses `wo.dot(h)` in `f32`, as the NDFs' `pdf_visible` does (every NDF
+//! and patch of the crate computes ⟨wo, m⟩ as `wo.dot(m)`; an [`Ndf`] of a caller's that rounds it
+//! otherwise gets a weight off by ~10⁻⁷ / ⟨wo, m⟩), and [`MicrofacetBrdf::eval`] and
+//! [`MicrofacetBrdf::pdf`] are 0 where the computed wo·h or wi·h is not positive. The weight is then
+//! F · G2/G1(wo) ≤ F up to a few ulps and up to the ratio of the normaliser of the NDF's
+//! `pdf_visible` to the `visible_area` its masking uses (1 for the analytic NDFs, ≤ 1 for patches
+//! whose masking uses an upper bound of V), for every view down to cos θo = 10⁻³⁰ and every u in
+//! [0, 1)² (tests/hostile_sampling.rs; measured ≤ 1 + 10⁻⁶ for the analytic NDFs and the mixture,
+//! ≤ 1 + 6·10⁻⁶ for the position-normal and smoothed bin-map patches; the unsmoothed bin map's
+//! visible sampler, which draws ⟨wo, m⟩ bilinearly in each bin, reaches 1.71 F in bins that wo's
+//! horizon cuts).
+//!
+//! With normal sampling the pdf is D(h) cos θh / (4c), c = ‖wo + wi‖/2, and the weight is
+//! F · M A_i c / cos θh ≤ F (wo·h) / (V_o cos θh): not bounded by F (it grows as cos θh → 0, the
+//! reason visible-normal sampling is the default), but equal to that expression to rounding.
+//!
+//! A micronormal density below `f32::MIN_POSITIVE` (subnormal) is taken as 0 (`pdf` = 0, `sample`
+//! → `None`): subnormals carry too few digits for the weight to be right. There, and only there,
+//! `eval` may be positive where `pdf` is 0.
 
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::frame::{half_vector_cos, is_upper, reflect};
@@ -73,18 +103,20 @@ pub enum Sampling {
 /// the albedo is below 1 for rough surfaces even with F = 1 (energy lost by masking, tabulated in
 /// docs/results.md).
 ///
-/// Sampling: draw m ([`Sampling`]), wi = reflect(wo, m), pdf = p_m(m) / (4 |wo·m|) (the Jacobian of
-/// reflection, \[Walter2007\] eq. 14). `None` when wo·m ≤ 0 or wi is below the horizon; the pdf is then the
+/// Sampling: draw m ([`Sampling`]), wi = reflect(wo, m), pdf = p_m(h) / (4 wo·h) at the h rebuilt from
+/// wi (the Jacobian of reflection, \[Walter2007\] eq. 14; module docs, "Sample weights", for which
+/// cosine). `None` when wo·m ≤ 0 or wi is below the horizon; the pdf is then the
 /// density of the directions that are produced (it integrates to less than 1 over the hemisphere).
+/// The weight f cos θi / pdf is F G2/G1(wo) ≤ F with visible normals at every view (module docs).
 ///
 /// # Reference
 /// \[TorranceSparrow1967\]; \[CookTorrance1982\]; \[Walter2007\] eq. 20; \[Heitz2014\] eq. 99;
 /// \[Chermain2019\] eq. 7.
 ///
 /// # Degenerate cases
-/// `wo`, `wi` not strictly above the horizon, zero-length or non-finite, wo = −wi, wo·h ≤ 0, V or the
-/// masking denominator not positive: f = 0, pdf = 0, `sample` → `None`. Values that overflow f32 are
-/// returned as 0.
+/// `wo`, `wi` not strictly above the horizon, zero-length or non-finite, wo = −wi, wo·h ≤ 0 or wi·h ≤ 0
+/// as computed, V or the masking denominator not positive: f = 0, pdf = 0, `sample` → `None`. Values
+/// that overflow f32 are returned as 0; a subnormal micronormal density gives pdf 0 (module docs).
 ///
 /// # Example
 /// ```
@@ -180,25 +212,19 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
         }
     }
 
-    /// Density of the micronormal sampler at m.
+    /// The half vector of a valid reflection configuration, or `None`: both directions strictly
+    /// above the horizon and strictly in front of h (wo·h > 0 and wi·h > 0 as computed, so that f,
+    /// the pdf and the NDF's χ⁺(wo·m) agree on the support even where h is rounding noise).
     #[inline]
-    fn pdf_m(&self, wo: Vec3, m: Vec3) -> f32 {
-        match self.sampling {
-            Sampling::Normals => self.ndf.pdf_normal(m),
-            Sampling::VisibleNormals => self.ndf.pdf_visible(wo, m),
-        }
-    }
-
-    /// The half vector of a valid reflection configuration and wo·h, or `None`.
-    #[inline]
-    fn half(wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
+    fn half(wo: Vec3, wi: Vec3) -> Option<Half> {
         if !(is_upper(wo) && is_upper(wi)) {
             return None;
         }
         // c = ‖wo + wi‖/2 rather than wo·h: exact where wi → −wo (frame::half_vector_cos) and
-        // symmetric in (wo, wi), so F(c) and the Jacobian 1/(4c) stay reciprocal to the last bit.
+        // symmetric in (wo, wi), so F(c) stays reciprocal to the last bit.
         let (h, c) = half_vector_cos(wo, wi)?;
-        (c > 0.0).then_some((h, c))
+        let k = wo.dot(h);
+        (c > 0.0 && k > 0.0 && wi.dot(h) > 0.0).then_some(Half { h, c, k })
     }
 
     /// The renderer's-measure factor A(wi)/cos θi (with `ai` = A(wi)) that turns the patch BRDF f_P (normalised in the
@@ -217,42 +243,65 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
 
     /// f(wo, wi) in the renderer's measure: F · D/4 · M(wo, wi) · A(wi)/cos θi (module docs).
     #[inline]
-    fn eval_at(&self, wo: Vec3, wi: Vec3, h: Vec3, c: f32) -> Vec3 {
-        let d = self.ndf.d(h);
+    fn eval_at(&self, wo: Vec3, wi: Vec3, hv: &Half) -> Vec3 {
+        let d = self.ndf.d(hv.h);
         if d.is_nan() || d <= 0.0 {
             return Vec3::ZERO;
         }
         let ai = self.ndf.projected_area(wi);
         let scale = 0.25 * d * self.masking_factor_with(wo, wi, ai) * Self::measure_factor(wi, ai);
-        let v = self.fresnel.eval(c) * scale;
+        let v = self.fresnel.eval(hv.c) * scale;
         if v.is_finite() { v } else { Vec3::ZERO }
     }
 
+    /// The density of `sample` at the wi of `hv`: p_m(h) / (4 wo·h), the Jacobian of reflection
+    /// (\[Walter2007\] eq. 14) written with the cosine the micronormal density itself uses (module
+    /// docs, "Sample weights"): wo·h = `wo.dot(h)` for visible normals, whose density carries that
+    /// same factor, and c = ‖wo + wi‖/2 for normals drawn from D cos θ.
+    /// A micronormal density below `f32::MIN_POSITIVE` is subnormal (fewer than 23 significant
+    /// bits, none at all near 10⁻⁴⁵) and is taken as 0, so that every returned pdf is accurate
+    /// to f32 rounding and no sample is drawn where it is not.
     #[inline]
-    fn pdf_at(&self, wo: Vec3, h: Vec3, c: f32) -> f32 {
-        let p = self.pdf_m(wo, h) / (4.0 * c);
+    fn pdf_at(&self, wo: Vec3, hv: &Half) -> f32 {
+        let (pm, cos) = match self.sampling {
+            Sampling::Normals => (self.ndf.pdf_normal(hv.h), hv.c),
+            Sampling::VisibleNormals => (self.ndf.pdf_visible(wo, hv.h), hv.k),
+        };
+        if pm.is_nan() || pm < f32::MIN_POSITIVE {
+            return 0.0;
+        }
+        let p = pm / (4.0 * cos);
         if p.is_finite() && p > 0.0 { p } else { 0.0 }
     }
+}
+
+/// The half vector h = (wo + wi)/‖wo + wi‖ of a reflection configuration with its two cosines:
+/// c = ‖wo + wi‖/2 (accurate, symmetric: Fresnel and the normal sampler's Jacobian) and
+/// k = `wo.dot(h)` (the factor ⟨wo, m⟩ of the visible-normal density, rounded as NDFs round it).
+struct Half {
+    h: Vec3,
+    c: f32,
+    k: f32,
 }
 
 impl<D: Ndf, F: Fresnel> Bxdf for MicrofacetBrdf<D, F> {
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match Self::half(wo, wi) {
-            Some((h, c)) => self.eval_at(wo, wi, h, c),
+            Some(hv) => self.eval_at(wo, wi, &hv),
             None => Vec3::ZERO,
         }
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match Self::half(wo, wi) {
-            Some((h, c)) => self.pdf_at(wo, h, c),
+            Some(hv) => self.pdf_at(wo, &hv),
             None => 0.0,
         }
     }
 
     fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         match Self::half(wo, wi) {
-            Some((h, c)) => (self.eval_at(wo, wi, h, c), self.pdf_at(wo, h, c)),
+            Some(hv) => (self.eval_at(wo, wi, &hv), self.pdf_at(wo, &hv)),
             None => (Vec3::ZERO, 0.0),
         }
     }

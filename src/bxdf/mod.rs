@@ -98,15 +98,28 @@ impl BxdfSample {
             && f.is_finite()
             && wi.is_finite()
             && wi.z > 0.0
-            && (f * (wi.z / pdf)).is_finite();
+            && weight_of(f, wi, pdf).is_finite();
         usable.then_some(BxdfSample { wi, f, pdf, flags })
     }
 
-    /// The Monte Carlo weight f · cos θ_i / pdf.
+    /// The Monte Carlo weight f · cos θ_i / pdf, formed in `f64` so that it is correctly rounded
+    /// even where cos θi / pdf alone would leave f32's normal range (cos θi ~ 10⁻²³ at grazing
+    /// views, where that quotient is subnormal and loses most of its digits).
     #[inline]
     pub fn weight(&self) -> Vec3 {
-        self.f * (self.wi.z.max(0.0) / self.pdf)
+        weight_of(self.f, self.wi, self.pdf)
     }
+}
+
+/// f · max(cos θi, 0) / pdf per channel, in `f64`, rounded once to `f32`.
+#[inline]
+fn weight_of(f: Vec3, wi: Vec3, pdf: f32) -> Vec3 {
+    let s = wi.z.max(0.0) as f64 / pdf as f64;
+    Vec3::new(
+        (f.x as f64 * s) as f32,
+        (f.y as f64 * s) as f32,
+        (f.z as f64 * s) as f32,
+    )
 }
 
 /// A BRDF in the local shading frame.

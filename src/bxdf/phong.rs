@@ -12,7 +12,7 @@
 //! integrates to less than 1 when part of the specular lobe is below the horizon).
 
 use super::lambert::unit_rgb;
-use super::lobe::{cosine_power, pdf_cosine_power, sample_cosine_power_about};
+use super::lobe::{cosine_power, lobe_probability, pdf_cosine_power, sample_cosine_power_about};
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::{Error, Result, non_negative};
 use crate::frame::is_upper;
@@ -49,12 +49,11 @@ fn check_sum(rho_d: Vec3, rho_s: Vec3) -> Result<()> {
 }
 
 /// Probability of choosing the specular lobe: s / (d + s) with d, s the mean diffuse and specular
-/// weights (½ when both vanish, where f = 0 anyway).
+/// weights (½ when both vanish, where f = 0 anyway; within [2⁻²⁴, 1 − 2⁻²⁴] when both are positive,
+/// see `lobe_probability`).
 #[inline]
 fn specular_probability(kd: Vec3, ks_weight: Vec3) -> f32 {
-    let d = kd.element_sum() / 3.0;
-    let s = ks_weight.element_sum() / 3.0;
-    if d + s > 0.0 { s / (d + s) } else { 0.5 }
+    lobe_probability(kd.element_sum() / 3.0, ks_weight.element_sum() / 3.0)
 }
 
 /// Density of the diffuse + cosine-power mixture used by both Phong types.

@@ -95,14 +95,15 @@ pub use model::{GlintModel, GlintOptions, GlintPatch};
 pub use position_normal::{PositionNormalBrdf, PositionNormalMap, PositionNormalPatch};
 pub use scratch::GlintScratch;
 pub use surface::{
-    BrushedParams, FlakesParams, Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MAX_SLOPE,
-    MIN_WIDTH_TEXELS, NormalMap, NormalRepair, ScratchedParams, TangentConvention, brushed, bumpy,
-    flakes, moments_mean_covariance, scratched,
+    BrushedParams, FlakesParams, Footprint, MAX_ANISOTROPY, MAX_CARVE_WORK_PER_TEXEL,
+    MAX_EXTENT_PERIODS, MAX_GENERATED_TEXELS, MAX_SLOPE, MIN_CELL_TEXELS, MIN_WIDTH_TEXELS,
+    NormalMap, NormalRepair, ScratchedParams, TangentConvention, brushed, bumpy, flakes,
+    moments_mean_covariance, scratched,
 };
 #[cfg(feature = "image")]
 pub use surface::{
-    DEFAULT_LENGTH_TOLERANCE, FloatEncoding, ImageDecoding, ImageOptions, MAX_IMPLAUSIBLE_FRACTION,
-    RAW_EVIDENCE_BELOW,
+    DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, ImageDecoding, ImageOptions,
+    MAX_IMPLAUSIBLE_FRACTION, RAW_EVIDENCE_BELOW,
 };
 pub use truth::{
     BinMasses, BinnedPndf, DEFAULT_MAX_QUADRATURE, DEFAULT_QUADRATURE_TOLERANCE, FootprintBrdf,

@@ -35,6 +35,17 @@ pub use slope_gaussian::*;
 ///
 /// Every method is total: below-horizon, zero-length or non-finite arguments give 0 (or, for the
 /// samplers, a valid upper-hemisphere normal), never NaN, never a panic.
+///
+/// **The density contract** (every NDF and glint patch of the crate, but for now the mixture's
+/// patch, whose densities sum its lobes without the slope truncation of its D; tests/pdf_contract.rs):
+/// `pdf_normal(m)` and `pdf_visible(wo, m)` are 0 wherever `d(m)` is 0, and `pdf_visible` is 0 for
+/// every invalid `wo` (at or below the horizon, −0.0, zero, non-finite) even though
+/// `sample_visible` still returns a normal there. A sampler may draw normals where its density is 0
+/// (the tails of lobes that D truncates, or where D rounds to 0 in `f32`); `MicrofacetBrdf::sample`
+/// returns `None` for them, so the BRDF's pdf remains the density of the directions it produces.
+/// `pdf_visible` computes ⟨wo, m⟩ as `wo.dot(m)` in `f32`, the same number the reflection
+/// Jacobian of `MicrofacetBrdf` divides by, so that sample weights stay bounded at grazing views
+/// (src/bxdf/microfacet.rs, "Sample weights").
 pub trait Ndf {
     /// D(m): micronormal density per unit solid angle. 0 for m below the horizon.
     fn d(&self, m: Vec3) -> f32;
@@ -95,7 +106,7 @@ pub trait Ndf {
     fn sample_normal(&self, u: Vec2) -> Vec3;
 
     /// Density of [`Ndf::sample_normal`]: D(m) cos θ_m (0 where that is not finite, e.g. for a
-    /// non-finite m, where 0 · ∞ would be NaN).
+    /// non-finite m, where 0 · ∞ would be NaN; 0 wherever D is).
     fn pdf_normal(&self, m: Vec3) -> f32 {
         let p = self.d(m) * m.z.max(0.0);
         if p.is_finite() { p } else { 0.0 }
@@ -104,7 +115,8 @@ pub trait Ndf {
     /// Draws a micronormal visible from `wo`, with density D_wo(m) = G1(wo, m) ⟨wo, m⟩ D(m) / A(wo).
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3;
 
-    /// Density of [`Ndf::sample_visible`]: D_wo(m) = χ⁺(wo·m) ⟨wo, m⟩ D(m) / ∫⟨wo, m'⟩ D dm'.
+    /// Density of [`Ndf::sample_visible`]: D_wo(m) = χ⁺(wo·m) ⟨wo, m⟩ D(m) / ∫⟨wo, m'⟩ D dm', with
+    /// ⟨wo, m⟩ = `wo.dot(m)`; 0 wherever D is and for invalid `wo` (the density contract above).
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
         let c = wo.dot(m);
         if !(wo.z > 0.0 && c > 0.0) {

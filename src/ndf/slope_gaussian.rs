@@ -400,12 +400,41 @@ impl SlopeGaussian {
         slope_to_normal_f64(sx, sy)
     }
 
-    /// ln(⟨wo, m⟩ D(m) / V(wo)) in `f64`, or `None` outside the visible support.
-    fn ln_pdf_visible(&self, wo: Vec3, m: Vec3) -> Option<f64> {
-        let t = self.view_terms(wo)?;
+    /// ln D(m) in `f64`: −½ |L⁻¹(ñ − μ)|² + ln(L⁻¹₁₁ L⁻¹₂₂ / (2π)) + 2 ln(1 + |ñ|²), with the slope
+    /// ñ = (−m_x/m_z, −m_y/m_z) formed in `f64` from the `f32` normal; `None` for m_z ≤ 0 or a
+    /// non-finite m.
+    ///
+    /// [`Ndf::d`] and [`Ndf::pdf_visible`] both go through it, so that they agree on where D is
+    /// zero: an `f32` slope loses up to 6·10⁻⁸ |ñ| (5·10⁻⁴ at |ñ| = 10⁴, where a lobe may have
+    /// σ = 10⁻⁴), and D and the pdf taken from two roundings of it could differ by any factor.
+    fn ln_d(&self, m: Vec3) -> Option<f64> {
         if !(m.z > 0.0 && m.is_finite()) {
             return None;
         }
+        let (mx, my, mz) = (m.x as f64, m.y as f64, m.z as f64);
+        let (sx, sy) = (-mx / mz, -my / mz);
+        let [i11, i21, i22] = self.inv_chol.map(f64::from);
+        let (dx, dy) = (sx - self.mean.x as f64, sy - self.mean.y as f64);
+        let (zx, zy) = (i11 * dx, i21 * dx + i22 * dy);
+        let ln_norm = (i11 * i22 / (2.0 * PI)).ln();
+        let ln_d = -0.5 * (zx * zx + zy * zy) + ln_norm + 2.0 * (1.0 + sx * sx + sy * sy).ln();
+        (!ln_d.is_nan()).then_some(ln_d)
+    }
+
+    /// ln D_wo(m) = ln(⟨wo, m⟩ D(m) / V(wo)) in `f64`, or `None` outside the visible support
+    /// (m below the horizon, ⟨wo, m⟩ ≤ 0 as `wo.dot(m)` rounds it, invalid wo).
+    ///
+    /// Finite on the whole support, also where D and V both underflow `f32` (grazing views of a
+    /// lobe tilted away: the visible normals then lie tens of σ out), where [`Ndf::pdf_visible`]
+    /// is 0 because D is: for references and tests that follow the visible sampler into that tail.
+    pub fn ln_pdf_visible(&self, wo: Vec3, m: Vec3) -> Option<f64> {
+        self.ln_d_and_pdf_visible(wo, m).map(|(_, l)| l)
+    }
+
+    /// (ln D(m), ln D_wo(m)) in `f64` (see [`SlopeGaussian::ln_pdf_visible`]).
+    fn ln_d_and_pdf_visible(&self, wo: Vec3, m: Vec3) -> Option<(f64, f64)> {
+        let t = self.view_terms(wo)?;
+        let ln_d = self.ln_d(m)?;
         let c = facing(wo, m);
         if c.is_nan() || c <= 0.0 {
             return None;
@@ -417,37 +446,29 @@ impl SlopeGaussian {
         } else {
             return None;
         };
-        let (mx, my, mz) = (m.x as f64, m.y as f64, m.z as f64);
-        let (sx, sy) = (-mx / mz, -my / mz);
-        let [l11, l21, l22] = self.chol.map(f64::from);
-        let zx = (sx - self.mean.x as f64) / l11;
-        let zy = (sy - self.mean.y as f64 - l21 * zx) / l22;
-        let ln_p22 = -0.5 * (zx * zx + zy * zy) - (2.0 * PI * l11 * l22).ln();
-        let ln_inv_cos4 = 2.0 * (1.0 + sx * sx + sy * sy).ln();
-        let ln_pdf = c.ln() + ln_p22 + ln_inv_cos4 - ln_v;
-        (!ln_pdf.is_nan()).then_some(ln_pdf)
+        let ln_pdf = c.ln() + ln_d - ln_v;
+        (!ln_pdf.is_nan()).then_some((ln_d, ln_pdf))
     }
 }
 
+/// D in `f32` from ln D: e^(ln D) rounded, values beyond `f32::MAX` clamped to it.
+#[inline]
+fn d_of_ln(ln_d: f64) -> f32 {
+    (ln_d.exp() as f32).min(f32::MAX)
+}
+
 impl Ndf for SlopeGaussian {
-    /// D(m) = P22(ñ(m)) (1 + |ñ|²)² = P22(ñ) / cos⁴θ_m (`f32`).
+    /// D(m) = P22(ñ(m)) (1 + |ñ|²)² = P22(ñ) / cos⁴θ_m, formed in `f64` (slope included) and
+    /// rounded once to `f32` (see `ln_d`).
     ///
-    /// 0 for m.z ≤ 0 or non-finite m; values beyond `f32::MAX` are clamped to it.
+    /// 0 for m.z ≤ 0 or non-finite m and where D underflows `f32`; values beyond `f32::MAX` are
+    /// clamped to it.
     ///
     /// # Reference
     /// \[Chermain2019\] eq. 2.
     #[inline]
     fn d(&self, m: Vec3) -> f32 {
-        let Some(s) = crate::frame::normal_to_slope(m) else {
-            return 0.0;
-        };
-        let p = self.p22(s);
-        if p == 0.0 {
-            return 0.0;
-        }
-        let c = 1.0 + s.length_squared();
-        let v = p * c * c;
-        if v.is_finite() { v } else { f32::MAX }
+        self.ln_d(m).map_or(0.0, d_of_ln)
     }
 
     /// Smith Λ(w) = V/A − 1 = G(−z)/z with z = A_s / s_w = (μ_w − q̄)/s, μ_w = cot θ.
@@ -538,17 +559,23 @@ impl Ndf for SlopeGaussian {
         ensure_facing(wo, m)
     }
 
-    /// D_wo(m) = ⟨wo, m⟩⁺ D(m) / V(wo), formed in `f64` logarithms so that it stays finite and
-    /// positive where D and V both underflow (grazing views of lobes tilted away).
+    /// D_wo(m) = ⟨wo, m⟩⁺ D(m) / V(wo), formed in `f64` logarithms so that it stays finite where V
+    /// underflows `f32` (grazing views of lobes tilted away).
     ///
-    /// 0 outside the visible set (m below the horizon or ⟨wo, m⟩ ≤ 0) and for invalid wo. Inside it,
-    /// values below `f32::MIN_POSITIVE` are returned as `f32::MIN_POSITIVE` (the density is positive
-    /// there; a caller testing pdf > 0 for "in the support" stays right) and values above `f32::MAX`
-    /// as `f32::MAX`.
+    /// 0 outside the visible set (m below the horizon or ⟨wo, m⟩ ≤ 0), for invalid wo, and wherever
+    /// [`Ndf::d`] is 0 (the density contract of every NDF: no density where D rounds to 0 in `f32`,
+    /// even where the `f64` density is positive, as tens of σ out at grazing views of a lobe tilted
+    /// away: the visible sampler may then return normals whose pdf is 0, and
+    /// [`SlopeGaussian::ln_pdf_visible`] gives their `f64` density). Elsewhere, values below
+    /// `f32::MIN_POSITIVE` are returned as `f32::MIN_POSITIVE` (the density is positive there; a
+    /// caller testing pdf > 0 for "in the support" stays right) and values above `f32::MAX` as
+    /// `f32::MAX`.
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
-        match self.ln_pdf_visible(wo, m) {
-            Some(l) => (l.exp() as f32).clamp(f32::MIN_POSITIVE, f32::MAX),
-            None => 0.0,
+        match self.ln_d_and_pdf_visible(wo, m) {
+            Some((ln_d, l)) if d_of_ln(ln_d) > 0.0 => {
+                (l.exp() as f32).clamp(f32::MIN_POSITIVE, f32::MAX)
+            }
+            _ => 0.0,
         }
     }
 }
@@ -570,10 +597,12 @@ fn visible_area_f64(t: &ViewTerms) -> f64 {
     }
 }
 
-/// ⟨wo, m⟩ in `f64` from the `f32` vectors (the same arithmetic in the sampler and in the pdf).
+/// ⟨wo, m⟩ as `wo.dot(m)` rounds it in `f32` (the same arithmetic in the sampler, in the pdf and
+/// in `MicrofacetBrdf`'s reflection Jacobian 1/(4 wo·h), so that the visible-normal weight
+/// F G2/G1 ≤ F holds to rounding even where the cosine is below f32's resolution), widened to `f64`.
 #[inline]
 fn facing(wo: Vec3, m: Vec3) -> f64 {
-    wo.x as f64 * m.x as f64 + wo.y as f64 * m.y as f64 + wo.z as f64 * m.z as f64
+    wo.dot(m) as f64
 }
 
 /// m if it faces wo after rounding, else m moved along wo to ⟨wo, m⟩ = [`FACING_NUDGE`].
@@ -849,19 +878,25 @@ mod tests {
     }
 
     #[test]
-    fn pdf_visible_is_positive_where_v_underflows() {
+    fn pdf_visible_is_zero_exactly_where_d_is_when_v_underflows() {
         // σ = 0.05, mean slope (1, 0), view from the side the lobe is tilted away from, 80°:
         // a = (cot 80° − 1)/0.05 ≈ −16.5, V ≈ 0.05 φ(16.5)/16.5² ≈ 1e-63: below f32.
         let g = lobe(1.0, 0.0, 0.05, 0.05, 0.0);
         let wo = Vec3::new(80f32.to_radians().sin(), 0.0, 80f32.to_radians().cos());
         assert_eq!(g.visible_area(wo), 0.0);
         assert_eq!(g.lambda(wo), f32::MAX);
+        // The normals facing wo lie ~16 σ out, where D itself rounds to 0 in f32: the pdf is
+        // positive exactly where D is (the pdf contract: d = 0 ⇒ pdf_visible = 0), finite always.
         for i in 0..50 {
             let u = Vec2::new((i as f32 + 0.5) / 50.0, ((i * 7) % 50) as f32 / 50.0 + 0.01);
             let m = g.sample_visible(wo, u);
             assert!(m.z > 0.0 && wo.dot(m) > 0.0);
             let p = g.pdf_visible(wo, m);
-            assert!(p > 0.0 && p.is_finite(), "{m} {p}");
+            assert!(
+                p.is_finite() && (p > 0.0) == (g.d(m) > 0.0),
+                "{m} {p} {}",
+                g.d(m)
+            );
         }
     }
 }

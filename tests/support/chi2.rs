@@ -5,7 +5,14 @@
 //! - cells: an equal-area grid in (z = cos θ, φ) over z ∈ [z_min, 1]; everything else (directions with
 //!   z < z_min, below the horizon, and draws for which the sampler returned `None`) is one more
 //!   "overflow" cell whose expected count is N·(1 − Σ expected inside);
-//! - the expected count of a cell is N ∫_cell pdf dω, by a 6×6 Gauss–Legendre rule in (z, φ) per cell;
+//! - the expected count of a cell is N ∫_cell pdf dω, by an adaptive Gauss–Legendre rule in (z, φ):
+//!   the cell's 6×6 rule is accepted if a 4×4 rule agrees with it within 5 % of the count's standard
+//!   deviation √max(E, 1) (or if the cell has no draw and expects less than 0.01); otherwise the cell
+//!   is split into quarters, each compared with its parent's share the same way (the quarters' sum
+//!   replacing the parent's estimate), down to 10 levels. A fixed 6×6 rule per cell mis-integrated
+//!   lobes that fill a sliver of a few cells at grazing views (anisotropic GGX α = 0.3/0.1 at
+//!   θo = 89°: χ² = 3977 on 3085 dof; Beckmann χ² = 193,335 on 248); a 48×48 rule, a 96×96 rule and
+//!   this adaptive rule all give the same counts there, and the samplers pass;
 //! - cells whose expected count is below 5 are pooled (smallest first) until the pool reaches 5, the usual
 //!   validity condition of the χ² approximation;
 //! - the null hypothesis "samples follow pdf" is rejected at significance 0.01, Šidák-corrected over the
@@ -40,6 +47,11 @@ pub struct Chi2 {
     pub significance: f64,
     /// RNG seed.
     pub seed: u64,
+    /// Gauss–Legendre points per axis of the expected-count quadrature (per cell, and per quarter
+    /// of a cell that the adaptive rule splits).
+    pub quadrature: usize,
+    /// Largest number of times the adaptive rule splits a cell (0: the fixed rule per cell).
+    pub max_depth: usize,
 }
 
 impl Default for Chi2 {
@@ -55,6 +67,9 @@ impl Default for Chi2 {
             family: 1,
             significance: 0.01,
             seed: 7,
+            quadrature: 6,
+            // 10 levels: quarters down to 1/1024 of a cell side, far below any lobe we test.
+            max_depth: 10,
         }
     }
 }
@@ -104,24 +119,28 @@ impl Chi2 {
             observed[cell] += 1.0;
         }
 
-        let gl = gauss_legendre(6);
+        let gl = gauss_legendre(self.quadrature);
+        let gl_check = gauss_legendre(self.quadrature.saturating_sub(2).max(1));
         let n = self.samples as f64;
         let mut expected = vec![0.0f64; nz * np + 1];
         for iz in 0..nz {
             for ip in 0..np {
                 let (z0, p0) = (z_min + iz as f64 * dz, ip as f64 * dphi);
-                let mut s = 0.0;
-                for &(xz, wz) in &gl {
-                    let z = z0 + 0.5 * dz * (xz + 1.0);
-                    let st = (1.0 - z * z).max(0.0).sqrt();
-                    for &(xp, wp) in &gl {
-                        let phi = p0 + 0.5 * dphi * (xp + 1.0);
-                        let w =
-                            Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, z as f32);
-                        s += wz * wp * pdf(w);
-                    }
-                }
-                expected[iz * np + ip] = n * s * 0.25 * dz * dphi;
+                let cell = Rect {
+                    z0,
+                    z1: z0 + dz,
+                    p0,
+                    p1: p0 + dphi,
+                };
+                let whole = cell.integrate(&gl, &pdf);
+                let quiet = observed[iz * np + ip] == 0.0 && n * whole < 1e-2;
+                let agrees =
+                    || (cell.integrate(&gl_check, &pdf) - whole).abs() <= tolerance(whole, n);
+                expected[iz * np + ip] = if self.max_depth == 0 || quiet || agrees() {
+                    n * whole
+                } else {
+                    n * cell.adaptive(&gl, &pdf, whole, n, self.max_depth)
+                };
             }
         }
         let inside: f64 = expected[..overflow].iter().sum();
@@ -226,5 +245,89 @@ impl Chi2 {
             .map(|c| if c.is_alphanumeric() { c } else { '_' })
             .collect();
         let _ = std::fs::write(dir.join(format!("{file}.txt")), s);
+    }
+}
+
+/// The adaptive rule's tolerance on a cell's probability `p` at `n` draws: 5 % of the standard
+/// deviation of its count, √max(n p, 1) / n (module docs).
+fn tolerance(p: f64, n: f64) -> f64 {
+    0.05 * (n * p).max(1.0).sqrt() / n
+}
+
+/// A cell [z0, z1] × [p0, p1] of the (z = cos θ, φ) grid, or a part of one.
+#[derive(Clone, Copy)]
+struct Rect {
+    z0: f64,
+    z1: f64,
+    p0: f64,
+    p1: f64,
+}
+
+impl Rect {
+    /// ∫ pdf dω over the rectangle (dω = dz dφ) by the tensor Gauss–Legendre rule `gl`.
+    fn integrate(&self, gl: &[(f64, f64)], pdf: &impl Fn(Vec3) -> f64) -> f64 {
+        let (dz, dp) = (self.z1 - self.z0, self.p1 - self.p0);
+        let mut s = 0.0;
+        for &(xz, wz) in gl {
+            let z = self.z0 + 0.5 * dz * (xz + 1.0);
+            let st = (1.0 - z * z).max(0.0).sqrt();
+            for &(xp, wp) in gl {
+                let phi = self.p0 + 0.5 * dp * (xp + 1.0);
+                let w = Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, z as f32);
+                s += wz * wp * pdf(w);
+            }
+        }
+        s * 0.25 * dz * dp
+    }
+
+    fn quarters(&self) -> [Rect; 4] {
+        let (zm, pm) = (0.5 * (self.z0 + self.z1), 0.5 * (self.p0 + self.p1));
+        [
+            Rect {
+                z1: zm,
+                p1: pm,
+                ..*self
+            },
+            Rect {
+                z0: zm,
+                p1: pm,
+                ..*self
+            },
+            Rect {
+                z1: zm,
+                p0: pm,
+                ..*self
+            },
+            Rect {
+                z0: zm,
+                p0: pm,
+                ..*self
+            },
+        ]
+    }
+
+    /// The adaptive integral given this rectangle's own estimate `whole` (see the module docs): the
+    /// quarters' sum if it agrees with `whole` within 5 % of the count's standard deviation at `n`
+    /// draws, else each quarter refined the same way, down to `depth` more levels.
+    fn adaptive(
+        &self,
+        gl: &[(f64, f64)],
+        pdf: &impl Fn(Vec3) -> f64,
+        whole: f64,
+        n: f64,
+        depth: usize,
+    ) -> f64 {
+        if depth == 0 {
+            return whole;
+        }
+        let parts = self.quarters().map(|q| (q, q.integrate(gl, pdf)));
+        let sum: f64 = parts.iter().map(|(_, v)| v).sum();
+        if (sum - whole).abs() <= tolerance(sum, n) {
+            return sum;
+        }
+        parts
+            .iter()
+            .map(|(q, v)| q.adaptive(gl, pdf, *v, n, depth - 1))
+            .sum()
     }
 }

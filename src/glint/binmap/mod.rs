@@ -123,8 +123,11 @@ pub const DEFAULT_SMOOTHING_ALPHA: f32 = 0.0;
 pub struct PatchOptions {
     /// Beckmann roughness α of a lobe that spreads every bin's mass about the bin's centre
     /// direction (slope σ = α/√2): D(h) = Σ_j mass_j D_j(h) (see [`BinMapPatch`]). 0 keeps the
-    /// one-bin resolution; a value that is not finite and > 0 means 0; α is raised to at least
-    /// [`crate::ndf::MIN_ALPHA`].
+    /// one-bin resolution; a value that is not finite and > 0 means 0; α is clamped to
+    /// [[`crate::ndf::MIN_ALPHA`], [`crate::ndf::MAX_ALPHA`]] = [10⁻⁴, 10⁴], the range of the
+    /// analytic NDFs (options are per query, so they are clamped rather than refused; beyond 10⁴
+    /// the lobes' variance leaves the slope range a `SlopeGaussian` holds and the window of bins a
+    /// smoothed D sums over overflows).
     ///
     /// # Reference
     /// The smoothing follows the idea of the authors' later full paper (a Beckmann lobe per bin);
@@ -667,7 +670,8 @@ impl GlintNdf for BinMap {
         scratch: Option<&'a mut GlintScratch>,
     ) -> BinMapPatch<'a> {
         let alpha = options.smoothing_alpha;
-        let alpha = (alpha.is_finite() && alpha > 0.0).then(|| alpha.max(crate::ndf::MIN_ALPHA));
+        let alpha = (alpha.is_finite() && alpha > 0.0)
+            .then(|| alpha.clamp(crate::ndf::MIN_ALPHA, crate::ndf::MAX_ALPHA));
         BinMapPatch::new(self, footprint, alpha, scratch.map(|s| s.slot()))
     }
 }

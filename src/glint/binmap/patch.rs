@@ -970,13 +970,22 @@ impl Ndf for BinMapPatch<'_> {
     /// The density of [`Ndf::sample_visible`] per unit solid angle of m:
     /// (s_j ν_j / Σ_k s_k ν_k) · bilerp(v_j, t) / (mean(v_j) |H|) for m at cell position t of bin j
     /// (unsmoothed), ⟨wo, m⟩⁺ Σ_j mass_j D_j(m) / Σ_j mass_j V_j(wo) (smoothed), or
-    /// [`Ndf::pdf_normal`] where the sampler falls back to it.
+    /// [`Ndf::pdf_normal`] where the sampler falls back to it for a valid wo (large footprints,
+    /// views nothing faces). 0 for an invalid wo (at or below the horizon, zero, non-finite), as
+    /// for every NDF, though the sampler still returns a normal there.
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        if !(wo.is_finite() && wo.z > 0.0) {
+            return 0.0;
+        }
         match self.visible_total(wo) {
             Some((e, total)) if e.lobes.as_slice().is_empty() => {
                 self.pdf_visible_bins(e, wo, total, m)
             }
-            Some((e, total)) => pdf_visible_lobes(e, wo, total, m),
+            // The smoothed D leaves out each lobe beyond its truncation radius (SMOOTH_TAIL), the
+            // lobes' own samplers do not: where D is 0 the density is 0 too (a draw there, at most
+            // 10⁻⁶ of a lobe's mass, gets pdf 0 and `MicrofacetBrdf::sample` returns `None`).
+            Some((e, total)) if self.d(m) > 0.0 => pdf_visible_lobes(e, wo, total, m),
+            Some(_) => 0.0,
             None => self.pdf_normal(m),
         }
     }

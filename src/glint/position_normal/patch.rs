@@ -519,10 +519,14 @@ impl Ndf for PositionNormalPatch<'_> {
         s.lobes[k].sample_normal(Vec2::new(ux, u.y))
     }
 
-    /// Σ W_i D_i(m) cos θ_m over every kept element: exactly the density of [`Ndf::sample_normal`];
-    /// differs from `d(m) cos θ_m` by at most the slope truncation. O(elements).
+    /// Σ W_i D_i(m) cos θ_m over every kept element where D_P(m) > 0, else 0: the density of
+    /// [`Ndf::sample_normal`] on the support of D_P. The sampler draws each element's whole
+    /// Gaussian, D_P leaves out an element beyond its slope box (`slope_sigmas`), so a draw outside
+    /// every box (at most 4 Q(k) of the mass for k = `slope_sigmas`, 1.3·10⁻⁴ at the default) has
+    /// pdf 0, where D_P is 0 too, and `MicrofacetBrdf::sample` returns `None` for it. Inside the
+    /// support the value differs from `d(m) cos θ_m` by at most the truncated tails. O(elements).
     fn pdf_normal(&self, m: Vec3) -> f32 {
-        if !(m.z > 0.0 && m.is_finite()) {
+        if !(m.z > 0.0 && m.is_finite() && self.d(m) > 0.0) {
             return 0.0;
         }
         let p = self.untruncated_d(m) * m.z as f64;
@@ -549,11 +553,15 @@ impl Ndf for PositionNormalPatch<'_> {
         s.lobes[k].sample_visible(wo, Vec2::new(r, u.y))
     }
 
-    /// ⟨wo, m⟩ Σ W_i D_i(m) / Σ W_i V_i(wo) over every kept element: exactly the density of
-    /// [`Ndf::sample_visible`]. O(elements).
+    /// ⟨wo, m⟩ Σ W_i D_i(m) / Σ W_i V_i(wo) over every kept element where D_P(m) > 0, else 0: the
+    /// density of [`Ndf::sample_visible`] on the support of D_P (draws outside it as in
+    /// [`Ndf::pdf_normal`]). 0 for invalid wo. O(elements).
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
         let c = wo.dot(m);
         if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
+            return 0.0;
+        }
+        if self.d(m) <= 0.0 {
             return 0.0;
         }
         let v = self.exact_visible_area(wo);

@@ -34,6 +34,15 @@ pub const MAX_IMPLAUSIBLE_FRACTION: f32 = 0.5;
 /// below 0.
 pub const RAW_EVIDENCE_BELOW: f32 = -0.01;
 
+/// Default [`ImageOptions::max_texels`]: 2²⁴ texels (4096², or 8192 × 2048).
+///
+/// The decoder's own buffer is bounded by the `image` crate's limit (512 MiB), but a decoded map
+/// then takes about 20 more bytes per texel in this crate (f32 channels, then slopes), and a
+/// compressed file as small as a kilobyte can claim millions of texels (a flat map compresses that
+/// well, so the file size proves nothing). At this cap a file costs at most ~340 MiB here plus
+/// ≤ 256 MiB of decoding (RGBA f32); larger maps need the cap raised explicitly.
+pub const DEFAULT_MAX_IMAGE_TEXELS: usize = 1 << 24;
+
 /// How the channels of a float (EXR) normal map encode the normal. Integer (PNG) channels are always
 /// read as c = value / (2^bits − 1), n = 2c − 1.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -53,8 +62,8 @@ pub enum FloatEncoding {
 }
 
 /// Options of [`NormalMap::load_with`] and [`NormalMap::from_image_bytes_with`]. `Default` gives
-/// OpenGL tangents, [`NormalRepair::Reject`], [`FloatEncoding::Encoded`] and
-/// [`DEFAULT_LENGTH_TOLERANCE`].
+/// OpenGL tangents, [`NormalRepair::Reject`], [`FloatEncoding::Encoded`],
+/// [`DEFAULT_LENGTH_TOLERANCE`] and [`DEFAULT_MAX_IMAGE_TEXELS`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImageOptions {
     /// Direction of the green channel.
@@ -67,6 +76,9 @@ pub struct ImageOptions {
     /// [`MAX_IMPLAUSIBLE_FRACTION`] of such texels is refused. `f32::INFINITY` disables the check
     /// (for files that store unnormalised vectors on purpose); must not be NaN or negative.
     pub length_tolerance: f32,
+    /// The largest image accepted, in texels (width × height, read from the file's header before
+    /// anything is decoded); must be ≥ 1. Default [`DEFAULT_MAX_IMAGE_TEXELS`].
+    pub max_texels: usize,
 }
 
 impl Default for ImageOptions {
@@ -76,6 +88,7 @@ impl Default for ImageOptions {
             repair: NormalRepair::Reject,
             float_encoding: FloatEncoding::Encoded,
             length_tolerance: DEFAULT_LENGTH_TOLERANCE,
+            max_texels: DEFAULT_MAX_IMAGE_TEXELS,
         }
     }
 }
@@ -219,17 +232,19 @@ impl NormalMap {
     /// [`MAX_IMPLAUSIBLE_FRACTION`] of the decoded vectors are off unit length by more than
     /// [`ImageOptions::length_tolerance`], or have z ≤ 0, the file was decoded with the wrong encoding
     /// (or is not a normal map) and is refused. Each normal is then normalised, repaired per
-    /// [`ImageOptions::repair`] and converted to a slope. Memory use while decoding is bounded by the
-    /// `image` crate's default limits (512 MiB).
+    /// [`ImageOptions::repair`] and converted to a slope. An image of more than
+    /// [`ImageOptions::max_texels`] texels is refused from its header, before decoding; memory use
+    /// is then at most ~20 bytes per texel here plus the decoder's buffer, which the `image`
+    /// crate's default limits also bound (512 MiB).
     ///
     /// # Reference
     /// Decoding 2c − 1 for every format: pbrt-v4 (`NormalMap` lookups in `materials.h`), Mitsuba 3
     /// (`normalmap` BSDF plugin).
     ///
     /// # Errors
-    /// [`Error::Image`] (naming `name`) for undecodable bytes, an empty image, or an image that is not
-    /// RGB/RGBA (e.g. greyscale); [`Error::InvalidParameter`] for a bad `ClampZ` bound or length
-    /// tolerance; [`Error::InvalidTexel`] (naming `name`, the texel and the file pixel) for a
+    /// [`Error::Image`] (naming `name`) for undecodable bytes, an empty image, an image of more
+    /// than [`ImageOptions::max_texels`] texels, or an image that is not RGB/RGBA (e.g. greyscale);
+    /// [`Error::InvalidParameter`] for a bad `ClampZ` bound, length tolerance or `max_texels` = 0; [`Error::InvalidTexel`] (naming `name`, the texel and the file pixel) for a
     /// non-finite or zero normal, or one with z ≤ 0 under [`NormalRepair::Reject`];
     /// [`Error::ImplausibleNormals`] (naming `name`, with the statistics and the likely cause) for a
     /// map mostly off unit length or below the horizon, or for [`FloatEncoding::Detect`] when the data
@@ -256,7 +271,30 @@ impl NormalMap {
             source_name: name.to_string(),
             reason,
         };
-        let img = image::load_from_memory(bytes).map_err(|e| image_err(e.to_string()))?;
+        if options.max_texels == 0 {
+            return Err(Error::InvalidParameter {
+                name: "max_texels",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
+        }
+        let reader = || {
+            image::ImageReader::new(std::io::Cursor::new(bytes))
+                .with_guessed_format()
+                .map_err(|e| image_err(e.to_string()))
+        };
+        let (w, h) = reader()?
+            .into_dimensions()
+            .map_err(|e| image_err(e.to_string()))?;
+        let texels = w as u64 * h as u64;
+        if texels > options.max_texels as u64 {
+            return Err(image_err(format!(
+                "the image claims {w}×{h} = {texels} texels, more than ImageOptions::max_texels = {} \
+                 (raise it to load larger maps)",
+                options.max_texels
+            )));
+        }
+        let img = reader()?.decode().map_err(|e| image_err(e.to_string()))?;
         let (w, h) = (img.width() as usize, img.height() as usize);
         if w == 0 || h == 0 {
             return Err(image_err(format!("the image is empty ({w}×{h} pixels)")));

@@ -18,8 +18,8 @@ mod procedural;
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 #[cfg(feature = "image")]
 pub use image_io::{
-    DEFAULT_LENGTH_TOLERANCE, FloatEncoding, ImageDecoding, ImageOptions, MAX_IMPLAUSIBLE_FRACTION,
-    RAW_EVIDENCE_BELOW,
+    DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, ImageDecoding, ImageOptions,
+    MAX_IMPLAUSIBLE_FRACTION, RAW_EVIDENCE_BELOW,
 };
 pub(crate) use moments::{MomentLevel, MomentPyramid};
 pub(crate) use normal_map::texel_count;
@@ -27,5 +27,6 @@ pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
 };
 pub use procedural::{
-    BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
+    BrushedParams, FlakesParams, MAX_CARVE_WORK_PER_TEXEL, MAX_GENERATED_TEXELS, MIN_CELL_TEXELS,
+    ScratchedParams, brushed, bumpy, flakes, scratched,
 };

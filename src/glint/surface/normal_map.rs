@@ -6,7 +6,7 @@
 //! # Reference
 //! \[Chermain2019\] §3 (slope representation, interpolated normals); \[Dupuy2013\] (slope moments, mipmaps).
 
-use crate::frame::{normal_to_slope, slope_to_normal};
+use crate::frame::{normal_to_slope, normalize_robust, slope_to_normal};
 use crate::glint::io::format::{self, Kind};
 use crate::glint::surface::MomentPyramid;
 use crate::{Error, Result};
@@ -54,7 +54,9 @@ pub enum NormalRepair {
     /// Normalise, raise z to at least `min_z` (0 < min_z ≤ 1), keep x and y, then renormalise:
     /// n' = normalize(x, y, max(z, min_z)) with (x, y, z) = n / ‖n‖. Normals already above `min_z` are only renormalised. The
     /// repaired normal keeps the azimuth of the original and its slope magnitude is at most
-    /// √(x² + y²) / min_z. Must satisfy `min_z ≥ 1 / MAX_SLOPE` so that repaired slopes stay valid.
+    /// √(x² + y²) / min_z. Must satisfy `min_z ≥ 1 / MAX_SLOPE` so that repaired slopes stay valid;
+    /// at `min_z = 1 / MAX_SLOPE` a horizontal normal gets a slope of exactly [`MAX_SLOPE`] (a
+    /// rounding excess is clipped), so every finite non-zero normal is repaired.
     ClampZ(f32),
 }
 
@@ -106,19 +108,26 @@ pub(crate) fn texel_count(width: usize, height: usize, len: usize) -> Result<usi
 
 /// The slope of one unit-ish normal, validated (finite, z > 0, |slope| ≤ MAX_SLOPE) after an optional
 /// z repair. `Err(reason)` says what is wrong.
+///
+/// Any non-zero finite vector is accepted, however short or long: its slope −(x, y)/z does not
+/// depend on its length, and where the repair needs the unit vector it is normalised by
+/// [`normalize_robust`] (scaled by its largest component first, so that a length of 10⁻³⁰ or 10³⁰
+/// does not underflow or overflow its square). Under [`NormalRepair::ClampZ`] the slope magnitude is
+/// at most √(x² + y²) / min_z ≤ 1 / min_z ≤ [`MAX_SLOPE`] in exact arithmetic, and a rounding excess
+/// of a few ulps is clipped back to `MAX_SLOPE`, so that every repaired normal is valid.
 pub(crate) fn repaired_slope(n: Vec3, repair: NormalRepair) -> std::result::Result<Vec2, String> {
     if !n.is_finite() {
         return Err(format!("non-finite normal {n:?}"));
     }
-    if n.length_squared() == 0.0 {
+    let Some(u) = normalize_robust(n) else {
         return Err("zero-length normal".to_string());
-    }
-    let n = match repair {
-        NormalRepair::Reject => n,
-        NormalRepair::ClampZ(min_z) => {
-            let u = n / n.length();
-            Vec3::new(u.x, u.y, u.z.max(min_z))
-        }
+    };
+    // The slope −(x, y)/z does not depend on the length: it is taken from `n` itself (exact to one
+    // rounding) unless the repair raises z, which needs the unit vector.
+    let (n, clamp) = match repair {
+        NormalRepair::Reject => (n, false),
+        NormalRepair::ClampZ(min_z) if u.z < min_z => (Vec3::new(u.x, u.y, min_z), true),
+        NormalRepair::ClampZ(_) => (n, true),
     };
     if n.z <= 0.0 {
         return Err(format!(
@@ -127,10 +136,22 @@ pub(crate) fn repaired_slope(n: Vec3, repair: NormalRepair) -> std::result::Resu
     }
     match normal_to_slope(n) {
         Some(s) if s.length() <= MAX_SLOPE => Ok(s),
+        Some(s) if clamp => Ok(clip_to_max_slope(s)),
         _ => Err(format!(
             "normal {n:?} is too close to the horizon (slope magnitude above MAX_SLOPE = {MAX_SLOPE})"
         )),
     }
+}
+
+/// `s` scaled to magnitude [`MAX_SLOPE`] (as `f32` computes the length: at most `MAX_SLOPE`).
+fn clip_to_max_slope(s: Vec2) -> Vec2 {
+    let len = (s.x as f64).hypot(s.y as f64);
+    let k = MAX_SLOPE as f64 / len;
+    let mut c = Vec2::new((s.x as f64 * k) as f32, (s.y as f64 * k) as f32);
+    while c.length() > MAX_SLOPE {
+        c *= 1.0 - f32::EPSILON;
+    }
+    c
 }
 
 /// Validates a [`NormalRepair`] parameter.
@@ -199,7 +220,8 @@ impl NormalMap {
         })
     }
 
-    /// A map from per-texel normals (row major; need not be unit length: they are normalised).
+    /// A map from per-texel normals (row major; need not be unit length: they are normalised, and
+    /// any finite non-zero length is accepted, 10⁻³⁰ and 10³⁰ included).
     ///
     /// Normals with z ≤ 0 are rejected or repaired according to `repair`.
     ///

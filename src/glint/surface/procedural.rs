@@ -12,6 +12,18 @@
 //!
 //! Costs: O(W·H·(ℓx + ℓy)) for the Gaussian-filtered noise (separable convolution, 4σ truncation);
 //! scratches cost their total length times their width; flakes 25 distance tests per texel.
+//!
+//! ## Bounds
+//! Every generator checks its parameters against what it can compute in bounded time and memory,
+//! and returns [`Error::InvalidParameter`] naming the parameter (or [`Error::InvalidSize`] for the
+//! map size) instead of panicking, aborting on allocation or running for ever:
+//! - maps of at most [`MAX_GENERATED_TEXELS`] texels (peak memory about 20 bytes per texel);
+//! - correlation lengths at most the map size along their axis (O(W·H·ℓ) work);
+//! - RMS slopes, tilts and groove slopes at most `MAX_SLOPE / 100`;
+//! - flakes of at least [`MIN_CELL_TEXELS`] texels (at most 4 Voronoi sites per texel);
+//! - scratches no wider than the map's shorter side, at most 10⁵ per 256² texels and 10⁵ texels
+//!   long, and together at most [`MAX_CARVE_WORK_PER_TEXEL`] texel visits of the rasteriser per
+//!   texel of the map (the defaults use about 4).
 
 use super::normal_map::{MAX_SLOPE, NormalMap};
 use crate::error::{Error, Result, non_negative, positive};
@@ -22,6 +34,38 @@ use rayon::prelude::*;
 
 /// Rows per parallel band in the scratch rasteriser.
 const BAND_ROWS: usize = 32;
+
+/// The largest map a generator builds: 2²⁶ texels (8192²). Its buffers (noise, blur, heights,
+/// slopes) take about 20 bytes per texel, 1.3 GiB at this size; larger requests are refused with
+/// [`Error::InvalidSize`] rather than aborting on allocation.
+pub const MAX_GENERATED_TEXELS: usize = 1 << 26;
+
+/// The smallest flake ([`FlakesParams::cell_texels`]): half a texel, i.e. at most 4 Voronoi sites
+/// per texel (a flake smaller than a texel is seen by no texel centre anyway).
+pub const MIN_CELL_TEXELS: f32 = 0.5;
+
+/// The scratch rasteriser's budget: at most this many texel visits per texel of the map, counted
+/// before carving as scratches × segments per scratch × texels of a segment's bounding box (the
+/// defaults use about 4). Beyond it [`scratched`] refuses `density`, `length_texels` and
+/// `width_texels` together.
+pub const MAX_CARVE_WORK_PER_TEXEL: f64 = 1024.0;
+
+/// The carve budget's floor, so that small maps still take a few long scratches: 2²⁰ texel visits
+/// (a millisecond).
+const MIN_CARVE_WORK: f64 = (1u64 << 20) as f64;
+
+/// Checks a generator's map size: both sides ≥ 1 and at most [`MAX_GENERATED_TEXELS`] texels.
+fn generated_size(width: usize, height: usize) -> Result<usize> {
+    let n = super::normal_map::texel_count(width, height, width.saturating_mul(height))?;
+    if n > MAX_GENERATED_TEXELS {
+        return Err(Error::InvalidSize {
+            width,
+            height,
+            reason: "a generated map holds at most MAX_GENERATED_TEXELS = 2^26 texels",
+        });
+    }
+    Ok(n)
+}
 
 /// SplitMix64 finaliser: a well-mixed 64-bit hash of `x`.
 fn mix(mut x: u64) -> u64 {
@@ -229,8 +273,8 @@ fn scaled_slopes(
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for `rms_slope` not in (0, MAX_SLOPE/100] or `correlation_texels` not
-/// in (0, min(width, height)]; [`Error::InvalidSize`] for a zero size or a map too small to have any
-/// slope (1 × 1).
+/// in (0, min(width, height)]; [`Error::InvalidSize`] for a zero size, more than
+/// [`MAX_GENERATED_TEXELS`] texels, or a map too small to have any slope (1 × 1).
 pub fn bumpy(
     width: usize,
     height: usize,
@@ -238,7 +282,7 @@ pub fn bumpy(
     correlation_texels: f32,
     seed: u64,
 ) -> Result<NormalMap> {
-    super::normal_map::texel_count(width, height, width.saturating_mul(height))?;
+    generated_size(width, height)?;
     let target = rms("rms_slope", rms_slope)?;
     let corr = correlation("correlation_texels", correlation_texels, width.min(height))?;
     let h = gaussian_field(width, height, corr, corr, seed, 1);
@@ -282,7 +326,7 @@ impl Default for BrushedParams {
 /// # Errors
 /// As [`bumpy`], for each parameter (lengths bounded by the map size along their axis).
 pub fn brushed(width: usize, height: usize, params: BrushedParams, seed: u64) -> Result<NormalMap> {
-    super::normal_map::texel_count(width, height, width.saturating_mul(height))?;
+    generated_size(width, height)?;
     let target = rms("rms_slope", params.rms_slope)?;
     let lx = correlation("length_texels", params.length_texels, width)?;
     let ly = correlation("width_texels", params.width_texels, height)?;
@@ -376,11 +420,24 @@ impl Segment {
     }
 }
 
+/// The number of scratches of [`scratch_segments`].
+fn scratch_count(width: usize, height: usize, p: &ScratchedParams) -> usize {
+    (p.density as f64 * (width * height) as f64 / 65536.0).round() as usize
+}
+
+/// An upper bound of the rasteriser's texel visits (see [`MAX_CARVE_WORK_PER_TEXEL`]): scratches ×
+/// segments per scratch (length / 8, rounded up) × the bounding box of a segment (8 texels long at
+/// most, half-width 0.625 `width_texels` at most, plus a texel of rounding each way).
+fn carve_work(width: usize, height: usize, p: &ScratchedParams) -> f64 {
+    let segments = (p.length_texels.1 as f64 / 8.0).ceil().max(1.0);
+    let side = 8.0 + 1.25 * p.width_texels as f64 + 2.0;
+    scratch_count(width, height, p) as f64 * segments * side * side
+}
+
 /// The scratches as polylines of segments at most 8 texels long (sequential draws from the seed).
 fn scratch_segments(width: usize, height: usize, p: &ScratchedParams, seed: u64) -> Vec<Segment> {
     let mut rng = stream(seed, 3, 0);
-    let area = (width * height) as f64;
-    let count = (p.density as f64 * area / 65536.0).round() as usize;
+    let count = scratch_count(width, height, p);
     let mut segs = Vec::new();
     for _ in 0..count {
         let start = Vec2::new(
@@ -468,22 +525,50 @@ fn carve(width: usize, height: usize, segs: &[Segment]) -> Vec<f32> {
 /// of scratched metal.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] naming the field for non-finite or out-of-range parameters (density,
-/// width, max_slope, base_rms_slope ≥ 0 …, curved_fraction in [0, 1], lengths ordered);
-/// [`Error::InvalidSize`] for a zero size.
+/// [`Error::InvalidParameter`] naming the field for a non-finite or out-of-range parameter:
+/// `density` in [0, 10⁵]; `width_texels` in (0, min(width, height)]; `max_slope` and
+/// `base_rms_slope` in [0, MAX_SLOPE / 100]; `max_turn` ≥ 0; `curved_fraction` in [0, 1];
+/// `length_texels` ordered in [0, 10⁵]; `base_correlation_texels` in (0, min(width, height)] when
+/// `base_rms_slope` > 0; and `density`, `length_texels` and `width_texels` together within the
+/// rasteriser's budget ([`MAX_CARVE_WORK_PER_TEXEL`], module docs). [`Error::InvalidSize`] for a zero
+/// size or more than [`MAX_GENERATED_TEXELS`] texels.
 pub fn scratched(
     width: usize,
     height: usize,
     params: ScratchedParams,
     seed: u64,
 ) -> Result<NormalMap> {
-    super::normal_map::texel_count(width, height, width.saturating_mul(height))?;
+    generated_size(width, height)?;
     let p = params;
     non_negative("density", p.density)?;
+    if p.density > 1e5 {
+        return Err(Error::InvalidParameter {
+            name: "density",
+            value: p.density as f64,
+            reason: "must be at most 1e5 scratches per 256² texels",
+        });
+    }
     positive("width_texels", p.width_texels)?;
+    if p.width_texels as f64 > width.min(height) as f64 {
+        return Err(Error::InvalidParameter {
+            name: "width_texels",
+            value: p.width_texels as f64,
+            reason: "must not exceed the map's shorter side",
+        });
+    }
     non_negative("max_slope", p.max_slope)?;
+    if p.max_slope > MAX_SLOPE / 100.0 {
+        return Err(Error::InvalidParameter {
+            name: "max_slope",
+            value: p.max_slope as f64,
+            reason: "must be at most MAX_SLOPE / 100",
+        });
+    }
     non_negative("max_turn", p.max_turn)?;
     non_negative("base_rms_slope", p.base_rms_slope)?;
+    if p.base_rms_slope > 0.0 {
+        rms("base_rms_slope", p.base_rms_slope)?;
+    }
     let unit = |name, v: f32| {
         if (0.0..=1.0).contains(&v) {
             Ok(())
@@ -505,11 +590,13 @@ pub fn scratched(
             reason: "needs 0 <= lower <= upper <= 1e5",
         });
     }
-    if p.max_slope > MAX_SLOPE / 100.0 || p.density > 1e5 {
+    let work = carve_work(width, height, &p);
+    if work > (MAX_CARVE_WORK_PER_TEXEL * (width * height) as f64).max(MIN_CARVE_WORK) {
         return Err(Error::InvalidParameter {
-            name: "max_slope / density",
-            value: p.max_slope.max(p.density) as f64,
-            reason: "max_slope must be at most MAX_SLOPE / 100 and density at most 1e5",
+            name: "density * length_texels.1 * width_texels",
+            value: work / (width * height) as f64,
+            reason: "the scratches would take more than MAX_CARVE_WORK_PER_TEXEL = 1024 texel \
+                     visits per texel (value: the visits per texel): fewer, shorter or narrower",
         });
     }
     let base = if p.base_rms_slope > 0.0 {
@@ -570,11 +657,19 @@ impl Default for FlakesParams {
 /// directions only: the sparkle of metallic paint.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for `cell_texels` not in (0, max(W, H)] or `tilt_sigma` not in
-/// [0, MAX_SLOPE / 100]; [`Error::InvalidSize`] for a zero size.
+/// [`Error::InvalidParameter`] for `cell_texels` not in [[`MIN_CELL_TEXELS`], max(W, H)] (at most
+/// 4 sites per texel) or `tilt_sigma` not in [0, MAX_SLOPE / 100]; [`Error::InvalidSize`] for a zero
+/// size or more than [`MAX_GENERATED_TEXELS`] texels.
 pub fn flakes(width: usize, height: usize, params: FlakesParams, seed: u64) -> Result<NormalMap> {
-    super::normal_map::texel_count(width, height, width.saturating_mul(height))?;
+    generated_size(width, height)?;
     positive("cell_texels", params.cell_texels)?;
+    if params.cell_texels < MIN_CELL_TEXELS {
+        return Err(Error::InvalidParameter {
+            name: "cell_texels",
+            value: params.cell_texels as f64,
+            reason: "must be at least MIN_CELL_TEXELS = 0.5 (at most 4 flakes per texel)",
+        });
+    }
     if params.cell_texels as f64 > width.max(height) as f64 {
         return Err(Error::InvalidParameter {
             name: "cell_texels",
