@@ -5,6 +5,7 @@
 
 pub mod chi2;
 pub mod format;
+pub mod mixture;
 pub mod quadrature;
 pub mod totality;
 
