@@ -1,28 +1,34 @@
-//! Cost of the Beckmann mixture of \[Chermain2019\]: the build, and per footprint size the patch
-//! construction, D_P, the exact and approximate Λ_P and the visible sampler, each per-direction query
-//! timed by the lobe blocks (`blocks`: the copy of the block loops the CPU selects at run time, AVX2
-//! where it has it; `blocks_baseline`: the same patch forced onto the baseline copy, SSE2 on x86-64)
-//! and by the scalar path (`scalar`, one lobe at a time rebuilt from its moments) in the same run. The blocks paths are the patch's `d`, exact `lambda` and
-//! `sample_visible` (`lambda_blocks` / `sample_visible_blocks` are the same code, callable by name);
-//! `d_scalar`, `lambda_scalar` and `sample_visible_scalar` are the former paths, all `#[doc(hidden)]`.
+//! Cost of the Beckmann mixture of \[Chermain2019\]: the build, and per footprint size, in full and
+//! compact storage (`full` and `compact` ids of each group), the patch construction, D_P, the exact
+//! Λ_P, the visible sampler and the P-BRDF's `eval_pdf`, and the approximate Λ_P (full storage).
 //!
-//! Maps: the four procedural maps (bumpy, brushed, scratched, flakes) at 512², default parameters,
-//! built before timing. Footprints: isotropic, 1 to 65 536 texels, the level of detail off (so that
-//! every size times the mixture itself). Each `d` iteration evaluates 32 precomputed normals (half
-//! drawn from the patch's own D_P cos, half uniform in a 40° cone: where a renderer's half vectors
-//! fall), each Λ / sampler iteration 32 cosine-distributed views, so criterion's throughput is the
-//! time per call.
+//! What is timed is the patch's public queries, i.e. the lobe-block kernels, in the copy of the block
+//! loops the CPU selects at run time (AVX2 where it has it). `BRDF_SIMD=baseline` in the environment
+//! forces the baseline copy (SSE2 on x86-64) for a whole run: run the same command twice to compare
+//! the two copies (their results are bit-identical, tested in the library). The library holds no
+//! scalar reference path to time against.
 //!
-//! Run: `cargo bench --bench mixture -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
-//! (one map: append e.g. `/bumpy`; build times at 2048²:
-//! `cargo test --release --test mixture -- --ignored build_2048 --nocapture`).
+//! Maps: the four procedural maps (bumpy, brushed, scratched, flakes) at 512², default parameters
+//! with the level of detail off (so that every size times the mixture itself), built before timing.
+//! Footprints: isotropic, 1 to 65 536 texels. Each `d` iteration evaluates 32 precomputed normals
+//! (half drawn from the full patch's D_P cos, half uniform in a 40° cone: where a renderer's half
+//! vectors fall), each Λ / sampler iteration 32 cosine-distributed views, each `eval_pdf` iteration
+//! 32 (wo, wi) pairs (half reflected about the full patch's visible samples, half cosine-distributed),
+//! the same inputs for both storages, so criterion's throughput is the time per call.
+//!
+//! Run: `cargo bench --bench mixture -- --warm-up-time 0.5 --measurement-time 2 --sample-size 10`
+//! (the queries only: append `'^mixture_(patch|d|lambda_exact|sample_visible|eval_pdf)/'`; one map:
+//! e.g. `/bumpy/`; build times at 2048²:
+//! `cargo test --release --test mixture_measure -- --ignored build_2048 --nocapture`).
 
+use brdf::fresnel::NoFresnel;
+use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams, PatchOptions};
 use brdf::glint::{
-    BeckmannMixture, BrushedParams, FlakesParams, Footprint, GlintNdf, MaskingMode, MixtureParams,
-    MixturePatch, NormalMap, PatchOptions, ScratchedParams, brushed, bumpy, flakes, scratched,
+    BeckmannMixture, BrushedParams, FlakesParams, Footprint, GlintNdf, NormalMap, ScratchedParams,
+    brushed, bumpy, flakes, scratched,
 };
 use brdf::ndf::Ndf;
-use brdf::{Vec2, Vec3};
+use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
@@ -50,7 +56,8 @@ fn maps() -> Vec<(&'static str, NormalMap)> {
     ]
 }
 
-fn params() -> MixtureParams {
+/// Exact masking, the level of detail off, in the given storage.
+fn params(storage: LobeStorage) -> MixtureParams {
     MixtureParams {
         patch: PatchOptions {
             masking: MaskingMode::Exact,
@@ -58,6 +65,7 @@ fn params() -> MixtureParams {
             lod_tolerance: 0.0,
             ..PatchOptions::default()
         },
+        storage,
         ..MixtureParams::default()
     }
 }
@@ -98,13 +106,32 @@ fn views(seed: u64) -> Vec<(Vec3, Vec2)> {
         .collect()
 }
 
-/// A copy of `patch` forced onto the baseline copy of the block loops (`blocks_baseline`; `blocks`
-/// is what the patch runs: AVX2 where the CPU has it). Bit-identical results
-/// (tests/mixture_dispatch.rs).
-fn baseline<'a>(patch: &MixturePatch<'a>) -> MixturePatch<'a> {
-    let mut base = patch.clone();
-    base.force_baseline_simd(true);
-    base
+/// (wo, wi) pairs for `eval_pdf`: wo cosine-distributed; wi reflected about the patch's visible
+/// sample (even k: where the P-BRDF is large) or cosine-distributed (odd k).
+fn pairs(patch: &impl Ndf) -> Vec<(Vec3, Vec3)> {
+    let (wo, wi) = (views(3), views(5));
+    (0..BATCH)
+        .map(|k| {
+            let (o, u) = wo[k];
+            if k % 2 == 0 {
+                let m = patch.sample_visible(o, u);
+                (o, 2.0 * o.dot(m) * m - o)
+            } else {
+                (o, wi[k].0)
+            }
+        })
+        .collect()
+}
+
+/// The two storages of one map, built with [`params`].
+fn both_storages(map: &NormalMap) -> [(&'static str, BeckmannMixture); 2] {
+    [LobeStorage::Full, LobeStorage::Compact].map(|s| {
+        let label = match s {
+            LobeStorage::Full => "full",
+            LobeStorage::Compact => "compact",
+        };
+        (label, BeckmannMixture::build(map, params(s)).unwrap())
+    })
 }
 
 fn build(c: &mut Criterion) {
@@ -120,32 +147,30 @@ fn build(c: &mut Criterion) {
 
 fn queries(c: &mut Criterion) {
     for (name, map) in maps() {
-        let mix = BeckmannMixture::build(&map, params()).unwrap();
+        let mixes = both_storages(&map);
+        let full = &mixes[0].1;
 
         let mut g = c.benchmark_group(format!("mixture_patch/{name}"));
         for area in AREAS {
             let f = footprint(area);
-            g.bench_with_input(BenchmarkId::from_parameter(area), &f, |b, f| {
-                b.iter(|| mix.patch(black_box(f)).lobe_count())
-            });
+            for (label, mix) in &mixes {
+                g.bench_with_input(BenchmarkId::new(*label, area), &f, |b, f| {
+                    b.iter(|| mix.patch(black_box(f)).lobe_count())
+                });
+            }
         }
         g.finish();
 
         let mut g = c.benchmark_group(format!("mixture_d/{name}"));
         g.throughput(Throughput::Elements(BATCH as u64));
         for area in AREAS {
-            let patch = mix.patch(&footprint(area));
-            let base = baseline(&patch);
-            let m = normals(&patch, 7);
-            g.bench_with_input(BenchmarkId::new("blocks", area), &m, |b, m| {
-                b.iter(|| m.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
-            });
-            g.bench_with_input(BenchmarkId::new("blocks_baseline", area), &m, |b, m| {
-                b.iter(|| m.iter().map(|&h| base.d(black_box(h))).sum::<f32>())
-            });
-            g.bench_with_input(BenchmarkId::new("scalar", area), &m, |b, m| {
-                b.iter(|| m.iter().map(|&h| patch.d_scalar(black_box(h))).sum::<f32>())
-            });
+            let m = normals(&full.patch(&footprint(area)), 7);
+            for (label, mix) in &mixes {
+                let patch = mix.patch(&footprint(area));
+                g.bench_with_input(BenchmarkId::new(*label, area), &m, |b, m| {
+                    b.iter(|| m.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
+                });
+            }
         }
         g.finish();
 
@@ -153,60 +178,52 @@ fn queries(c: &mut Criterion) {
         let mut g = c.benchmark_group(format!("mixture_lambda_exact/{name}"));
         g.throughput(Throughput::Elements(BATCH as u64));
         for area in AREAS {
-            let patch = mix.patch(&footprint(area));
-            let _ = patch.lambda_scalar(Vec3::Z); // build the scalar path's lazy lobes before timing
-            let base = baseline(&patch);
-            g.bench_with_input(BenchmarkId::new("blocks", area), &w, |b, w| {
-                b.iter(|| {
-                    w.iter()
-                        .map(|&(v, _)| patch.lambda_blocks(black_box(v)))
-                        .sum::<f32>()
-                })
-            });
-            g.bench_with_input(BenchmarkId::new("blocks_baseline", area), &w, |b, w| {
-                b.iter(|| {
-                    w.iter()
-                        .map(|&(v, _)| base.lambda_blocks(black_box(v)))
-                        .sum::<f32>()
-                })
-            });
-            g.bench_with_input(BenchmarkId::new("scalar", area), &w, |b, w| {
-                b.iter(|| {
-                    w.iter()
-                        .map(|&(v, _)| patch.lambda_scalar(black_box(v)))
-                        .sum::<f32>()
-                })
-            });
+            for (label, mix) in &mixes {
+                let patch = mix.patch(&footprint(area));
+                g.bench_with_input(BenchmarkId::new(*label, area), &w, |b, w| {
+                    b.iter(|| {
+                        w.iter()
+                            .map(|&(v, _)| patch.lambda(black_box(v)))
+                            .sum::<f32>()
+                    })
+                });
+            }
         }
         g.finish();
 
         let mut g = c.benchmark_group(format!("mixture_sample_visible/{name}"));
         g.throughput(Throughput::Elements(BATCH as u64));
         for area in AREAS {
-            let patch = mix.patch(&footprint(area));
-            let _ = patch.lambda_scalar(Vec3::Z);
-            let base = baseline(&patch);
-            g.bench_with_input(BenchmarkId::new("blocks", area), &w, |b, w| {
-                b.iter(|| {
-                    w.iter()
-                        .map(|&(v, u)| patch.sample_visible_blocks(black_box(v), u).z)
-                        .sum::<f32>()
-                })
-            });
-            g.bench_with_input(BenchmarkId::new("blocks_baseline", area), &w, |b, w| {
-                b.iter(|| {
-                    w.iter()
-                        .map(|&(v, u)| base.sample_visible_blocks(black_box(v), u).z)
-                        .sum::<f32>()
-                })
-            });
-            g.bench_with_input(BenchmarkId::new("scalar", area), &w, |b, w| {
-                b.iter(|| {
-                    w.iter()
-                        .map(|&(v, u)| patch.sample_visible_scalar(black_box(v), u).z)
-                        .sum::<f32>()
-                })
-            });
+            for (label, mix) in &mixes {
+                let patch = mix.patch(&footprint(area));
+                g.bench_with_input(BenchmarkId::new(*label, area), &w, |b, w| {
+                    b.iter(|| {
+                        w.iter()
+                            .map(|&(v, u)| patch.sample_visible(black_box(v), u).z)
+                            .sum::<f32>()
+                    })
+                });
+            }
+        }
+        g.finish();
+
+        let mut g = c.benchmark_group(format!("mixture_eval_pdf/{name}"));
+        g.throughput(Throughput::Elements(BATCH as u64));
+        for area in AREAS {
+            let io = pairs(&full.patch(&footprint(area)));
+            for (label, mix) in &mixes {
+                let brdf = MicrofacetBrdf::new(mix.patch(&footprint(area)), NoFresnel);
+                g.bench_with_input(BenchmarkId::new(*label, area), &io, |b, io| {
+                    b.iter(|| {
+                        io.iter()
+                            .map(|&(o, i)| {
+                                let (f, p) = brdf.eval_pdf(black_box(o), i);
+                                f.x + p
+                            })
+                            .sum::<f32>()
+                    })
+                });
+            }
         }
         g.finish();
 
@@ -215,11 +232,9 @@ fn queries(c: &mut Criterion) {
         for area in AREAS {
             let options = PatchOptions {
                 masking: MaskingMode::Approximate,
-                lod_lobes: f32::INFINITY,
-                lod_tolerance: 0.0,
-                ..PatchOptions::default()
+                ..params(LobeStorage::Full).patch
             };
-            let patch = mix.patch_with(&footprint(area), options);
+            let patch = full.patch_with(&footprint(area), &options, None);
             g.bench_with_input(BenchmarkId::from_parameter(area), &w, |b, w| {
                 b.iter(|| {
                     w.iter()
@@ -232,12 +247,12 @@ fn queries(c: &mut Criterion) {
     }
 }
 
-/// Issue 15 item 3: the build with the default separable filter against the 256-node QMC build of
-/// earlier versions, on the four procedural maps at 512² and 1024² (2048²:
+/// The build with the default separable filter against the 256-node QMC build
+/// ([`brdf::glint::mixture::MomentMethod::Qmc`]), on the four procedural maps at 512² and 1024² (2048²:
 /// `cargo test --lib -- --ignored build_timing_2048 --nocapture`, which alternates the two).
 /// Run: `cargo bench --bench mixture -- mixture_build_method --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 fn build_method(c: &mut Criterion) {
-    use brdf::glint::{BrushedParams, FlakesParams, MomentMethod, brushed, flakes};
+    use brdf::glint::mixture::MomentMethod;
     for n in [512usize, 1024] {
         let maps = [
             ("bumpy", bumpy(n, n, 0.25, 4.0, 1).unwrap()),
@@ -272,8 +287,8 @@ fn build_method(c: &mut Criterion) {
     }
 }
 
-/// The levels of detail (issue 15 item 2): `d` and `patch()` of the full mixture (`full`: tolerance 0,
-/// no cap) against the default level of detail (`lod`: [`brdf::glint::DEFAULT_LOD_TOLERANCE`] and
+/// The levels of detail: `d` and `patch()` of the full mixture (`full`: tolerance 0,
+/// no cap) against the default level of detail (`lod`: [`brdf::glint::mixture::DEFAULT_LOD_TOLERANCE`] and
 /// the default cost cap), alternating per footprint, 256 to 65 536 texels; the same 32 normals
 /// (drawn from the full patch) for both.
 ///
@@ -292,9 +307,9 @@ fn lod(c: &mut Criterion) {
         g.throughput(Throughput::Elements(BATCH as u64));
         for area in [256.0f32, 1024.0, 4096.0, 16384.0, 65536.0] {
             let f = footprint(area);
-            let m = normals(&mix.patch_with(&f, full), 7);
+            let m = normals(&mix.patch_with(&f, &full, None), 7);
             for (label, o) in [("full", full), ("lod", lod)] {
-                let patch = mix.patch_with(&f, o);
+                let patch = mix.patch_with(&f, &o, None);
                 g.bench_with_input(BenchmarkId::new(label, area), &m, |b, m| {
                     b.iter(|| m.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
                 });
@@ -306,7 +321,7 @@ fn lod(c: &mut Criterion) {
             let f = footprint(area);
             for (label, o) in [("full", full), ("lod", lod)] {
                 g.bench_with_input(BenchmarkId::new(label, area), &f, |b, f| {
-                    b.iter(|| mix.patch_with(black_box(f), o).lobe_count())
+                    b.iter(|| mix.patch_with(black_box(f), &o, None).lobe_count())
                 });
             }
         }
@@ -314,80 +329,5 @@ fn lod(c: &mut Criterion) {
     }
 }
 
-/// Compact storage (issue 16 item 5): `patch()`, `d`, exact-masking `lambda` and `sample_visible` of full
-/// (`full`) against compact storage (`compact`: every block decoded on each visit), alternating
-/// per footprint, 256 and 4096 texels, the level of detail off (the full mixture); the same 32
-/// normals (drawn from the full patch) and views for both.
-///
-/// `cargo bench --bench mixture -- mixture_storage --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
-fn storage(c: &mut Criterion) {
-    use brdf::glint::LobeStorage;
-    for (name, map) in maps() {
-        let full = BeckmannMixture::build(&map, params()).unwrap();
-        let compact = BeckmannMixture::build(
-            &map,
-            MixtureParams {
-                storage: LobeStorage::Compact,
-                ..params()
-            },
-        )
-        .unwrap();
-        let w = views(3);
-        let areas = [256.0f32, 4096.0];
-        let mut g = c.benchmark_group(format!("mixture_storage_patch/{name}"));
-        for area in areas {
-            let f = footprint(area);
-            for (label, mix) in [("full", &full), ("compact", &compact)] {
-                g.bench_with_input(BenchmarkId::new(label, area), &f, |b, f| {
-                    b.iter(|| mix.patch(black_box(f)).lobe_count())
-                });
-            }
-        }
-        g.finish();
-        let mut g = c.benchmark_group(format!("mixture_storage_d/{name}"));
-        g.throughput(Throughput::Elements(BATCH as u64));
-        for area in areas {
-            let m = normals(&full.patch(&footprint(area)), 7);
-            for (label, mix) in [("full", &full), ("compact", &compact)] {
-                let patch = mix.patch(&footprint(area));
-                g.bench_with_input(BenchmarkId::new(label, area), &m, |b, m| {
-                    b.iter(|| m.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
-                });
-            }
-        }
-        g.finish();
-        let mut g = c.benchmark_group(format!("mixture_storage_lambda/{name}"));
-        g.throughput(Throughput::Elements(BATCH as u64));
-        for area in areas {
-            for (label, mix) in [("full", &full), ("compact", &compact)] {
-                let patch = mix.patch(&footprint(area));
-                g.bench_with_input(BenchmarkId::new(label, area), &w, |b, w| {
-                    b.iter(|| {
-                        w.iter()
-                            .map(|&(v, _)| patch.lambda(black_box(v)))
-                            .sum::<f32>()
-                    })
-                });
-            }
-        }
-        g.finish();
-        let mut g = c.benchmark_group(format!("mixture_storage_sample_visible/{name}"));
-        g.throughput(Throughput::Elements(BATCH as u64));
-        for area in areas {
-            for (label, mix) in [("full", &full), ("compact", &compact)] {
-                let patch = mix.patch(&footprint(area));
-                g.bench_with_input(BenchmarkId::new(label, area), &w, |b, w| {
-                    b.iter(|| {
-                        w.iter()
-                            .map(|&(v, u)| patch.sample_visible(black_box(v), u).z)
-                            .sum::<f32>()
-                    })
-                });
-            }
-        }
-        g.finish();
-    }
-}
-
-criterion_group!(benches, build, queries, build_method, lod, storage);
+criterion_group!(benches, build, queries, build_method, lod);
 criterion_main!(benches);

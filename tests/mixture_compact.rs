@@ -10,10 +10,8 @@ mod support;
 
 use brdf::bxdf::Masking;
 use brdf::fresnel::NoFresnel;
-use brdf::glint::{
-    self, BeckmannMixture, Footprint, GlintNdf, LobeStorage, MaskingMode, MixtureParams, NormalMap,
-    PatchOptions,
-};
+use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::{self, BeckmannMixture, Footprint, GlintNdf, NormalMap};
 use brdf::ndf::Ndf;
 use brdf::{MicrofacetBrdf, Vec2, Vec3};
 use rand::RngExt;
@@ -38,7 +36,7 @@ const FULL_MIXTURE: PatchOptions = PatchOptions {
     masking: MaskingMode::Exact,
     lod_lobes: f32::INFINITY,
     lod_tolerance: 0.0,
-    lod_resolution: brdf::glint::DEFAULT_LOD_RESOLUTION,
+    lod_resolution: brdf::glint::mixture::DEFAULT_LOD_RESOLUTION,
 };
 
 /// Memory per lobe from `memory()`: ≤ 16 bytes in all under compact storage (the target),
@@ -49,7 +47,7 @@ fn compact_memory_is_at_most_16_bytes_per_lobe() {
     for n in [256usize, 200] {
         let map = glint::bumpy(n, n, 0.25, 4.0, 1).unwrap();
         let (full, compact) = pair(&map);
-        let per = |m: brdf::glint::MixtureMemory| m.total() as f64 / m.lobes as f64;
+        let per = |m: brdf::glint::mixture::MixtureMemory| m.total() as f64 / m.lobes as f64;
         let (f, c) = (per(full.memory()), per(compact.memory()));
         println!("{n}²: full {f:.2} B/lobe, compact {c:.2} B/lobe");
         assert!(c <= 16.0, "{n}²: {c} B/lobe");
@@ -140,7 +138,7 @@ fn compact_d_equals_the_sum_over_its_decoded_lobes() {
                 lod_tolerance: tol,
                 ..FULL_MIXTURE
             };
-            let patch = mix.patch_with(&fp, opts);
+            let patch = mix.patch_with(&fp, &opts, None);
             let lobes: Vec<_> = patch.weighted_lobes().collect();
             for i in 0..200 {
                 let m = if i % 2 == 0 {
@@ -237,8 +235,8 @@ fn tv_rows(
             let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
             let truth = binned_pndf(&map, &fp, Kernel::Gaussian, &bins, samples, 17);
             for &(label, opts) in options {
-                let pf = full.patch_with(&fp, opts);
-                let pc = compact.patch_with(&fp, opts);
+                let pf = full.patch_with(&fp, &opts, None);
+                let pc = compact.patch_with(&fp, &opts, None);
                 let (tf, tc, between) = tv_pair(&pf, &pc, &truth);
                 let delta = tc - tf;
                 rows.push(format!(
@@ -369,7 +367,7 @@ fn compact_chi_square() {
     let mix = BeckmannMixture::build(&map, params(LobeStorage::Compact)).unwrap();
     let fp = Footprint::isotropic_texels(Vec2::new(0.3, 0.3), 16.0, n, n);
     support::chi2_patch_samplers(
-        &mix.patch_with(&fp, FULL_MIXTURE),
+        &mix.patch_with(&fp, &FULL_MIXTURE, None),
         "compact",
         &[30.0, 88.0],
         true,
@@ -377,10 +375,11 @@ fn compact_chi_square() {
     let big = Footprint::isotropic_texels(Vec2::new(0.3, 0.3), 1024.0, n, n);
     let merged = mix.patch_with(
         &big,
-        PatchOptions {
+        &PatchOptions {
             lod_tolerance: 1.0,
             ..FULL_MIXTURE
         },
+        None,
     );
     assert!(merged.level() >= 1);
     support::chi2_patch_samplers(&merged, "compact merged", &[60.0], false);
@@ -408,7 +407,7 @@ fn compact_refuses_tiny_sigma_min() {
         .is_ok()
     );
     let ok = MixtureParams {
-        sigma_min: brdf::glint::MIN_COMPACT_SIGMA,
+        sigma_min: brdf::glint::mixture::MIN_COMPACT_SIGMA,
         ..p
     };
     assert!(BeckmannMixture::build(&map, ok).is_ok());
@@ -427,8 +426,8 @@ fn compact_small_grids_are_total() {
         let (full, compact) = pair(&map);
         let fp = Footprint::isotropic_texels(Vec2::new(0.5, 0.5), 4.0, w, h);
         let (pf, pc) = (
-            full.patch_with(&fp, FULL_MIXTURE),
-            compact.patch_with(&fp, FULL_MIXTURE),
+            full.patch_with(&fp, &FULL_MIXTURE, None),
+            compact.patch_with(&fp, &FULL_MIXTURE, None),
         );
         for theta in [0.0, 30.0, 89.9] {
             let m = support::dir(theta, 10.0);

@@ -9,9 +9,10 @@
 
 mod support;
 
+use brdf::glint::GlintNdf;
+use brdf::glint::mixture::{MixtureParams, PatchOptions};
 use brdf::glint::{
-    BeckmannMixture, Footprint, HemisphereBins, Kernel, MixtureParams, MixturePatch, PatchOptions,
-    binned_pndf, tv_distance,
+    BeckmannMixture, Footprint, HemisphereBins, Kernel, MixturePatch, binned_pndf, tv_distance,
 };
 use brdf::ndf::{Ndf, SlopeGaussian};
 use brdf::{Vec2, Vec3};
@@ -270,11 +271,11 @@ fn lod_diagnose() {
                 lod_tolerance: 0.0,
                 ..PatchOptions::default()
             };
-            let full_p = mix.patch_with(&fp, opts(f32::INFINITY));
+            let full_p = mix.patch_with(&fp, &opts(f32::INFINITY), None);
             let full = patch_mixture(&full_p);
             let own = own_full(&mix, &fp, 3.0);
             let own_c: Vec<Comp> = own.iter().map(|p| p.2).collect();
-            let filt = patch_mixture(&mix.patch_with(&fp, opts(0.0)));
+            let filt = patch_mixture(&mix.patch_with(&fp, &opts(0.0), None));
             let grid = Grid::covering(&[&full], 0.005, 0.0);
             let g_full = grid.splat(&full, 0.0);
             let grid2 = Grid {
@@ -320,7 +321,7 @@ fn lod_diagnose() {
                 excess_kurtosis(&full)
             );
             for l in 1..=levels {
-                let p = mix.patch_with(&fp, opts(1.01 * texels / 4f32.powi(l as i32)));
+                let p = mix.patch_with(&fp, &opts(1.01 * texels / 4f32.powi(l as i32)), None);
                 assert_eq!(p.level(), l as usize);
                 let lv = patch_mixture(&p);
                 let g_lv = grid.splat(&lv, 0.0);
@@ -430,11 +431,12 @@ fn level_of_detail_respects_its_tolerance_at_its_resolution() {
             let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
             let full_p = mix.patch_with(
                 &fp,
-                PatchOptions {
+                &PatchOptions {
                     lod_lobes: f32::INFINITY,
                     lod_tolerance: 0.0,
                     ..PatchOptions::default()
                 },
+                None,
             );
             assert_eq!(full_p.level(), 0);
             let full = patch_mixture(&full_p);
@@ -452,12 +454,13 @@ fn level_of_detail_respects_its_tolerance_at_its_resolution() {
                 for tol in [0.02f32, 0.3] {
                     let p = mix.patch_with(
                         &fp,
-                        PatchOptions {
+                        &PatchOptions {
                             lod_lobes: f32::INFINITY,
                             lod_tolerance: tol,
                             lod_resolution: r,
                             ..PatchOptions::default()
                         },
+                        None,
                     );
                     let bound = p.lod_error() as f64;
                     assert!(
@@ -518,12 +521,13 @@ fn lod_resolution_is_validated_and_total() {
     let at = |r: f32| {
         mix.patch_with(
             &fp,
-            PatchOptions {
+            &PatchOptions {
                 lod_lobes: f32::INFINITY,
                 lod_tolerance: 0.3,
                 lod_resolution: r,
                 ..PatchOptions::default()
             },
+            None,
         )
     };
     let zero = at(0.0);
@@ -534,7 +538,7 @@ fn lod_resolution_is_validated_and_total() {
     }
     // The stored bounds are non-increasing in r, node by node.
     for l in 1..mix.level_count() {
-        for k in 1..brdf::glint::LOD_RESOLUTIONS.len() {
+        for k in 1..brdf::glint::mixture::LOD_RESOLUTIONS.len() {
             let (a, b) = (mix.level_errors_at(l, k - 1), mix.level_errors_at(l, k));
             assert_eq!(a.len(), b.len());
             assert!(a.iter().zip(b).all(|(x, y)| y <= x), "level {l} res {k}");

@@ -7,6 +7,7 @@ pub mod binmap;
 pub mod bxdf;
 pub mod chi2;
 pub mod format;
+pub mod mixture;
 pub mod ndf_centred;
 pub mod position_normal;
 pub mod quadrature;

@@ -25,10 +25,6 @@ use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Default nodes per texel per axis of the filter build (even) for seed spacings h ≥ 1: 4. Finer
-/// spacings use proportionally more, see `nodes_per_texel` in the build code.
-pub const DEFAULT_SUPERSAMPLING: u32 = 4;
-
 /// Nodes per texel along an axis of lobe spacing `h` texels: the multiple of 4 ≥ `supersampling` / min(1, h),
 /// so that the node step never exceeds h / `supersampling` (the kernel's σ is 0.42 h) nor
 /// 1 / `supersampling` texel (the map's own scale).
@@ -285,6 +281,7 @@ fn project(m: &[f64; 5]) -> [f64; 5] {
 
 #[cfg(test)]
 mod tests {
+    use super::super::params::DEFAULT_SUPERSAMPLING;
     use super::*;
 
     #[test]
@@ -511,7 +508,7 @@ mod tests {
         }
     }
 
-    /// The table of docs/results.md ("Fast build (issue 15)"): every lobe of 64² maps.
+    /// The table of docs/results.md ("Fast build"): every lobe of 64² maps.
     /// `cargo test --lib -- --ignored moment_accuracy_table --nocapture`
     #[test]
     #[ignore]

@@ -1,6 +1,6 @@
 //! The two pyramids over the lobe grid: the implicit quadtree of slope bounding boxes that prunes
-//! D_P evaluations (\[Chermain2019\] §5), and the mip chain of lobe moments that serves the approximate
-//! masking terms and the level of detail (\[Chermain2019\] §4.2.2).
+//! D_P evaluations (\[Chermain2019\] §5), and the mip chain of lobe moments that gives a footprint's
+//! filtered lobe (\[Chermain2019\] §4.2.2; full storage, full.rs).
 //!
 //! Lobes sit on a regular grid, so positions are implicit: a node of level l ≥ 1 is the block of
 //! 2^l × 2^l lobes starting at lobe (x·2^l, y·2^l) (clipped at the grid's edge), and stores only the

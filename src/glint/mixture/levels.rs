@@ -1,4 +1,4 @@
-//! Lobe levels of detail (issue 15 item 2): for each level l ≥ 1 of the lobe grid, the merged lobe
+//! Lobe levels of detail: for each level l ≥ 1 of the lobe grid, the merged lobe
 //! of every 2^l × 2^l block of lobes, stored exactly as level 0 is (moments, structure-of-arrays
 //! blocks, slope-box quadtree), plus a per-node merge error, so that a patch evaluates a level like
 //! level 0 (same kernels, same code paths for D_P, the masking sums and the samplers).
@@ -29,7 +29,7 @@
 //! caps it for well-separated children. Both are upper bounds; docs/mixture.md ("Levels of detail
 //! chosen by error") compares the patch-level bound with the measured TV. A patch made of level-l nodes with weights W_n has
 //! TV(Σ W_n G_n, Σ W_n M_n) ≤ Σ W_n e(n) (convexity), which is what the patch compares with its
-//! tolerance (src/glint/mixture/patch.rs).
+//! tolerance (src/glint/mixture/gather.rs).
 //!
 //! **At a slope resolution r.** The same bound holds for the lobes convolved with an isotropic
 //! Gaussian N(0, r² I) in slope space: convolution adds r² I to every covariance, the convolved
@@ -47,10 +47,9 @@
 
 use super::blocks::LobeBlocks;
 use super::hierarchy::lobe_box;
+use super::params::LOD_RESOLUTIONS;
 use crate::glint::kernels::slope_tree::SlopeTree;
 use crate::ndf::SlopeGaussian;
-
-use super::LOD_RESOLUTIONS;
 
 /// Number of tabulated resolutions.
 pub(super) const N_RES: usize = LOD_RESOLUTIONS.len();
@@ -61,7 +60,8 @@ pub(super) fn resolution_index(r: f32) -> usize {
     LOD_RESOLUTIONS.iter().rposition(|&t| t <= r).unwrap_or(0)
 }
 
-/// One level l ≥ 1 of merged lobes (see the module docs).
+/// One level of the lobe grid in full storage: level 0 (the lobes themselves, no merge error) or a
+/// level l ≥ 1 of merged lobes (see the module docs).
 #[derive(Clone, Debug)]
 pub(super) struct LobeLevel {
     /// Nodes along x and y: (nx / 2^l, ny / 2^l).
@@ -73,7 +73,7 @@ pub(super) struct LobeLevel {
     /// The slope-box quadtree over the merged lobes.
     pub tree: SlopeTree,
     /// The merge errors e_r(n) ∈ [0, 1] per node, one vector per resolution r of
-    /// [`LOD_RESOLUTIONS`] (see the module docs).
+    /// [`LOD_RESOLUTIONS`] (see the module docs); empty vectors at level 0 (exact).
     pub error: [Vec<f32>; N_RES],
 }
 
@@ -84,51 +84,6 @@ impl LobeLevel {
             + self.blocks.bytes()
             + self.tree.bytes()
             + self.error.iter().map(|e| e.len() * 4).sum::<usize>()
-    }
-}
-
-/// A level of the lobe grid as a patch reads it: level 0 (the lobes themselves, no merge error) or
-/// a [`LobeLevel`].
-#[derive(Clone, Copy, Debug)]
-pub(super) struct LevelRef<'a> {
-    /// The level l (a node covers 2^l × 2^l lobes).
-    pub level: usize,
-    pub grid: [usize; 2],
-    pub moments: &'a [[f32; 5]],
-    pub blocks: &'a LobeBlocks,
-    pub tree: &'a SlopeTree,
-    /// The merge errors per resolution (module docs); empty at level 0 (exact).
-    pub error: &'a [Vec<f32>],
-    pub sigma_min: f32,
-    /// The level in compact storage (compact.rs): then `moments`, `blocks` and `error` are empty
-    /// and the lobes, blocks and errors are decoded from it.
-    pub compact: Option<&'a super::compact::CompactLevel>,
-}
-
-impl LevelRef<'_> {
-    /// Node k (row major) as a [`SlopeGaussian`].
-    #[inline]
-    pub fn lobe_at(&self, k: usize) -> SlopeGaussian {
-        if let Some(c) = self.compact {
-            return c.lobe(k, self.sigma_min);
-        }
-        SlopeGaussian::from_moments(self.moments[k], self.sigma_min)
-    }
-
-    /// The merge error of node k at the resolution of index `res` in [`LOD_RESOLUTIONS`] (0 at
-    /// level 0).
-    #[inline]
-    pub fn error_at(&self, k: usize, res: usize) -> f32 {
-        // Compact storage keeps one code per node, the bound at r = 0 (plus the encoding's TV):
-        // an upper bound at every resolution r ≥ 0, since blurring both sides only shrinks a TV.
-        if let Some(c) = self.compact {
-            return c.error_at(k);
-        }
-        self.error
-            .get(res)
-            .and_then(|e| e.get(k))
-            .copied()
-            .unwrap_or(0.0)
     }
 }
 

@@ -1,20 +1,37 @@
-//! The mixture's runtime dispatch (issue 15 item 1, docs/mixture.md "Runtime dispatch"): the lobe
-//! blocks' per-query loops compiled for the baseline target and, on CPUs that have it, for AVX2 must
-//! give **bit-identical** results (no FMA, same operation order), so a renderer's images do not
-//! depend on the CPU it runs on.
+//! The runtime dispatch (docs/mixture.md, "Runtime dispatch"): the per-query loops over lobe blocks
+//! compiled for the baseline target and, on CPUs that have it, for AVX2 must give **bit-identical**
+//! results (no FMA, same operation order), so a renderer's images do not depend on the CPU it runs
+//! on. A unit test, since the copy a patch runs is crate-private (`MixturePatch::with_simd`).
 //!
 //! Every comparison is `to_bits` equality: any rounding difference between the two copies (a fused
-//! multiply-add, a reassociated sum) fails the test. On CPUs without AVX2, or with `BRDF_SIMD=baseline`,
-//! there is only one copy: the test prints a note and checks nothing else.
+//! multiply-add, a reassociated sum) fails the test. On CPUs without AVX2, or with
+//! `BRDF_SIMD=baseline`, there is only one copy: the test prints a note and checks nothing else.
 
-mod support;
-
-use brdf::glint::{
-    BeckmannMixture, Footprint, LobeStorage, MaskingMode, MixtureParams, MixturePatch, PatchOptions,
+use super::{BeckmannMixture, LobeStorage, MaskingMode, MixtureParams, MixturePatch, PatchOptions};
+use crate::glint::{
+    BrushedParams, FlakesParams, Footprint, GlintNdf, NormalMap, ScratchedParams, brushed, bumpy,
+    flakes, scratched,
 };
-use brdf::ndf::Ndf;
-use brdf::{Vec2, Vec3};
-use rand::RngExt;
+use crate::ndf::Ndf;
+use glam::{Vec2, Vec3};
+use rand::{RngExt, SeedableRng};
+
+/// The four procedural maps at `n`² with the gallery's parameters and seeds (as tests/support's
+/// `procedural_maps`).
+fn procedural_maps(n: usize) -> Vec<(&'static str, NormalMap)> {
+    vec![
+        ("bumpy", bumpy(n, n, 0.25, 4.0, 1).unwrap()),
+        (
+            "brushed",
+            brushed(n, n, BrushedParams::default(), 2).unwrap(),
+        ),
+        (
+            "scratched",
+            scratched(n, n, ScratchedParams::default(), 3).unwrap(),
+        ),
+        ("flakes", flakes(n, n, FlakesParams::default(), 4).unwrap()),
+    ]
+}
 
 const N: usize = 64;
 
@@ -119,10 +136,10 @@ fn avx2_and_baseline_are_bit_identical() {
         },
         PatchOptions::default(),
     ];
-    let mut rng = support::rng(15);
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(15);
     let mut compared = 0;
     let mut patches = 0;
-    let maps = support::procedural_maps(N);
+    let maps = procedural_maps(N);
     let storages = [LobeStorage::Full, LobeStorage::Compact];
     for ((name, map), storage) in storages
         .iter()
@@ -145,18 +162,16 @@ fn avx2_and_baseline_are_bit_identical() {
                 let angle = 3.2 * rng.random::<f32>();
                 let c = Vec2::new(rng.random(), rng.random());
                 let f = Footprint::anisotropic_texels(c, area, aspect, angle, N, N);
-                let mut avx2 = mix.patch_with(&f, o);
-                avx2.force_baseline_simd(false);
-                if avx2.simd_path() != "avx2" {
+                let avx2 = mix.patch_with(&f, &o, None).with_simd(false);
+                if avx2.simd_name() != "avx2" {
                     println!(
                         "note: this CPU has no AVX2 (or BRDF_SIMD=baseline is set): one copy of \
                          the block loops only, nothing to compare"
                     );
                     return;
                 }
-                let mut base = avx2.clone();
-                base.force_baseline_simd(true);
-                assert_eq!(base.simd_path(), "baseline");
+                let base = avx2.clone().with_simd(true);
+                assert_eq!(base.simd_name(), "baseline");
                 let (diff, n) = first_difference(&avx2, &base, &mut rng);
                 if let Some(e) = diff {
                     panic!(

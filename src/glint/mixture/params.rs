@@ -1,0 +1,380 @@
+//! The mixture's parameters: the build parameters ([`MixtureParams`], validated by the build and the
+//! loader), the per-patch options ([`PatchOptions`]), the choices they hold ([`MomentMethod`],
+//! [`LobeStorage`], [`MaskingMode`]), their documented `DEFAULT_*` values and limits, and the memory
+//! report [`MixtureMemory`].
+
+use crate::error::{Error, Result, positive};
+
+/// Default nodes per texel per axis of the filter build ([`MomentMethod::Filter`]) for seed spacings
+/// h ≥ 1: 4 (a multiple of 4, so that texel centres are nodes). Finer spacings use proportionally
+/// more (`nodes_per_texel` in src/glint/mixture/build_filter.rs).
+pub const DEFAULT_SUPERSAMPLING: u32 = 4;
+
+/// Default seed spacing h = 1 texel: one lobe per texel, at the texel centres (\[Chermain2019\] §5.1.1).
+pub const DEFAULT_SPACING: f32 = 1.0;
+
+/// Default floor σ_ε = 0.01 of the lobes' slope standard deviation (\[Chermain2019\] §3.2).
+pub const DEFAULT_SIGMA_MIN: f32 = crate::ndf::DEFAULT_SIGMA_MIN;
+
+/// Smallest accepted seed spacing h: 1/8 texel. The interpolated map is bilinear per texel, so finer
+/// lobes add memory (∝ 1/h²) without new slope information.
+pub const MIN_SPACING: f32 = 0.125;
+
+/// Largest accepted truncation, in standard deviations, of the seed kernels and position weights
+/// (`kernel_sigmas`, `weight_sigmas`, and the position-normal map's `weight_sigmas`): 10.
+pub const MAX_TRUNCATION_SIGMAS: f32 = 10.0;
+
+/// Default number of quasi-Monte Carlo nodes per lobe for the moments (eq. 6) when
+/// [`MixtureParams::moments`] is [`MomentMethod::Qmc`].
+///
+/// Measured (docs/results.md, `accuracy_table` test, 64² crops of the four procedural maps): the
+/// largest error of any lobe's slope standard deviation against 16384 nodes is 0.29-0.87 σ_ε at 256
+/// nodes (1.0-2.5 σ_ε at 64, 2.9-7.6 σ_ε at 16), the largest mean-slope error 1.7e-3-4.3e-3. Cost is
+/// linear in the count (one interpolated-normal lookup per node).
+pub const DEFAULT_SAMPLES: usize = 256;
+
+/// Default truncation of the seed kernel k_i for the moment integral, in standard deviations per
+/// axis: ±3 σ, the support \[Chermain2019\] §5 gives k_i (the box holds 99.46 % of its mass; the moments
+/// are those of the truncated kernel).
+pub const DEFAULT_KERNEL_SIGMAS: f32 = 3.0;
+
+/// Default truncation of the position weights W_i: lobes whose centre lies more than this many
+/// standard deviations of k_i ∗ k_P from the footprint centre, along either axis, are left out
+/// (then the kept weights are renormalised to sum to 1). 3, as the paper's ±3σ boxes.
+pub const DEFAULT_WEIGHT_SIGMAS: f32 = 3.0;
+
+/// Default tail mass left outside a lobe's slope bounding box: 10⁻⁶.
+///
+/// The box is that of the ellipse holding 1 − tail of the lobe, k² = −2 ln(tail) (k = 5.26 here);
+/// D_P ignores a lobe outside its box, so D_P integrates to at least 1 − tail and the samplers (which
+/// draw the untruncated lobes) disagree with the pdf by at most `tail` in total variation. The paper
+/// uses the 99 % box (tail 0.01, k = 3.03): 1.8× fewer lobes touched per query (docs/mixture.md) but
+/// a normalisation error up to 1 %.
+pub const DEFAULT_SLOPE_TAIL: f32 = 1.0e-6;
+
+/// Default cost cap of the level of detail: a patch whose footprint covers more than this many
+/// nodes (area in cells of the chosen level) moves to coarser levels, whatever the tolerance; when
+/// no level is coarse enough (grids that do not halve evenly), it is served by the single filtered
+/// lobe (D, masking and sampling).
+///
+/// A cost bound, not an accuracy one: `d` costs ~20-40 ns per touched lobe, so 16384 nodes bound a
+/// query to ~0.1-1 ms (docs/results.md). Set `f32::INFINITY` to let only the tolerance decide. The cap
+/// picks the finest level of merged lobes under it, not the filtered lobe straight away (which costs
+/// 4-26× the TV to the ground truth where a merged level exists; docs/mixture.md).
+pub const DEFAULT_LOD_LOBES: f32 = 16384.0;
+
+/// Default level-of-detail tolerance: the bound Σ W_n e_r(n) on the total variation between a
+/// patch of merged lobes and the full mixture that a patch may spend (e_r(n) the merge error of
+/// node n at the slope resolution r = [`PatchOptions::lod_resolution`], src/glint/mixture/levels.rs).
+/// 0 keeps the full mixture.
+///
+/// Since |TV(lod, R) − TV(full, R)| ≤ TV(lod, full) for any reference R, at r = 0 the tolerance
+/// bounds the increase of the TV to any (binned) ground truth, up to the node-weight approximation
+/// (docs/mixture.md); at r > 0 it bounds the increase seen through a Gaussian blur of std r. 0.01 is
+/// the budget chosen for that increase; the footprint sweep of docs/results.md ("Levels of detail
+/// chosen by error") measured +0.013 at 0.1 on the scratched map (within that tolerance, over the
+/// 0.01 budget) for 5× cheaper `d`. At 0.01 the tolerance alone merged nothing on the 512² maps of
+/// that sweep at r = 0, 0.01 or 0.04: merged levels there change the P-NDF's shape by more than
+/// 0.01 (docs/mixture.md, "Why merged levels lose"), and levels ≥ 1 come from the cost cap.
+pub const DEFAULT_LOD_TOLERANCE: f32 = 0.01;
+
+/// The slope resolutions r at which the levels store their merge-error bounds (slope units, an
+/// isotropic Gaussian's standard deviation): a patch reads the bound at the largest of these ≤
+/// [`PatchOptions::lod_resolution`], which also bounds the error at that resolution (the TV of
+/// blurred densities can only shrink as the blur grows). 0 is the continuous bound.
+pub const LOD_RESOLUTIONS: [f32; 3] = [0.0, 0.01, 0.04];
+
+/// Default resolution of the level-of-detail error: r = 0.01 in slope (~0.57° of normal
+/// direction), the standard deviation of an isotropic Gaussian blur applied to both P-NDFs before
+/// their total variation is bounded (src/glint/mixture/levels.rs).
+///
+/// Why 0.01: the ground truth the crate measures against is binned on 64² equal-area hemisphere
+/// bins, 0.039 wide in slope near the normal, whose uniform spread has a standard deviation of
+/// 0.039/√12 = 0.011; and a renderer sees the P-NDF through its lights: a light of angular radius ρ
+/// moves the half vector by ρ/2, so 0.01 is the spread of a light about 4.6° across (a sun, 0.53°,
+/// blurs by 0.0012; r = 0 keeps the continuous bound for point lights). Measured effect in
+/// docs/results.md, "Levels of detail chosen by error".
+pub const DEFAULT_LOD_RESOLUTION: f32 = 0.01;
+
+/// How the build integrates each lobe's five slope moments (\[Chermain2019\] eq. 6).
+///
+/// Both integrate the same quantity (the interpolated map's slopes under the seed kernel truncated
+/// at ±`kernel_sigmas` σ per axis); they differ in cost and quadrature error. Measured against a
+/// converged 65 536-node QMC reference (docs/mixture.md, docs/results.md, "Fast build").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MomentMethod {
+    /// A separable filter of the interpolated map sampled on a grid of `supersampling` nodes per
+    /// texel per axis (rounded up to even; multiplied by 1/h for spacings h < 1), linear between nodes
+    /// and integrated exactly against the kernel; processed in parallel bands of lobe rows. Cost per
+    /// lobe ~ (supersampling · h)² node lookups plus two short 1D filters; error O(1/supersampling²).
+    /// `supersampling` in [1, 64].
+    Filter {
+        /// Nodes per texel per axis ([`DEFAULT_SUPERSAMPLING`]).
+        supersampling: u32,
+    },
+    /// Quasi-Monte Carlo with [`MixtureParams::samples`] nodes per lobe (an R2 point set mapped
+    /// through the truncated Gaussian's inverse cdf). Slower than the filter at the same accuracy;
+    /// reproduces the moments of mixtures built with it bit for bit.
+    Qmc,
+}
+
+impl Default for MomentMethod {
+    fn default() -> Self {
+        MomentMethod::Filter {
+            supersampling: DEFAULT_SUPERSAMPLING,
+        }
+    }
+}
+
+/// Largest accepted [`MomentMethod::Filter`] supersampling: 64 nodes per texel per axis (the
+/// node rows a band holds grow with it; the quadrature error is already ~1e-3 of 4's).
+pub const MAX_SUPERSAMPLING: u32 = 64;
+
+/// How a [`BeckmannMixture`](super::BeckmannMixture) holds its lobes in memory (and in files).
+///
+/// Trade-off (docs/mixture.md, "Compact storage"; measured in docs/results.md): `Compact` holds
+/// ≤ 16 bytes per lobe in all (15.4 measured, against ~87 for `Full`) and loads several times faster, at the cost
+/// of a per-block decode in every query (`d`, the exact masking and the visible sampler run slower,
+/// see the results) and of an encoding error far below the mixture's own (mean slopes to 16 bits
+/// inside their block's slope box, the inverse Cholesky factor to binary16: TV change against the
+/// ground truth ≤ 0.002 measured). Either way the model is self-consistent: `d`, the masking terms,
+/// the samplers and their pdfs all read the same stored lobes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum LobeStorage {
+    /// The raw moments (20 B per lobe), the lobe blocks in `f32` (32 B), the quadtree, the moment
+    /// mip chain and the levels of detail in the same form: ~87 bytes per lobe (87.1 measured: 64 for
+    /// level 0 and its mip chain, 23.1 for the levels l ≥ 1), the fastest queries.
+    #[default]
+    Full,
+    /// Every level of detail only as compact blocks (per lobe the mean slope as two `u16` inside its
+    /// block's slope box and the scaled inverse Cholesky factor as three binary16: 10 bytes), the
+    /// quadtree from the block level up, one-byte merge errors rounded up, no moments and no mip
+    /// chain (the filtered lobe comes from the levels of detail): ≤ 16 bytes per lobe in all.
+    /// Needs `sigma_min` ≥ [`MIN_COMPACT_SIGMA`].
+    Compact,
+}
+
+/// Smallest `sigma_min` accepted with [`LobeStorage::Compact`]: 2·10⁻⁵. Every entry of the scaled
+/// inverse Cholesky factor is at most √(½ log₂ e)/σ_min in magnitude (the covariance floor keeps every
+/// direction's σ ≥ σ_min), which must stay below binary16's largest value 65504.
+pub const MIN_COMPACT_SIGMA: f32 = 2.0e-5;
+
+/// Default masking mode of patches.
+pub const DEFAULT_MASKING: MaskingMode = MaskingMode::Exact;
+
+/// How a patch computes A_P, Λ_P (and so G1, G2 and the P-BRDF's normalisation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum MaskingMode {
+    /// Exact: V_P(w) = Σ W_i V_i(w) over every lobe of the footprint, A_P(w) from the patch mean
+    /// slope (\[Chermain2019\] eq. 13-17). O(lobes) per direction.
+    #[default]
+    Exact,
+    /// Approximate: A_P from the patch mean slope (exact) and V_P bounded from above by Scarf's
+    /// bound on the patch's slope mean and covariance, gathered once per patch. O(1) per
+    /// direction. Sound where the paper's filtered-lobe Λ (\[Chermain2019\] §4.2.2) is not: V is never
+    /// under-estimated, so the white furnace stays ≤ 1; the price is darker grazing views (the bound
+    /// over-shadows; docs/results.md, "Beckmann mixture").
+    Approximate,
+}
+
+/// Per-patch options: the masking mode and the level of detail (error tolerance and cost cap).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PatchOptions {
+    /// Exact or approximate masking terms ([`DEFAULT_MASKING`]).
+    pub masking: MaskingMode,
+    /// Cost cap ([`DEFAULT_LOD_LOBES`]): footprints of more than this many nodes of the chosen
+    /// level move to coarser levels (the filtered lobe alone when none is coarse enough);
+    /// `f32::INFINITY` disables the cap.
+    pub lod_lobes: f32,
+    /// Error tolerance of the level of detail ([`DEFAULT_LOD_TOLERANCE`]): a patch uses the
+    /// coarsest level of merged lobes whose weighted merge-error bound Σ W_n e(n) is at most this
+    /// (and whose nodes are no wider than half the footprint's smaller standard deviation); 0 keeps the
+    /// full mixture (level 0), unless the cost cap moves it. Not stored in saved files.
+    pub lod_tolerance: f32,
+    /// Slope resolution r of the tolerance's error ([`DEFAULT_LOD_RESOLUTION`], slope units): the
+    /// bound Σ W_n e_r(n) is on the TV between the two P-NDFs after both are blurred by an isotropic
+    /// Gaussian of standard deviation r in slope space, read at the largest r of
+    /// [`LOD_RESOLUTIONS`] not above this. 0: the continuous TV. Not stored in saved files.
+    pub lod_resolution: f32,
+}
+
+impl Default for PatchOptions {
+    fn default() -> Self {
+        PatchOptions {
+            masking: DEFAULT_MASKING,
+            lod_lobes: DEFAULT_LOD_LOBES,
+            lod_tolerance: DEFAULT_LOD_TOLERANCE,
+            lod_resolution: DEFAULT_LOD_RESOLUTION,
+        }
+    }
+}
+
+/// Build parameters of a [`BeckmannMixture`](super::BeckmannMixture). `Default` gives the documented `DEFAULT_*` values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MixtureParams {
+    /// Seed spacing h in texels (≥ [`MIN_SPACING`]). The lobe grid has max(1, round(width / h)) × max(1,
+    /// round(height / h)) lobes, so the spacing actually used per axis is width / nx (height / ny):
+    /// an integer number of lobes tiles the map.
+    pub spacing: f32,
+    /// Floor σ_ε of the lobes' slope standard deviation (> 0).
+    pub sigma_min: f32,
+    /// Quasi-Monte Carlo nodes per lobe for the moments, used (and required ≥ 1) when `moments` is
+    /// [`MomentMethod::Qmc`]; ignored under [`MomentMethod::Filter`], where any value is accepted.
+    pub samples: usize,
+    /// Truncation of k_i for the moment integral, in σ (in (0, [`MAX_TRUNCATION_SIGMAS`]]).
+    pub kernel_sigmas: f32,
+    /// Truncation of the position weights, in σ (in (0, [`MAX_TRUNCATION_SIGMAS`]]).
+    pub weight_sigmas: f32,
+    /// Mass left outside each lobe's slope box (0 < tail < 1).
+    pub slope_tail: f32,
+    /// Options of the patches made by [`GlintNdf::patch`](crate::glint::GlintNdf::patch).
+    pub patch: PatchOptions,
+    /// How the moments are integrated ([`MomentMethod::default`]: the filter). Not stored in saved
+    /// files (a loaded mixture reads its moments and reports the default here).
+    pub moments: MomentMethod,
+    /// How the lobes are held ([`LobeStorage::Full`] by default). Stored in files (as the model
+    /// kind, docs/format.md).
+    pub storage: LobeStorage,
+}
+
+impl Default for MixtureParams {
+    fn default() -> Self {
+        MixtureParams {
+            spacing: DEFAULT_SPACING,
+            sigma_min: DEFAULT_SIGMA_MIN,
+            samples: DEFAULT_SAMPLES,
+            kernel_sigmas: DEFAULT_KERNEL_SIGMAS,
+            weight_sigmas: DEFAULT_WEIGHT_SIGMAS,
+            slope_tail: DEFAULT_SLOPE_TAIL,
+            patch: PatchOptions::default(),
+            moments: MomentMethod::default(),
+            storage: LobeStorage::default(),
+        }
+    }
+}
+
+impl MixtureParams {
+    /// Checks every field (the build's and the loader's gate).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the first invalid field.
+    pub(super) fn validate(&self) -> Result<()> {
+        if !(self.spacing >= MIN_SPACING && self.spacing.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "spacing",
+                value: self.spacing as f64,
+                reason: "must be finite and >= 0.125 texel (MIN_SPACING: finer lobes repeat the \
+                         bilinear map's moments and multiply memory by 1/h²)",
+            });
+        }
+        positive("sigma_min", self.sigma_min)?;
+        for (name, v) in [
+            ("kernel_sigmas", self.kernel_sigmas),
+            ("weight_sigmas", self.weight_sigmas),
+        ] {
+            if !(v > 0.0 && v <= MAX_TRUNCATION_SIGMAS) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: v as f64,
+                    reason: "must be in (0, 10] (MAX_TRUNCATION_SIGMAS: beyond 10 σ a Gaussian \
+                             holds < 1e-22 of its mass, and the enumerated region grows as its square)",
+                });
+            }
+        }
+        // `samples` counts the QMC nodes: unused (and so not checked) under the filter.
+        if self.moments == MomentMethod::Qmc && self.samples == 0 {
+            return Err(Error::InvalidParameter {
+                name: "samples",
+                value: 0.0,
+                reason: "must be at least 1 with MomentMethod::Qmc",
+            });
+        }
+        if let MomentMethod::Filter { supersampling } = self.moments
+            && !(1..=MAX_SUPERSAMPLING).contains(&supersampling)
+        {
+            return Err(Error::InvalidParameter {
+                name: "supersampling",
+                value: supersampling as f64,
+                reason: "must be in [1, 64] (MAX_SUPERSAMPLING)",
+            });
+        }
+        if self.storage == LobeStorage::Compact
+            && (self.sigma_min.is_nan() || self.sigma_min < MIN_COMPACT_SIGMA)
+        {
+            return Err(Error::InvalidParameter {
+                name: "sigma_min",
+                value: self.sigma_min as f64,
+                reason: "must be >= 2e-5 (MIN_COMPACT_SIGMA) with LobeStorage::Compact: the \
+                         inverse Cholesky factors must fit binary16",
+            });
+        }
+        if !(self.slope_tail > 0.0 && self.slope_tail < 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "slope_tail",
+                value: self.slope_tail as f64,
+                reason: "must be in (0, 1)",
+            });
+        }
+        if self.patch.lod_lobes.is_nan() || self.patch.lod_lobes < 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "lod_lobes",
+                value: self.patch.lod_lobes as f64,
+                reason: "must be >= 0 (infinity disables the level of detail)",
+            });
+        }
+        let t = self.patch.lod_tolerance;
+        if !(t >= 0.0 && t.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "lod_tolerance",
+                value: t as f64,
+                reason: "must be finite and >= 0 (0 keeps the full mixture)",
+            });
+        }
+        let r = self.patch.lod_resolution;
+        if !(r >= 0.0 && r.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "lod_resolution",
+                value: r as f64,
+                reason: "must be finite and >= 0 (0: the continuous bound)",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Memory held by a [`BeckmannMixture`](super::BeckmannMixture), in bytes.
+///
+/// Under [`LobeStorage::Compact`]: `lobe_bytes` and `mip_bytes` are 0 (no moments, no mip chain),
+/// `block_bytes` holds level 0's compact blocks (160 bytes per 4 × 4 lobes), `hierarchy_bytes` its
+/// quadtree from level 2 up, and `level_bytes` the levels l ≥ 1 in the same form with one byte of
+/// merge error per node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MixtureMemory {
+    /// Number of lobes.
+    pub lobes: usize,
+    /// The lobes' moments (20 bytes each).
+    pub lobe_bytes: usize,
+    /// The slope-box quadtree (levels ≥ 1, 16 bytes per node).
+    pub hierarchy_bytes: usize,
+    /// The moment mip chain above the lobes (20 bytes per node), for the filtered lobe
+    /// ([`MixturePatch::filtered_lobe`](super::MixturePatch::filtered_lobe)).
+    pub mip_bytes: usize,
+    /// The lobe blocks: per lobe the mean, the Cholesky factor and its scaled inverse in `f32`
+    /// (32 bytes per lobe, in tiles of 4 × 4 lobes; edge tiles padded), what `d`, the exact masking
+    /// and the samplers read.
+    pub block_bytes: usize,
+    /// The levels of detail l ≥ 1 (per node: moments, block lanes, quadtree, merge error; ≤ ⅓ of
+    /// level 0's lobes + blocks + quadtree for a full chain).
+    pub level_bytes: usize,
+}
+
+impl MixtureMemory {
+    /// Total bytes (lobes, hierarchy, mip chain, blocks and levels of detail).
+    pub fn total(&self) -> usize {
+        self.lobe_bytes
+            + self.hierarchy_bytes
+            + self.mip_bytes
+            + self.block_bytes
+            + self.level_bytes
+    }
+}
