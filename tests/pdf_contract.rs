@@ -314,12 +314,10 @@ fn issue_cases() {
     }
 }
 
-/// The mixture's patches: the same contract. `pdf_normal` and `pdf_visible` of the mixture sum
-/// its lobes without the slope-box truncation that `d` applies (src/glint/mixture/patch.rs), so
-/// they are positive where `d` is 0; the fix belongs to the mixture (being restructured
-/// elsewhere): ignored until then.
+/// The mixture's patches: the same contract. `pdf_normal` and `pdf_visible` of the mixture sum its
+/// lobes without the slope-box truncation that `d` applies, so they are 0 where `d` is by an
+/// explicit check (src/glint/mixture/patch.rs).
 #[test]
-#[ignore]
 fn mixture_patch_pdfs_vanish_where_d_does() {
     let map = bumpy(16, 16, 0.3, 3.0, 5).unwrap();
     let mut patches: Vec<(String, BeckmannMixture)> = Vec::new();

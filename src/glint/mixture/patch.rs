@@ -417,13 +417,15 @@ impl Ndf for MixturePatch<'_> {
     }
 
     /// Σ W_i D_i(m) cos θ_m over **every** gathered lobe (no slope-box truncation): exactly the
-    /// density of [`Ndf::sample_normal`]. Differs from `d(m) cos θ_m` by at most the truncated tail
-    /// (`slope_tail` of each lobe's mass). O(lobes).
+    /// density of [`Ndf::sample_normal`] where D_P > 0, and 0 where D_P = 0 (outside every lobe's
+    /// slope box, where the sampler lands with probability at most `slope_tail`; `MicrofacetBrdf`
+    /// then returns no sample). Differs from `d(m) cos θ_m` by at most the truncated tail. O(lobes).
     fn pdf_normal(&self, m: Vec3) -> f32 {
         let Some(g) = &self.gathered else {
             return self.filtered.pdf_normal(m);
         };
-        if !(m.z > 0.0 && m.is_finite()) {
+        // 0 where D_P is (outside every lobe's slope box): one density contract for every NDF.
+        if !(m.z > 0.0 && m.is_finite()) || self.d(m) <= 0.0 {
             return 0.0;
         }
         let p = self.untruncated_d(g, m) * m.z as f64;
@@ -432,13 +434,18 @@ impl Ndf for MixturePatch<'_> {
     }
 
     /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe, with the exact V_P in every masking
-    /// mode: exactly the density of [`Ndf::sample_visible`]. O(lobes).
+    /// mode: exactly the density of [`Ndf::sample_visible`] where D_P > 0, and 0 where D_P = 0.
+    /// O(lobes).
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
         let Some(g) = &self.gathered else {
             return self.filtered.pdf_visible(wo, m);
         };
         let c = wo.dot(m);
         if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
+            return 0.0;
+        }
+        // 0 where D_P is (outside every lobe's slope box): one density contract for every NDF.
+        if self.d(m) <= 0.0 {
             return 0.0;
         }
         let v = self.exact_visible_area(g, wo);
