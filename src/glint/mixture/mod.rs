@@ -20,7 +20,8 @@
 //! The model, the hierarchy layout, the deviations from the paper and the defaults with their
 //! measurements are in docs/mixture.md.
 //!
-//! **Files, bottom to top.** Each file imports only files listed before it (no cycles):
+//! **Files, bottom to top.** Each file imports only files listed before it (no cycles; unit-test
+//! modules may also build mixtures through the public API):
 //! 1. `params.rs`: parameters, options, `DEFAULT_*` constants, [`MixtureMemory`];
 //! 2. `build.rs` (QMC moments), `build_filter.rs` (the separable filter's moments);
 //! 3. `lanes.rs` (lane arithmetic: `exp2`, the ramp term), `blocks.rs` (the 4 × 4 lobe blocks, their
