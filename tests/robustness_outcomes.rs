@@ -7,7 +7,7 @@ mod support;
 use brdf::bxdf::PhongNormalization;
 use brdf::fresnel::{ConductorFresnel, DielectricFresnel, SchlickFresnel};
 use brdf::glint::binmap::BinMapParams;
-use brdf::glint::mixture::MixtureParams;
+use brdf::glint::mixture::{MixtureParams, MomentMethod};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
     BeckmannMixture, BinMap, NormalMap, NormalRepair, PositionNormalMap, TangentConvention,
@@ -205,10 +205,15 @@ fn constructor_cases() -> Vec<Case> {
             ..d
         },
     ));
+    // `samples` counts quasi-Monte Carlo nodes: checked under `MomentMethod::Qmc` only.
     v.push(mix(
-        "samples 0",
+        "samples 0, QMC moments",
         "samples",
-        MixtureParams { samples: 0, ..d },
+        MixtureParams {
+            samples: 0,
+            moments: MomentMethod::Qmc,
+            ..d
+        },
     ));
     v.push(mix(
         "slope_tail 1",
