@@ -7,7 +7,8 @@
 //! Run: `cargo bench --bench fresnel -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 //! (the figures in docs/results.md, section "Fresnel and warps", come from this command).
 //!
-//! Table mode (the Fresnel rows of the C++ comparison in docs/results.md, "Analytic NDFs"):
+//! Table mode (the Fresnel rows of the C++ comparison in docs/results.md,
+//! "Analytic NDFs: speed against pbrt-v4 and Mitsuba 3"):
 //! `BRDF_TABLE=1 cargo bench --bench fresnel` prints the minimum and median ns per call over
 //! 5 × 1000 batches of 1024 calls on the inputs of `benches/cpp/analytic.cpp`.
 

@@ -14,7 +14,7 @@
 //! D_P cos θ, half bin centres), the best of 3 alternating rounds over the configurations, each
 //! round repeating the 512 calls for ≥ 20 ms. Writes `mixture_lod.csv`, and per map
 //! `mixture_lod_tv_{map}.png` and `mixture_lod_time_{map}.png` (the charted configurations); prints
-//! two Markdown tables (docs/results.md, "Levels of detail chosen by error (issue 15)"): TV / time /
+//! two Markdown tables (docs/results.md, "Levels of detail chosen by error"): TV / time /
 //! level per configuration and footprint, and issue 15's target cell by cell at ≥ 4096 texels.
 
 mod common;

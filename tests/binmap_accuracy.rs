@@ -331,7 +331,7 @@ fn subtexel_table() {
     }
 }
 
-/// The measure and the model (docs/results.md, "The bin map, finished"): TV against the
+/// The measure and the model (docs/results.md, "Inverse bin map (Atanasov 2020)"): TV against the
 /// parallelogram-kernel ground truth (256² procedural maps, footprints at uv (0.43, 0.57), 64²
 /// reference bins, 4·10⁶ positions), with the midpoint rule of `tv_distance` (8 × 8 points per
 /// reference bin, the measure of the tables before) and with the exact overlaps (`masses_on`), for

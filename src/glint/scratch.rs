@@ -13,7 +13,7 @@ use std::sync::{Mutex, OnceLock};
 /// Reusable buffers for the patches of every glint model (see the module docs).
 ///
 /// Holds no data between patches, only capacity: its memory is the largest patch's working set
-/// (about 12 + 32 bytes per lobe of the largest mixture footprint, 24 + 32 per element of the
+/// (about 16 bytes per lobe slot of the largest mixture footprint, 24 + 32 per element of the
 /// largest position-normal footprint). `Default` is empty and allocates nothing.
 ///
 /// Each model keeps its own buffer type in one slot, found by type (a short scan of at most one

@@ -199,7 +199,7 @@ impl SlopeTree {
     /// grids under 2²⁹ elements per side) so that the stack is 1 KiB of plain zeros to set up.
     ///
     /// `#[inline(always)]`: the mixture's lobe-block passes are compiled once more with AVX2
-    /// (src/glint/mixture/blocks.rs, `dispatch`), and only code inlined into them gets that copy.
+    /// (src/glint/mixture/simd.rs), and only code inlined into them gets that copy.
     #[inline(always)]
     pub fn for_each_node(
         &self,

@@ -219,7 +219,7 @@ fn lobe_mean_cov(m: &[f32; 5], s2: f64) -> Option<([f64; 2], [f64; 3])> {
 /// the tree's level 1) whose Gaussians and boxes live only in a per-thread scratch: each lobe's
 /// Gaussian is computed once, and neither the Gaussians (32 bytes per lobe) nor the boxes (16) are
 /// ever held for the whole grid. Loading a mixture is bounded by the memory it fills (docs/results.md,
-/// "Format version 2 and the faster loaders"), so not holding those 48 bytes per lobe of
+/// "Loads of format version 3"), so not holding those 48 bytes per lobe of
 /// temporaries is what keeps a load fast.
 fn derive_blocks_and_tree(
     nx: usize,

@@ -100,7 +100,7 @@ pub const DEFAULT_LOD_RESOLUTION: f32 = 0.01;
 ///
 /// Both integrate the same quantity (the interpolated map's slopes under the seed kernel truncated
 /// at ±`kernel_sigmas` σ per axis); they differ in cost and quadrature error. Measured against a
-/// converged 65 536-node QMC reference (docs/mixture.md, docs/results.md, "Fast build").
+/// converged 65 536-node QMC reference (docs/mixture.md, docs/results.md, "Mixture build: filter against QMC").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum MomentMethod {
     /// A separable filter of the interpolated map sampled on a grid of `supersampling` nodes per
@@ -173,7 +173,7 @@ pub enum MaskingMode {
     /// bound on the patch's slope mean and covariance, gathered once per patch. O(1) per
     /// direction. Sound where the paper's filtered-lobe Λ (\[Chermain2019\] §4.2.2) is not: V is never
     /// under-estimated, so the white furnace stays ≤ 1; the price is darker grazing views (the bound
-    /// over-shadows; docs/results.md, "Beckmann mixture").
+    /// over-shadows; docs/results.md, "Exact and approximate masking").
     Approximate,
 }
 

@@ -96,7 +96,7 @@ impl BeckmannMixture {
     /// Cost: one pass over the file (read, checksum and range check together) plus the O(lobes) lobe
     /// blocks, quadtree and mip chain (parallel, derived in bands of 4 lobe rows); no moment integration.
     /// On a 2-core machine the time is mostly the page faults of the model's fresh 64 bytes per lobe
-    /// (docs/results.md, "Format version 2 and the faster loaders"). Memory is allocated only as data
+    /// (docs/results.md, "Loads of format version 3"). Memory is allocated only as data
     /// arrive (in 64 KiB steps), whatever the header claims.
     ///
     /// # Errors
