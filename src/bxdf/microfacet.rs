@@ -37,9 +37,9 @@
 //! number. At grazing views a micronormal nearly perpendicular to wo reflects wo to wi ≈ −wo, and h
 //! rebuilt from wo + wi is then off by up to ~6·10⁻⁸ / (2 wo·m) radians (the rounding of wi against
 //! the tiny sum); wo·h, a difference of terms of size 1, is off by as much, so any other cosine
-//! (the accurate ‖wo + wi‖/2, say) disagrees with it by a factor that grows like 1/(wo·m)²: the
-//! weight reached 880 at cos θo = 10⁻⁷ and 8.8·10¹⁵ at 10⁻²⁰ for Beckmann before this was written
-//! so. The Jacobian therefore uses `wo.dot(h)` in `f32`, as the NDFs' `pdf_visible` does (every NDF
+//! (the accurate ‖wo + wi‖/2, say) disagrees with it by a factor that grows like 1/(wo·m)²: with
+//! that cosine the weight reaches 880 at cos θo = 10⁻⁷ and 8.8·10¹⁵ at 10⁻²⁰ for Beckmann. The
+//! Jacobian therefore uses `wo.dot(h)` in `f32`, as the NDFs' `pdf_visible` does (every NDF
 //! and patch of the crate computes ⟨wo, m⟩ as `wo.dot(m)`; an [`Ndf`] of a caller's that rounds it
 //! otherwise gets a weight off by ~10⁻⁷ / ⟨wo, m⟩), and [`MicrofacetBrdf::eval`] and
 //! [`MicrofacetBrdf::pdf`] are 0 where the computed wo·h or wi·h is not positive. The weight is then
