@@ -85,11 +85,11 @@ fn patch_construction(c: &mut Criterion) {
     }
     g.finish();
     let mut g = c.benchmark_group("binmap_patch_in_2048");
-    let mut scratch = GlintScratch::default();
+    let scratch = GlintScratch::default();
     for area in AREAS {
         let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, SIZE, SIZE);
         g.bench_with_input(BenchmarkId::from_parameter(area), &fp, |b, fp| {
-            b.iter(|| bm.patch_in(black_box(fp), &mut scratch).area_texels())
+            b.iter(|| bm.patch_in(black_box(fp), &scratch).area_texels())
         });
     }
     g.finish();

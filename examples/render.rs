@@ -39,7 +39,8 @@ fn main() -> Res<()> {
 #[cfg(test)]
 mod tests {
     use super::common::render::showcase::{Options, glint_model, progress_bar, showcase};
-    use super::common::render::{Camera, Material, Scene, Sky, render};
+    use super::common::render::{Camera, Scene, Sky, render};
+    use brdf::GlintMaterial;
     use brdf::fresnel::NoFresnel;
     use brdf::glint::{ScratchedParams, bumpy, scratched};
     use brdf::{Vec2, Vec3};
@@ -60,11 +61,8 @@ mod tests {
             glint_model(&scratched(32, 32, ScratchedParams::default(), 1).unwrap()).unwrap();
         let scene = showcase(
             |tiles| {
-                Ok(Material::Glint {
-                    model,
-                    fresnel: Box::new(brdf::fresnel::ConductorFresnel::GOLD),
-                    tiles,
-                })
+                let glints = GlintMaterial::new(model, brdf::fresnel::ConductorFresnel::GOLD);
+                Ok(glints.with_uv_scale(tiles)?.into())
             },
             &opts,
         )
@@ -89,14 +87,12 @@ mod tests {
         let (w, h, spp) = (32u32, 32u32, 16u32);
         // A rough map (RMS slope 0.3), so that both the sky sampler and BRDF sampling carry weight.
         let model = glint_model(&bumpy(64, 64, 0.3, 4.0, 2).unwrap()).unwrap();
+        let glints = GlintMaterial::new(model, NoFresnel).with_uv_scale(Vec2::new(2.0, 1.0));
         let scene = Scene {
+            materials: vec![glints.unwrap().into()],
             center: Vec3::ZERO,
             radius: 1.0,
-            sphere: Material::Glint {
-                model,
-                fresnel: Box::new(NoFresnel),
-                tiles: Vec2::new(2.0, 1.0),
-            },
+            sphere: 0,
             ground: None,
             light: None,
             sky: Sky::Constant(Vec3::ONE),

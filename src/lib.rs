@@ -35,6 +35,7 @@ pub mod frame;
 pub mod fresnel;
 pub mod glint;
 mod math;
+pub mod material;
 pub mod ndf;
 pub mod warp;
 
@@ -44,6 +45,7 @@ pub use bxdf::{
 };
 pub use error::{Error, Result};
 pub use fresnel::Fresnel;
+pub use material::{Bsdf, GlintMaterial, Material};
 pub use glam::{Mat2, Vec2, Vec3};
 pub use ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
 

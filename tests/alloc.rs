@@ -50,7 +50,7 @@ fn allocations() -> usize {
 fn shade(
     model: &GlintModel,
     options: &GlintOptions,
-    scratch: &mut GlintScratch,
+    scratch: &GlintScratch,
     fp: &Footprint,
     k: usize,
 ) -> f32 {
@@ -91,18 +91,91 @@ fn shading_allocates_nothing_after_warm_up() {
         .collect();
     for ex in &examples {
         let (model, options) = (&ex.model, &ex.options);
-        let mut scratch = GlintScratch::default();
+        let scratch = GlintScratch::default();
         // Warm-up: the largest footprint first grows every buffer to its size.
-        let mut sink = shade(model, options, &mut scratch, &footprints[4], 0);
+        let mut sink = shade(model, options, &scratch, &footprints[4], 0);
         let before = allocations();
         for k in 0..40 {
             let fp = &footprints[k % footprints.len()];
-            sink += shade(model, options, &mut scratch, fp, k);
+            sink += shade(model, options, &scratch, fp, k);
         }
         let n = allocations() - before;
         assert!(sink.is_finite());
         assert_eq!(n, 0, "{}: {n} allocations in 40 shading points", ex.label);
     }
+}
+
+/// A renderer's path through `Material`: three live BSDFs of one scratch at once (a path's
+/// vertices), every kind of material (analytic, layered, each registered glint model alone and
+/// over a base), evaluated and sampled while the others are alive; nothing allocates once the
+/// scratch has grown to the largest footprint and the most live patches.
+#[test]
+fn materials_with_several_live_bsdfs_allocate_nothing() {
+    use brdf::fresnel::ConductorFresnel;
+    use brdf::material::{GlintMaterial, Material};
+    use brdf::ndf::{Beckmann, Ggx};
+    use std::sync::Arc;
+
+    let map = brdf::glint::scratched(64, 64, Default::default(), 4).unwrap();
+    let mut materials = vec![
+        Material::from(brdf::Lambert::new(Vec3::splat(0.5)).unwrap()),
+        Material::microfacet(Ggx::isotropic(0.3).unwrap(), ConductorFresnel::GOLD),
+        Material::layered(
+            Beckmann::new(0.2, 0.4).unwrap(),
+            SchlickFresnel::new(Vec3::splat(0.04)).unwrap(),
+            Vec3::new(0.8, 0.1, 0.1),
+        )
+        .unwrap(),
+    ];
+    for ex in support::registry::examples(&map) {
+        let glint = GlintMaterial::new(Arc::new(ex.model), ConductorFresnel::SILVER)
+            .with_options(ex.options)
+            .with_uv_scale(Vec2::new(2.0, 1.0))
+            .unwrap();
+        materials.push(glint.clone().into());
+        materials.push(glint.over_base(Vec3::splat(0.3)).unwrap().into());
+    }
+    let footprints: Vec<Footprint> = [3000.0f32, 0.3, 4.0, 50.0, 700.0]
+        .iter()
+        .enumerate()
+        .map(|(k, &a)| {
+            let c = Vec2::new(0.13 + 0.17 * k as f32, 0.71 - 0.11 * k as f32);
+            Footprint::isotropic_texels(c, a / 2.0, 64, 64)
+        })
+        .collect();
+    let path = |scratch: &brdf::glint::GlintScratch, k: usize| -> f32 {
+        let n = materials.len();
+        let fp = |j: usize| &footprints[(k + j) % footprints.len()];
+        let (a, b, c) = (
+            materials[k % n].bsdf(fp(0), scratch),
+            materials[(k + 1) % n].bsdf(fp(1), scratch),
+            materials[(k + 2) % n].bsdf(fp(2), scratch),
+        );
+        let wo = support::dir(10.0 + 7.0 * (k % 11) as f64, 37.0 * k as f64);
+        let wi = support::dir(35.0, 180.0 + 37.0 * k as f64);
+        let mut acc = 0.0;
+        for bsdf in [&a, &b, &c] {
+            if let Some(s) = bsdf.sample(wo, 0.3, Vec2::new(0.4, 0.6)) {
+                acc += s.weight().x;
+            }
+            let (f, pdf) = bsdf.eval_pdf(wo, wi);
+            acc += f.x + pdf;
+        }
+        acc
+    };
+    let scratch = GlintScratch::default();
+    // Warm-up: every material at every footprint position of the cycle, three live at once.
+    let mut sink = 0.0;
+    for k in 0..materials.len() * footprints.len() {
+        sink += path(&scratch, k);
+    }
+    let before = allocations();
+    for k in 0..materials.len() * footprints.len() {
+        sink += path(&scratch, k);
+    }
+    let n = allocations() - before;
+    assert!(sink.is_finite());
+    assert_eq!(n, 0, "{n} allocations in {} paths", materials.len());
 }
 
 /// The counter counts (a check of the test itself): `patch` without a scratch allocates.

@@ -430,7 +430,7 @@ fn glint_model_patches_equal_their_models_patches() {
             (m, o)
         },
     ];
-    let mut scratch = GlintScratch::default();
+    let scratch = GlintScratch::default();
     let mut rng = support::rng(41);
     for area in [400.0f32, 2.0, 64.0] {
         let fp = Footprint::isotropic_texels(Vec2::new(0.3, 0.8), area, 32, 32);
@@ -448,7 +448,7 @@ fn glint_model_patches_equal_their_models_patches() {
         ];
         for ((material, options), own) in materials.iter().zip(own) {
             let via_patch = material.patch_with(&fp, options, None);
-            let via_scratch = material.patch_with(&fp, options, Some(&mut scratch));
+            let via_scratch = material.patch_with(&fp, options, Some(&scratch));
             for _ in 0..50 {
                 let wo = support::dir(rng.random_range(0.0..89.0), rng.random_range(0.0..360.0));
                 let m = support::dir(rng.random_range(0.0..60.0), rng.random_range(0.0..360.0));

@@ -2,23 +2,21 @@
 //! plane), a pinhole camera with ray differentials, and the integrator (next-event estimation of a
 //! point light and an environment light, multiple importance sampling against BRDF sampling).
 //!
-//! Every BRDF is used the same way: radiance = Σ f(wo, wi) · L · cos θi / pdf, with the geometric
-//! cosine (local `wi.z`); the glint materials are `MicrofacetBrdf::new(model.patch_in(&footprint,
-//! scratch), fresnel)` and need nothing else. World space: y up, lengths in scene units; BRDFs see
+//! Every material is a `brdf::Material` in one `Vec`, used the same way: at a hit, its BSDF for
+//! the hit's ray footprint (`material.bsdf(&footprint, &scratch)`, one `GlintScratch` per thread),
+//! then radiance = Σ f(wo, wi) · L · cos θi / pdf, with the geometric cosine (local `wi.z`). World space: y up, lengths in scene units; BRDFs see
 //! directions in the local frame of the hit (z = normal, x = ∂p/∂u). See docs/render.md.
 
-use brdf::bxdf::{Bxdf, LayeredBrdf, MicrofacetBrdf};
+use brdf::bxdf::Bxdf;
 use brdf::frame::Frame;
-use brdf::fresnel::{ConductorFresnel, Fresnel};
-use brdf::glint::{Footprint, GlintModel, GlintNdf, GlintScratch};
+use brdf::glint::{Footprint, GlintScratch};
 use brdf::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
-use brdf::{Ggx, Lambert, Vec2, Vec3};
+use brdf::{Material, Vec2, Vec3};
 use indicatif::ProgressBar;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 use rayon::prelude::*;
 use std::f32::consts::PI;
-use std::sync::Arc;
 
 pub mod showcase;
 
@@ -31,85 +29,12 @@ pub const MAX_BOUNCES: usize = 4;
 /// footprint by a fixed factor per bounce (secondary glints are then smooth, as they should be).
 const SECONDARY_FOOTPRINT_GROWTH: f32 = 16.0;
 
-/// A surface material. The glint variants hold the model behind an `Arc`, shared by every material
-/// that uses the same normal map; `tiles` repeats the map over the sphere's (u, v).
-pub enum Material {
-    /// A Lambertian checkerboard (the ground), squares of side `square` scene units.
-    Checker { a: Lambert, b: Lambert, square: f32 },
-    /// An analytic microfacet conductor.
-    Conductor(MicrofacetBrdf<Ggx, ConductorFresnel>),
-    /// A glint microfacet BRDF over a normal map.
-    Glint {
-        model: Arc<GlintModel>,
-        fresnel: Box<dyn Fresnel + Send + Sync>,
-        tiles: Vec2,
-    },
-    /// A glint specular layer over a Lambertian base of albedo `base` ([`LayeredBrdf`]).
-    GlintCoat {
-        model: Arc<GlintModel>,
-        fresnel: Box<dyn Fresnel + Send + Sync>,
-        tiles: Vec2,
-        base: Vec3,
-    },
-}
-
-/// A black BRDF, for the one impossible case (a layered base already validated at scene build).
-struct Black;
-impl Bxdf for Black {
-    fn eval(&self, _: Vec3, _: Vec3) -> Vec3 {
-        Vec3::ZERO
-    }
-    fn pdf(&self, _: Vec3, _: Vec3) -> f32 {
-        0.0
-    }
-    fn sample(&self, _: Vec3, _: f32, _: Vec2) -> Option<brdf::BxdfSample> {
-        None
-    }
-}
-
-impl Material {
-    /// Runs `f` with the material's BRDF at `hit`; `dp_dxy` are the hit's ∂p/∂x, ∂p/∂y.
-    fn with_bxdf<R>(
-        &self,
-        hit: &Hit,
-        dp_dxy: (Vec3, Vec3),
-        scratch: &mut GlintScratch,
-        f: impl FnOnce(&dyn Bxdf) -> R,
-    ) -> R {
-        // The footprint of a map repeated `tiles` times: uv and ∂p/∂(u, v) in tile units (Footprint docs).
-        let footprint = |tiles: Vec2| {
-            let (dpdu, dpdv) = (hit.dpdu / tiles.x, hit.dpdv / tiles.y);
-            Footprint::from_surface_differentials(hit.uv * tiles, dpdu, dpdv, dp_dxy.0, dp_dxy.1)
-        };
-        match self {
-            Material::Checker { a, b, square } => {
-                let c = (hit.p.x / square).floor() + (hit.p.z / square).floor();
-                f(if c.rem_euclid(2.0) < 1.0 { a } else { b })
-            }
-            Material::Conductor(brdf) => f(brdf),
-            Material::Glint {
-                model,
-                fresnel,
-                tiles,
-            } => f(&MicrofacetBrdf::new(
-                model.patch_in(&footprint(*tiles), scratch),
-                fresnel,
-            )),
-            Material::GlintCoat {
-                model,
-                fresnel,
-                tiles,
-                base,
-            } => {
-                let coat =
-                    MicrofacetBrdf::new(model.patch_in(&footprint(*tiles), scratch), fresnel);
-                match LayeredBrdf::new(coat, *base) {
-                    Ok(layered) => f(&layered),
-                    Err(_) => f(&Black),
-                }
-            }
-        }
-    }
+/// The ground's checkerboard: squares of side `square` scene units alternating between the
+/// materials `a` and `b` (indices into [`Scene::materials`]).
+pub struct Checker {
+    pub a: usize,
+    pub b: usize,
+    pub square: f32,
 }
 
 /// A point light of radiant intensity `intensity` (W/sr per channel).
@@ -224,13 +149,14 @@ pub struct Hit {
     pub sphere: bool,
 }
 
-/// The scene: one sphere (centre, radius, material), an optional ground plane y = 0, optional point
-/// light, a sky, and the camera.
+/// The scene: its materials, one sphere (centre, radius, material index), an optional checkered
+/// ground plane y = 0, optional point light, a sky, and the camera.
 pub struct Scene {
+    pub materials: Vec<Material>,
     pub center: Vec3,
     pub radius: f32,
-    pub sphere: Material,
-    pub ground: Option<Material>,
+    pub sphere: usize,
+    pub ground: Option<Checker>,
     pub light: Option<PointLight>,
     pub sky: Sky,
     pub camera: Camera,
@@ -299,6 +225,17 @@ impl Scene {
         }
     }
 
+    /// The index of the material at `hit`: the sphere's, or the ground's checker square.
+    fn material_at(&self, hit: &Hit) -> usize {
+        match (&self.ground, hit.sphere) {
+            (Some(Checker { a, b, square }), false) => {
+                let c = (hit.p.x / square).floor() + (hit.p.z / square).floor();
+                if c.rem_euclid(2.0) < 1.0 { *a } else { *b }
+            }
+            _ => self.sphere,
+        }
+    }
+
     /// Whether nothing blocks o + t d for t in (ε, t_max).
     fn unoccluded(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
         let blocked = |t: Option<f32>| t.is_some_and(|t| t < t_max);
@@ -323,7 +260,7 @@ impl Scene {
         mut o: Vec3,
         mut d: Vec3,
         rng: &mut Pcg32,
-        scratch: &mut GlintScratch,
+        scratch: &GlintScratch,
         footprint_scale: f32,
     ) -> Vec3 {
         let mut total = Vec3::ZERO;
@@ -342,12 +279,12 @@ impl Scene {
             if wo.z <= 0.0 {
                 break;
             }
+            let material = &self.materials[self.material_at(&hit)];
             let (dpdx, dpdy) = self.camera.dp_dxy(hit.p, hit.n);
-            let material = if hit.sphere {
-                &self.sphere
-            } else {
-                self.ground.as_ref().unwrap_or(&self.sphere)
-            };
+            let (dpdx, dpdy) = (dpdx * spread, dpdy * spread);
+            let footprint =
+                Footprint::from_surface_differentials(hit.uv, hit.dpdu, hit.dpdv, dpdx, dpdy);
+            let bsdf = material.bsdf(&footprint, scratch);
             let u = [
                 rng.random::<f32>(),
                 rng.random(),
@@ -355,14 +292,11 @@ impl Scene {
                 rng.random(),
                 rng.random(),
             ];
-            let (direct, next) =
-                material.with_bxdf(&hit, (dpdx * spread, dpdy * spread), scratch, |bxdf| {
-                    let direct = self.direct(&hit, &frame, wo, bxdf, Vec2::new(u[0], u[1]));
-                    let s = bxdf.sample(wo, u[2], Vec2::new(u[3], u[4]));
-                    (direct, s.map(|s| (frame.to_world(s.wi), s.weight(), s.pdf)))
-                });
-            total += throughput * direct;
-            let Some((wi, weight, pdf)) = next else { break };
+            total += throughput * self.direct(&hit, &frame, wo, &bsdf, Vec2::new(u[0], u[1]));
+            let Some(s) = bsdf.sample(wo, u[2], Vec2::new(u[3], u[4])) else {
+                break;
+            };
+            let (wi, weight, pdf) = (frame.to_world(s.wi), s.weight(), s.pdf);
             throughput *= weight;
             o = hit.p + hit.n * RAY_EPSILON;
             d = wi;
@@ -379,7 +313,7 @@ impl Scene {
     /// Next-event estimation at a hit: the point light (a delta light: light sampling only) plus one
     /// environment sample drawn with [`Scene::sky_pdf`], weighted against BRDF sampling by the power
     /// heuristic. Each term is f · L · cos θi / pdf with the geometric cos θi = local `wi.z`.
-    fn direct(&self, hit: &Hit, frame: &Frame, wo: Vec3, bxdf: &dyn Bxdf, u: Vec2) -> Vec3 {
+    fn direct(&self, hit: &Hit, frame: &Frame, wo: Vec3, bxdf: &impl Bxdf, u: Vec2) -> Vec3 {
         let origin = hit.p + hit.n * RAY_EPSILON;
         let mut l = Vec3::ZERO;
         if let Some(light) = &self.light {

@@ -92,6 +92,15 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
         })
     }
 
+    /// [`LayeredBrdf::new`] for a `base` already checked by `unit_rgb`.
+    pub(crate) fn with_valid_base(specular: MicrofacetBrdf<D, F>, base: Vec3) -> Self {
+        LayeredBrdf {
+            specular,
+            base,
+            cache: Mutex::new(None),
+        }
+    }
+
     /// The specular layer.
     pub fn specular(&self) -> &MicrofacetBrdf<D, F> {
         &self.specular

@@ -21,6 +21,7 @@ mod phong;
 
 pub use blinn_phong::{BlinnPhongLobe, BlinnPhongNormalization};
 pub use lambert::Lambert;
+pub(crate) use lambert::unit_rgb;
 pub use layered::{LayeredBrdf, TRANSMISSION_SAMPLES};
 pub use microfacet::{Masking, MicrofacetBrdf, Sampling};
 pub use phong::{

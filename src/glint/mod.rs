@@ -152,7 +152,7 @@ use crate::ndf::Ndf;
 ///         &'a self,
 ///         footprint: &Footprint,
 ///         _options: &(),
-///         _scratch: Option<&'a mut GlintScratch>,
+///         _scratch: Option<&'a GlintScratch>,
 ///     ) -> Patch<'a> {
 ///         // Per-footprint work happens here, once, in texel units of the map.
 ///         let (_centre, _cov) = footprint.gaussian_texels(self.map.width(), self.map.height());
@@ -185,15 +185,16 @@ pub trait GlintNdf {
 
     /// The P-NDF of the surface seen through one ray footprint:
     /// D_P(ω_h) = ∫ δ(ω_n(u) − ω_h) k_P(u) du (\[Chermain2019\] eq. 8), as approximated by the model
-    /// with `options`. With a `scratch` (one per render thread), the patch borrows its working
-    /// buffers from it and gives them back when it drops: once the scratch has grown to the largest
-    /// footprint, building and querying a patch performs no heap allocation (tests/alloc.rs).
+    /// with `options`. With a `scratch` (one per render thread), the patch takes its working
+    /// buffers from it and gives them back when it drops; several patches of one scratch can be
+    /// alive at once. Once the scratch has grown to the largest footprint (and the most live
+    /// patches), building and querying a patch performs no heap allocation (tests/alloc.rs).
     /// Without one, the patch allocates its own. Results are bit-identical either way.
     fn patch_with<'a>(
         &'a self,
         footprint: &Footprint,
         options: &Self::Options,
-        scratch: Option<&'a mut GlintScratch>,
+        scratch: Option<&'a GlintScratch>,
     ) -> Self::Patch<'a>;
 
     /// [`GlintNdf::patch_with`] with the model's [`options`](GlintNdf::options), allocating.
@@ -206,7 +207,7 @@ pub trait GlintNdf {
     fn patch_in<'a>(
         &'a self,
         footprint: &Footprint,
-        scratch: &'a mut GlintScratch,
+        scratch: &'a GlintScratch,
     ) -> Self::Patch<'a> {
         self.patch_with(footprint, &self.options(), Some(scratch))
     }

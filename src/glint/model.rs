@@ -144,7 +144,7 @@ macro_rules! glint_models {
                 &'a self,
                 footprint: &Footprint,
                 options: &GlintOptions,
-                scratch: Option<&'a mut GlintScratch>,
+                scratch: Option<&'a GlintScratch>,
             ) -> GlintPatch<'a> {
                 match self {
                     $(

@@ -271,7 +271,7 @@ impl GlintNdf for MixtureVariant<'_> {
         &'b self,
         footprint: &Footprint,
         options: &PatchOptions,
-        scratch: Option<&'b mut brdf::glint::GlintScratch>,
+        scratch: Option<&'b brdf::glint::GlintScratch>,
     ) -> MixturePatch<'b> {
         self.mixture.patch_with(footprint, options, scratch)
     }

@@ -2,16 +2,15 @@
 //! conductors, a glint coat over paint), the normal map PNG it writes first, tone mapping and the
 //! progress bar.
 
-use super::{Camera, Image, Material, PointLight, Scene, Sky, render};
+use super::{Camera, Checker, Image, PointLight, Scene, Sky, render};
 use crate::common::{Artifact, Res, save_rgb};
-use brdf::bxdf::MicrofacetBrdf;
 use brdf::fresnel::{ConductorFresnel, DielectricFresnel};
 use brdf::glint::mixture::{MixtureParams, PatchOptions};
 use brdf::glint::{
     BeckmannMixture, FlakesParams, GlintModel, NormalMap, NormalRepair, ScratchedParams,
     TangentConvention, flakes, scratched,
 };
-use brdf::{Ggx, Lambert, Vec2, Vec3};
+use brdf::{GlintMaterial, Ggx, Lambert, Material, Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
@@ -112,13 +111,19 @@ pub fn showcase(sphere: impl FnOnce(Vec2) -> Res<Material>, opts: &Options) -> R
         .round()
         .max(1.0);
     let tiles = Vec2::new(tiles_u, (0.5 * tiles_u).round().max(1.0));
+    let materials = vec![
+        sphere(tiles)?,
+        Lambert::new(Vec3::splat(0.6))?.into(),
+        Lambert::new(Vec3::splat(0.25))?.into(),
+    ];
     Ok(Scene {
+        materials,
         center: Vec3::new(0.0, 1.0, 0.0),
         radius: 1.0,
-        sphere: sphere(tiles)?,
-        ground: Some(Material::Checker {
-            a: Lambert::new(Vec3::splat(0.6))?,
-            b: Lambert::new(Vec3::splat(0.25))?,
+        sphere: 0,
+        ground: Some(Checker {
+            a: 1,
+            b: 2,
             square: 0.5,
         }),
         light: Some(PointLight {
@@ -171,46 +176,33 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
         (
             "render_gold.png",
             "analytic gold: GGX α = 0.15, conductor Fresnel",
-            Box::new(|_| {
-                Ok(Material::Conductor(MicrofacetBrdf::new(
-                    Ggx::isotropic(0.15)?,
-                    ConductorFresnel::GOLD,
-                )))
-            }),
+            Box::new(|_| Ok(Material::microfacet(Ggx::isotropic(0.15)?, ConductorFresnel::GOLD))),
         ),
         (
             "render_scratched.png",
             "glints: silver with a procedural scratched map (Beckmann mixture)",
             Box::new(move |tiles| {
-                Ok(Material::Glint {
-                    model: scratched,
-                    fresnel: Box::new(ConductorFresnel::SILVER),
-                    tiles,
-                })
+                let glints = GlintMaterial::new(scratched, ConductorFresnel::SILVER);
+                Ok(glints.with_uv_scale(tiles)?.into())
             }),
         ),
         (
             "render_hammered.png",
             "glints: copper with the hammered PNG normal map (Beckmann mixture)",
             Box::new(move |tiles| {
-                Ok(Material::Glint {
-                    model: hammered,
-                    fresnel: Box::new(ConductorFresnel::COPPER),
-                    tiles,
-                })
+                let glints = GlintMaterial::new(hammered, ConductorFresnel::COPPER);
+                Ok(glints.with_uv_scale(tiles)?.into())
             }),
         ),
         (
             "render_flake_paint.png",
             "layered: a glint clear coat (flakes map, η = 1.5) over red Lambert paint",
             Box::new(move |tiles| {
-                let fresnel = Box::new(DielectricFresnel::new(1.5)?);
-                Ok(Material::GlintCoat {
-                    model: flakes,
-                    fresnel,
-                    tiles,
-                    base: Vec3::new(0.5, 0.03, 0.02),
-                })
+                let coat = GlintMaterial::new(flakes, DielectricFresnel::new(1.5)?);
+                Ok(coat
+                    .with_uv_scale(tiles)?
+                    .over_base(Vec3::new(0.5, 0.03, 0.02))?
+                    .into())
             }),
         ),
     ];

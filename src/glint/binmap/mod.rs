@@ -667,12 +667,12 @@ impl GlintNdf for BinMap {
         &'a self,
         footprint: &Footprint,
         options: &PatchOptions,
-        scratch: Option<&'a mut GlintScratch>,
+        scratch: Option<&'a GlintScratch>,
     ) -> BinMapPatch<'a> {
         let alpha = options.smoothing_alpha;
         let alpha = (alpha.is_finite() && alpha > 0.0)
             .then(|| alpha.clamp(crate::ndf::MIN_ALPHA, crate::ndf::MAX_ALPHA));
-        BinMapPatch::new(self, footprint, alpha, scratch.map(|s| s.slot()))
+        BinMapPatch::new(self, footprint, alpha, scratch)
     }
 }
 

@@ -7,7 +7,8 @@
 use super::clip::{Overlap, Parallelogram};
 use super::forest::QueryStats;
 use super::{BinFacet, BinMap, EXACT_MASKING_TEXELS};
-use crate::glint::{Footprint, HemisphereBins, MIN_WIDTH_TEXELS};
+use crate::glint::scratch::Lent;
+use crate::glint::{Footprint, GlintScratch, HemisphereBins, MIN_WIDTH_TEXELS};
 use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
 use crate::warp::{
@@ -132,48 +133,13 @@ pub struct BinMapPatch<'a> {
     sigma: Option<f64>,
 }
 
-/// The bin map's slot of a [`GlintScratch`](crate::glint::GlintScratch): the footprint's periodic images and, for footprints with exact
-/// masking terms, its bins (or smoothing lobes). The buffers grow to the largest footprint seen and
-/// are then reused, so patches allocate nothing. A patch borrows the scratch for its lifetime.
-#[derive(Default, Debug)]
-pub(crate) struct BinMapScratch {
-    images: Vec<[f64; 2]>,
-    acc: Vec<(u32, f64)>,
-    bins: Vec<PatchBin>,
-    lobes: Vec<(f32, SlopeGaussian)>,
-}
+/// A buffer of a patch: taken from the caller's [`GlintScratch`](crate::glint::GlintScratch) (one
+/// pool per element type) or fresh, given back with its capacity when the patch drops, so patches
+/// allocate nothing once the pools have grown to the largest footprint. A clone owns its buffer.
+type Buf<'a, T> = Lent<'a, Vec<T>>;
 
-/// A buffer owned by the patch or borrowed from a `BinMapScratch`.
-#[derive(Debug)]
-enum Buf<'a, T> {
-    Owned(Vec<T>),
-    Borrowed(&'a mut Vec<T>),
-}
-
-impl<T> Buf<'_, T> {
-    fn vec(&mut self) -> &mut Vec<T> {
-        match self {
-            Buf::Owned(v) => v,
-            Buf::Borrowed(v) => v,
-        }
-    }
-
-    fn as_slice(&self) -> &[T] {
-        match self {
-            Buf::Owned(v) => v,
-            Buf::Borrowed(v) => v,
-        }
-    }
-}
-
-/// A clone owns its buffers.
-impl<T: Clone> Clone for Buf<'_, T> {
-    fn clone(&self) -> Self {
-        Buf::Owned(self.as_slice().to_vec())
-    }
-}
-
-/// The buffers of one patch under construction.
+/// The buffers of one patch under construction: the footprint's periodic images and, for
+/// footprints with exact masking terms, its bins (or smoothing lobes).
 struct Bufs<'a> {
     images: Buf<'a, [f64; 2]>,
     acc: Buf<'a, (u32, f64)>,
@@ -182,30 +148,17 @@ struct Bufs<'a> {
 }
 
 impl<'a> Bufs<'a> {
-    fn new(scratch: Option<&'a mut BinMapScratch>) -> Bufs<'a> {
-        let mut b = match scratch {
-            Some(BinMapScratch {
-                images,
-                acc,
-                bins,
-                lobes,
-            }) => Bufs {
-                images: Buf::Borrowed(images),
-                acc: Buf::Borrowed(acc),
-                bins: Buf::Borrowed(bins),
-                lobes: Buf::Borrowed(lobes),
-            },
-            None => Bufs {
-                images: Buf::Owned(Vec::new()),
-                acc: Buf::Owned(Vec::new()),
-                bins: Buf::Owned(Vec::new()),
-                lobes: Buf::Owned(Vec::new()),
-            },
+    fn new(scratch: Option<&'a GlintScratch>) -> Bufs<'a> {
+        let mut b = Bufs {
+            images: Lent::new(scratch.map(GlintScratch::home)),
+            acc: Lent::new(scratch.map(GlintScratch::home)),
+            bins: Lent::new(scratch.map(GlintScratch::home)),
+            lobes: Lent::new(scratch.map(GlintScratch::home)),
         };
-        b.images.vec().clear();
-        b.acc.vec().clear();
-        b.bins.vec().clear();
-        b.lobes.vec().clear();
+        b.images.clear();
+        b.acc.clear();
+        b.bins.clear();
+        b.lobes.clear();
         b
     }
 }
@@ -215,7 +168,7 @@ impl<'a> BinMapPatch<'a> {
         map: &'a BinMap,
         footprint: &Footprint,
         alpha: Option<f32>,
-        scratch: Option<&'a mut BinMapScratch>,
+        scratch: Option<&'a GlintScratch>,
     ) -> Self {
         let mut bufs = Bufs::new(scratch);
         let sub = map.params.subdivisions as f64;
@@ -233,7 +186,7 @@ impl<'a> BinMapPatch<'a> {
             &para,
             map.grid_w as f64,
             map.grid_h as f64,
-            bufs.images.vec(),
+            &mut bufs.images,
         );
         let center = Vec2::new(
             (para.center()[0] / sub) as f32,
@@ -257,7 +210,7 @@ impl<'a> BinMapPatch<'a> {
             lobes,
         } = bufs;
         let exact = (area_texels <= EXACT_MASKING_TEXELS as f64).then(|| {
-            ExactMasking::new(map, &para, images.as_slice(), sigma, acc.vec(), bins, lobes)
+            ExactMasking::new(map, &para, images.as_slice(), sigma, &mut *acc, bins, lobes)
         });
         BinMapPatch {
             map,
@@ -662,7 +615,7 @@ impl<'a> ExactMasking<'a> {
         }
         let acc = sort_by_bin(acc, map.bins.len());
         let inv_area = 1.0 / para.area();
-        let (bins_out, lobes_out) = (bins.vec(), lobes.vec());
+        let (bins_out, lobes_out) = (&mut *bins, &mut *lobes);
         bins_out.clear();
         lobes_out.clear();
         let mut a = [0.0f64; 3];

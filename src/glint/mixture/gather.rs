@@ -16,7 +16,7 @@ use super::levels::resolution_index;
 use super::params::PatchOptions;
 use super::storage::{LevelView, LobeStore};
 use crate::glint::Footprint;
-use crate::glint::scratch::Lent;
+use crate::glint::scratch::{Home, Lent};
 use crate::ndf::SlopeGaussian;
 use glam::Vec2;
 
@@ -112,7 +112,7 @@ impl AxisSlots {
     }
 }
 
-/// The per-slot buffers of a patch; also part of the mixture's share of
+/// The per-slot buffers of a patch: the mixture's buffer type in a
 /// [`GlintScratch`](crate::glint::GlintScratch).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SlotBuffers {
@@ -149,12 +149,6 @@ impl BlockRect {
         let o = self.offset + ((by - self.by0) * self.bw + (bx - self.bx0)) * LANES;
         bw[o..o + LANES].try_into().expect("16 lanes")
     }
-}
-
-/// The mixture's share of [`GlintScratch`](crate::glint::GlintScratch): the buffers a patch borrows.
-#[derive(Debug, Default)]
-pub(crate) struct MixtureScratch {
-    pub(super) slots: SlotBuffers,
 }
 
 /// The gathered lobes of a footprint.
@@ -479,7 +473,7 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
     options: &PatchOptions,
     weight_sigmas: f32,
     sigma_min: f32,
-    slots: Option<&'a mut SlotBuffers>,
+    slots: Option<Home<'a, SlotBuffers>>,
 ) -> Footprinted<'a, S::Level<'a>> {
     let area = fp.area();
     let lod = 0.5 * area.max(1e-300).log2();

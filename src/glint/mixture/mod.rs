@@ -83,7 +83,7 @@ impl GlintNdf for BeckmannMixture {
         &'a self,
         footprint: &Footprint,
         options: &PatchOptions,
-        scratch: Option<&'a mut GlintScratch>,
+        scratch: Option<&'a GlintScratch>,
     ) -> MixturePatch<'a> {
         MixturePatch::new(self, footprint, *options, scratch)
     }

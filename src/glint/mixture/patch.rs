@@ -9,7 +9,7 @@
 use super::blocks;
 use super::compact::CompactView;
 use super::full::FullLevel;
-use super::gather::{FootprintLobes, Gathered, MixtureScratch, footprint_patch};
+use super::gather::{FootprintLobes, Gathered, SlotBuffers, footprint_patch};
 use super::model::{BeckmannMixture, Storage};
 use super::params::{MaskingMode, PatchOptions};
 use super::passes::{SumP22, UntruncatedSum, VisiblePick, VisibleSum};
@@ -105,9 +105,9 @@ impl<'a> MixturePatch<'a> {
         mixture: &'a BeckmannMixture,
         footprint: &Footprint,
         options: PatchOptions,
-        scratch: Option<&'a mut GlintScratch>,
+        scratch: Option<&'a GlintScratch>,
     ) -> MixturePatch<'a> {
-        let slots = scratch.map(|s| &mut s.slot::<MixtureScratch>().slots);
+        let slots = scratch.map(|s| s.home::<SlotBuffers>());
         let (width, height) = mixture.map_size();
         let fp = FootprintLobes::new(footprint, width, height, mixture.spacing_f64());
         let p = mixture.params();

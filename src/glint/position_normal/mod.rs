@@ -342,7 +342,7 @@ impl GlintNdf for PositionNormalMap {
         &'a self,
         footprint: &Footprint,
         options: &PatchOptions,
-        scratch: Option<&'a mut GlintScratch>,
+        scratch: Option<&'a GlintScratch>,
     ) -> PositionNormalPatch<'a> {
         PositionNormalPatch::new(self, footprint, options.max_query_texels, scratch)
     }

@@ -260,7 +260,7 @@ impl<'a> PositionNormalPatch<'a> {
         map: &'a PositionNormalMap,
         footprint: &Footprint,
         max_query_texels: f32,
-        scratch: Option<&'a mut GlintScratch>,
+        scratch: Option<&'a GlintScratch>,
     ) -> PositionNormalPatch<'a> {
         Self::build(
             map,
@@ -272,7 +272,7 @@ impl<'a> PositionNormalPatch<'a> {
     fn build(
         map: &'a PositionNormalMap,
         geo: Geometry,
-        scratch: Option<&'a mut GlintScratch>,
+        scratch: Option<&'a GlintScratch>,
     ) -> PositionNormalPatch<'a> {
         let rect = [geo.range(0), geo.range(1)];
         let mut total = 0.0f64;
@@ -300,7 +300,7 @@ impl<'a> PositionNormalPatch<'a> {
             mean_slope: Vec2::new(moments[0], moments[1]),
             moments,
             moments_lobe,
-            slots: Loan::new(scratch.map(|s| s.slot())),
+            slots: Loan::new(scratch.map(|s| s.home())),
         }
     }
 

@@ -1,0 +1,70 @@
+//! The BSDF of a material at one shading point: a [`Bxdf`] that borrows the material (and, for
+//! glints, the patch's buffers from the caller's scratch).
+
+use super::{AnalyticNdf, AnyFresnel};
+use crate::bxdf::{
+    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, LayeredBrdf, MicrofacetBrdf, OriginalPhong, Phong,
+};
+use crate::glint::GlintPatch;
+use glam::{Vec2, Vec3};
+
+/// A material's BRDF at one shading point ([`Material::bsdf`](super::Material::bsdf)): evaluate,
+/// sample and take densities through [`Bxdf`], in the local shading frame (z = normal, x along
+/// ∂p/∂u, y along ∂p/∂v; crate-root conventions).
+///
+/// It borrows the material and, for glint materials, buffers from the caller's
+/// [`GlintScratch`](crate::glint::GlintScratch), which it gives back when it drops; any number of
+/// `Bsdf`s of one scratch can be alive at once (one per path vertex, say). Building one allocates
+/// nothing once the scratch is warm.
+#[derive(Debug)]
+pub struct Bsdf<'a>(pub(super) Inner<'a>);
+
+/// The BRDF behind a [`Bsdf`].
+#[derive(Debug)]
+pub(super) enum Inner<'a> {
+    Lambert(&'a Lambert),
+    Phong(&'a Phong),
+    OriginalPhong(&'a OriginalPhong),
+    BlinnPhong(&'a BlinnPhongLobe),
+    Microfacet(&'a MicrofacetBrdf<AnalyticNdf, AnyFresnel>),
+    /// A copy per shading point: the layered BRDF caches R̂(wo), which must not be shared between
+    /// threads shading other points.
+    Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
+    Glint(MicrofacetBrdf<GlintPatch<'a>, AnyFresnel>),
+    GlintCoat(LayeredBrdf<GlintPatch<'a>, AnyFresnel>),
+}
+
+/// Forwards one `Bxdf` method to the BRDF behind the `Bsdf`.
+macro_rules! forward {
+    ($self_:ident, $b:ident => $e:expr) => {
+        match &$self_.0 {
+            Inner::Lambert($b) => $e,
+            Inner::Phong($b) => $e,
+            Inner::OriginalPhong($b) => $e,
+            Inner::BlinnPhong($b) => $e,
+            Inner::Microfacet($b) => $e,
+            Inner::Layered($b) => $e,
+            Inner::Glint($b) => $e,
+            Inner::GlintCoat($b) => $e,
+        }
+    };
+}
+
+impl Bxdf for Bsdf<'_> {
+    #[inline]
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        forward!(self, b => b.eval(wo, wi))
+    }
+    #[inline]
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        forward!(self, b => b.pdf(wo, wi))
+    }
+    #[inline]
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BxdfSample> {
+        forward!(self, b => b.sample(wo, uc, u))
+    }
+    #[inline]
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        forward!(self, b => b.eval_pdf(wo, wi))
+    }
+}

@@ -1,0 +1,172 @@
+//! One run-time material type for every BRDF of the crate, so that a renderer keeps its materials
+//! in one `Vec<Material>` and shades every hit the same way:
+//!
+//! ```
+//! use brdf::bxdf::{Bxdf, Lambert};
+//! use brdf::fresnel::ConductorFresnel;
+//! use brdf::glint::mixture::MixtureParams;
+//! use brdf::glint::{BeckmannMixture, Footprint, GlintModel, GlintScratch, ScratchedParams};
+//! use brdf::material::{GlintMaterial, Material};
+//! use brdf::ndf::Ggx;
+//! use brdf::{Vec2, Vec3};
+//!
+//! let map = brdf::glint::scratched(64, 64, ScratchedParams::default(), 1)?;
+//! let glints = GlintModel::from(BeckmannMixture::build(&map, MixtureParams::default())?);
+//! let materials = vec![
+//!     Material::from(Lambert::new(Vec3::splat(0.5))?),
+//!     Material::microfacet(Ggx::isotropic(0.3)?, ConductorFresnel::GOLD),
+//!     GlintMaterial::new(glints, ConductorFresnel::SILVER)
+//!         .with_uv_scale(Vec2::new(4.0, 2.0))?
+//!         .into(),
+//! ];
+//! let scratch = GlintScratch::default(); // one per render thread
+//! // At a hit: its footprint (ray differentials, ray cone), then one BSDF per path vertex.
+//! let footprint = Footprint::isotropic_texels(Vec2::new(0.3, 0.6), 8.0, 64, 64);
+//! let wo = Vec3::new(0.3, 0.1, 0.9).normalize();
+//! for material in &materials {
+//!     let bsdf = material.bsdf(&footprint, &scratch);
+//!     if let Some(s) = bsdf.sample(wo, 0.5, Vec2::new(0.25, 0.75)) {
+//!         assert!(s.weight().is_finite() && s.weight().min_element() >= 0.0);
+//!     }
+//! }
+//! # Ok::<(), brdf::Error>(())
+//! ```
+//!
+//! ## Design
+//! [`Material`] is a closed enum dispatched by `match`, not a trait object: its BSDF at a shading
+//! point ([`Bsdf`]) lives on the caller's stack, borrows the material and (for glints) buffers
+//! from the per-thread [`GlintScratch`], and costs no allocation and no virtual call; a
+//! `Box<dyn Bxdf>` per shading point would allocate, and a `&dyn Bxdf` needs the value stored
+//! somewhere, which is what the enum is. A renderer with BRDFs of its own wraps `Material` in
+//! its own enum. `Material` is `Send + Sync` and cheap to clone: the analytic variants are a few
+//! numbers, a glint material holds its model in an `Arc`.
+//!
+//! Several BSDFs of one scratch can be alive at once (a path's vertices, the layers of a
+//! material): each glint patch takes its own buffers from the scratch and gives them back when it
+//! drops (tests/alloc.rs: no allocation per shading point once warm).
+
+mod analytic;
+mod bsdf;
+mod fresnel;
+mod glint;
+
+pub use analytic::AnalyticNdf;
+pub use bsdf::Bsdf;
+pub use fresnel::AnyFresnel;
+pub use glint::GlintMaterial;
+
+use crate::bxdf::{BlinnPhongLobe, Lambert, LayeredBrdf, MicrofacetBrdf, OriginalPhong, Phong};
+use crate::error::Result;
+use crate::glint::{Footprint, GlintNdf, GlintScratch};
+use bsdf::Inner;
+use glam::Vec3;
+
+/// Any BRDF of the crate, chosen at run time (module docs): build it with the constructors or
+/// `From` the model, get its BSDF at a shading point with [`Material::bsdf`].
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub enum Material {
+    /// Lambertian diffuse ([`Lambert`]).
+    Lambert(Lambert),
+    /// The modified Phong model ([`Phong`]).
+    Phong(Phong),
+    /// The original Phong model ([`OriginalPhong`]).
+    OriginalPhong(OriginalPhong),
+    /// The Blinn-Phong lobe ([`BlinnPhongLobe`]).
+    BlinnPhong(BlinnPhongLobe),
+    /// An analytic microfacet BRDF (GGX or Beckmann, any Fresnel term).
+    Microfacet(MicrofacetBrdf<AnalyticNdf, AnyFresnel>),
+    /// An analytic microfacet layer over a Lambertian base ([`LayeredBrdf`]).
+    Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
+    /// Glints: a glint model seen through each shading point's footprint ([`GlintMaterial`]).
+    Glint(GlintMaterial),
+}
+
+impl Material {
+    /// The microfacet BRDF of `ndf` ([`crate::ndf::Ggx`] or [`crate::ndf::Beckmann`]) and `fresnel`
+    /// (any model of [`crate::fresnel`]), with the default masking and sampling.
+    pub fn microfacet(ndf: impl Into<AnalyticNdf>, fresnel: impl Into<AnyFresnel>) -> Material {
+        Material::Microfacet(MicrofacetBrdf::new(ndf.into(), fresnel.into()))
+    }
+
+    /// A microfacet layer (`ndf`, `fresnel`) over a Lambertian base of RGB albedo `base`.
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidParameter`] naming `base` unless every channel is finite and in [0, 1].
+    pub fn layered(
+        ndf: impl Into<AnalyticNdf>,
+        fresnel: impl Into<AnyFresnel>,
+        base: Vec3,
+    ) -> Result<Material> {
+        let specular = MicrofacetBrdf::new(ndf.into(), fresnel.into());
+        Ok(Material::Layered(LayeredBrdf::new(specular, base)?))
+    }
+
+    /// Whether the material's BSDF depends on the footprint given to [`Material::bsdf`] (glints):
+    /// a renderer may skip computing ray differentials or cones for the others.
+    pub fn uses_footprint(&self) -> bool {
+        matches!(self, Material::Glint(_))
+    }
+
+    /// The material's BRDF at a shading point whose ray footprint on the surface is `footprint`
+    /// (surface uv; ignored unless [`Material::uses_footprint`]). Glint patches take their
+    /// buffers from `scratch` (one per render thread) and give them back when the [`Bsdf`] drops.
+    /// Total: any footprint works.
+    pub fn bsdf<'a>(&'a self, footprint: &Footprint, scratch: &'a GlintScratch) -> Bsdf<'a> {
+        Bsdf(match self {
+            Material::Lambert(b) => Inner::Lambert(b),
+            Material::Phong(b) => Inner::Phong(b),
+            Material::OriginalPhong(b) => Inner::OriginalPhong(b),
+            Material::BlinnPhong(b) => Inner::BlinnPhong(b),
+            Material::Microfacet(b) => Inner::Microfacet(b),
+            Material::Layered(b) => Inner::Layered(b.clone()),
+            Material::Glint(g) => {
+                let fp = g.map_footprint(footprint);
+                let patch = g.model().patch_with(&fp, g.options(), Some(scratch));
+                let layer = MicrofacetBrdf::new(patch, g.fresnel());
+                match g.base() {
+                    None => Inner::Glint(layer),
+                    // Validated by `GlintMaterial::over_base`.
+                    Some(base) => Inner::GlintCoat(LayeredBrdf::with_valid_base(layer, base)),
+                }
+            }
+        })
+    }
+}
+
+/// `From` each BRDF a [`Material`] variant holds.
+macro_rules! material_from {
+    ($($variant:ident($ty:ty)),+ $(,)?) => {
+        $(
+            impl From<$ty> for Material {
+                fn from(b: $ty) -> Material {
+                    Material::$variant(b)
+                }
+            }
+        )+
+    };
+}
+
+material_from! {
+    Lambert(Lambert),
+    Phong(Phong),
+    OriginalPhong(OriginalPhong),
+    BlinnPhong(BlinnPhongLobe),
+    Microfacet(MicrofacetBrdf<AnalyticNdf, AnyFresnel>),
+    Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
+    Glint(GlintMaterial),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A renderer shares its materials between threads and copies them cheaply.
+    #[test]
+    fn materials_are_send_sync_and_clone() {
+        fn shared<T: Send + Sync + Clone>() {}
+        fn per_thread<T: Send + Sync>() {}
+        shared::<Material>();
+        per_thread::<GlintScratch>();
+    }
+}
