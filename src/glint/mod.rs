@@ -24,8 +24,8 @@
 //!
 //! 1. A folder `src/glint/<model>/` whose `mod.rs` holds the model type, its parameters, its
 //!    per-query options and their `DEFAULT_*` constants; the model implements [`GlintNdf`] (its
-//!    patch takes its buffers from the scratch with `GlintScratch`'s crate-private `slot::<T>()`, so
-//!    the scratch needs no field for it) and the crate-private `Stored` trait of `io/format.rs`
+//!    patch takes its buffers from the scratch's pool of their type with `GlintScratch`'s
+//!    crate-private `home::<T>()`, so the scratch needs no field for it) and the crate-private `Stored` trait of `io/format.rs`
 //!    (`save` / `load` in the crate's file format).
 //! 2. One line per registry: the model's file-format `Kind` code (`io/format.rs`), its line in the
 //!    `glint_models!` registry (`model.rs`: the [`GlintModel`] and [`GlintPatch`] variants, the

@@ -37,10 +37,10 @@ macro_rules! glint_models {
         /// let map = brdf::glint::scratched(64, 64, Default::default(), 7)?;
         /// let materials: Vec<Arc<GlintModel>> =
         ///     vec![Arc::new(BinMap::build(&map, BinMapParams::default())?.into())];
-        /// let mut scratch = GlintScratch::default(); // one per render thread
+        /// let scratch = GlintScratch::default(); // one per render thread
         /// let fp = Footprint::isotropic_texels(Vec2::new(0.3, 0.7), 25.0, 64, 64);
         /// let brdf = MicrofacetBrdf::new(
-        ///     materials[0].patch_in(&fp, &mut scratch),
+        ///     materials[0].patch_in(&fp, &scratch),
         ///     SchlickFresnel::new(Vec3::splat(0.9))?,
         /// );
         /// let f = brdf.eval(Vec3::new(0.3, 0.0, 0.954), Vec3::new(-0.3, 0.0, 0.954));

@@ -210,7 +210,7 @@ impl<'a> BinMapPatch<'a> {
             lobes,
         } = bufs;
         let exact = (area_texels <= EXACT_MASKING_TEXELS as f64).then(|| {
-            ExactMasking::new(map, &para, images.as_slice(), sigma, &mut *acc, bins, lobes)
+            ExactMasking::new(map, &para, images.as_slice(), sigma, &mut acc, bins, lobes)
         });
         BinMapPatch {
             map,
