@@ -9,7 +9,8 @@
 //!   flat regions (s ≪ σ_ε) and wide lobes (s ≫ σ_ε) are exact;
 //! - the inverse bin map (\[Atanasov2020\], smoothing of the authors' later full paper): every bin's
 //!   mass spread by a Beckmann lobe of α = √2 σ_ε (`binmap::PatchOptions::smoothing_alpha`; the
-//!   patch takes slope σ = α/√2, the same per-axis slope σ). The lobe sits at the bin's centre, so
+//!   patch takes slope σ = α/√2, the same per-axis slope σ), and its masking lobe floored at σ_ε
+//!   (`BinMapParams::sigma_min`). The lobe sits at the bin's centre, so
 //!   the bin's own width is added to σ_ε rather than removed (near the pole a bin of n² is about
 //!   √(2π)/n wide in slope, a uniform spread of σ ≈ √(π/6)/n: 2.8·10⁻³ at n = 255, 5.7·10⁻³ at
 //!   127, so the default 255² renders √(σ_ε² + (2.8·10⁻³)²) ≈ 1.04 σ_ε);

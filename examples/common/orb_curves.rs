@@ -107,7 +107,12 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
     let mixture = Configured::new(Arc::new(BeckmannMixture::build(map, params)?.into()));
     let mixture_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, BinMapParams::default())?.into());
+    // The masking lobe's floor at σ_ε too.
+    let binmap_params = BinMapParams {
+        sigma_min: SIGMA_EPS,
+        ..BinMapParams::default()
+    };
+    let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, binmap_params)?.into());
     let binmap_s = t.elapsed().as_secs_f64();
     let pn = |sigma_r| -> Res<(Configured, f64)> {
         let t = Instant::now();

@@ -167,6 +167,7 @@ fn binmap_methods(map: &NormalMap, _: &Settings) -> Res<Vec<Box<dyn Method>>> {
         let params = BinMapParams {
             bins_per_axis: n,
             subdivisions: s,
+            sigma_min: SIGMA_EPS,
             ..BinMapParams::default()
         };
         let bm = Arc::new(BinMap::build(map, params)?);

@@ -337,7 +337,12 @@ pub fn build_methods(opts: &OrbOptions, map: &NormalMap) -> Res<Vec<OrbMethod>> 
     };
     let default_lod = PatchOptions::default().lod_lobes;
     let t = Instant::now();
-    let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, BinMapParams::default())?.into());
+    // The masking lobe's floor at σ_ε too.
+    let binmap_params = BinMapParams {
+        sigma_min: sigma,
+        ..BinMapParams::default()
+    };
+    let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, binmap_params)?.into());
     let binmap_build = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let pn = |sigma_r| {
