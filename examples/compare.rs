@@ -38,7 +38,7 @@ mod tests {
                 }
                 assert!(t.k >= 4 && t.change.is_finite(), "{r:?}");
             }
-            // 128² bins exactly for the footprints up to `fine_up_to`.
+            // 127² bins exactly for the footprints up to `fine_up_to`.
             assert_eq!(r.tv_fine.is_some(), r.area <= settings.fine_up_to, "{r:?}");
             assert!(r.patch_s > 0.0 && r.d_s > 0.0 && r.eval_s > 0.0, "{r:?}");
         }
@@ -57,6 +57,36 @@ mod tests {
         for a in artifacts {
             assert!(a.path.exists(), "{}", a.path.display());
         }
+    }
+
+    /// Every method the harness builds (through its own builders) renders the scene's σ_ε, read
+    /// back from the built method; the only exceptions are the rows labelled "paper default",
+    /// which carry exactly the paper's σ they declare, and each family has a σ_ε-matched method.
+    #[test]
+    fn every_method_is_built_with_the_scenes_sigma() {
+        use super::common::material::{SIGMA_EPS, same_sigma};
+        let settings = Settings::tiny();
+        let map = brdf::glint::scratched(32, 32, Default::default(), 7).unwrap();
+        for (family, build) in methods::builders() {
+            let methods = build(&map, &settings).unwrap();
+            assert!(
+                methods.iter().any(|m| m.paper_default().is_none()),
+                "{family}: no method at σ_ε"
+            );
+            for m in &methods {
+                let (label, sigma) = (m.label(), m.sigma());
+                match m.paper_default() {
+                    None => assert!(same_sigma(sigma, SIGMA_EPS), "{label}: σ = {sigma}"),
+                    Some(p) => {
+                        assert!(label.contains("paper default"), "{label}");
+                        assert!(same_sigma(sigma, p) || sigma == p, "{label}: σ = {sigma}");
+                        assert!(!same_sigma(p, SIGMA_EPS), "{label}");
+                    }
+                }
+            }
+        }
+        // The convolved truth is the same material.
+        assert!(same_sigma(truth::SIGMA_EPS as f32, SIGMA_EPS));
     }
 
     #[test]

@@ -236,9 +236,9 @@ mod tests {
             let m = load_map(&opts).unwrap();
             let (refs, _, methods) = render_all(&opts, &m).unwrap();
             let (a, b) = (&refs.pbrdf.0, &refs.pbrdf.1);
-            // Five glint renders (mixture exact, approximate, filtered lobe, bin map,
-            // position-normal) and naive 16 spp.
-            assert_eq!(methods.len(), 6);
+            // Seven glint renders (mixture exact, approximate, filtered lobe, bin map at σ_ε and
+            // at σ = 0, position-normal at σ_ε and at σ_r = 0.005) and naive 16 spp.
+            assert_eq!(methods.len(), 8);
             let mask = coverage(&Scene::new(SIZE, opts.tiles));
             let (c, d) = (&refs.normal_mapped.0, &refs.normal_mapped.1);
             for img in [a, b, c, d]
@@ -257,6 +257,53 @@ mod tests {
             }
             assert!(reference_noise(a, b, &mask).is_finite());
         }
+    }
+
+    /// Every glint method the orb and its curves build (through their own constructors) renders
+    /// the scene's σ_ε, read back from the built model or from its patches; the only exceptions are
+    /// the rows labelled "paper default", which carry exactly the paper's σ they declare. Each
+    /// family (mixture, bin map, position-normal) has a row at σ_ε. The orb is built at σ_ε = 0.02,
+    /// not the default, so that a model left at its own default fails.
+    #[test]
+    fn every_method_is_built_with_the_scenes_sigma() {
+        use super::common::material::{SIGMA_EPS, same_sigma};
+        use super::common::orb::render::build_methods;
+        use super::common::orb_curves::build_models;
+        let check = |methods: &[OrbMethod], sigma_eps: f32| {
+            for family in ["mixture", "bin map", "position-normal"] {
+                assert!(
+                    methods
+                        .iter()
+                        .any(|m| m.label.starts_with(family) && m.paper_sigma.is_none()),
+                    "{family}: no method at σ_ε"
+                );
+            }
+            for m in methods {
+                let sigma = m.glint.sigma();
+                match m.paper_sigma {
+                    None => assert!(same_sigma(sigma, sigma_eps), "{}: σ = {sigma}", m.label),
+                    Some(p) => {
+                        assert!(m.label.contains("paper default"), "{}", m.label);
+                        assert!(
+                            sigma == p || same_sigma(sigma, p),
+                            "{}: σ = {sigma}",
+                            m.label
+                        );
+                    }
+                }
+            }
+        };
+        assert_eq!(OrbOptions::default().sigma_eps, SIGMA_EPS);
+        let opts = OrbOptions {
+            map_size: 32,
+            sigma_eps: 0.02,
+            mixture_samples: 4,
+            progress: false,
+            ..OrbOptions::default()
+        };
+        let map = load_map(&opts).unwrap();
+        check(&build_methods(&opts, &map).unwrap(), 0.02);
+        check(&build_models(&map).unwrap(), SIGMA_EPS);
     }
 
     /// The references converge: on the bumpy map the noise of (a) and of (b) (half the difference of

@@ -9,6 +9,7 @@ pub mod compare;
 pub mod curves;
 pub mod grazing;
 pub mod lobes;
+pub mod material;
 pub mod mixture_images;
 pub mod orb;
 pub mod orb_curves;

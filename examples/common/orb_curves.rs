@@ -8,9 +8,10 @@
 //! ‖m − r‖² minus the reference's own noise variance ‖a − b‖²/4 (E‖r − E r‖²), clamped at 0,
 //! over ‖r‖² — an unbiased estimate of the squared error against the reference's expectation.
 
+use super::material::{Configured, SIGMA_EPS};
 use super::orb::{
-    Errors, Image, MapSource, OrbOptions, Scene, coverage, errors, gap_errors, glint_pixel,
-    load_map, reference_noise, render_glint_evals, render_naive, render_references,
+    Errors, Image, MapSource, OrbMethod, OrbOptions, Scene, coverage, errors, gap_errors,
+    glint_pixel, load_map, reference_noise, render_glint_evals, render_naive, render_references,
 };
 use super::{Artifact, Res, register_font, save_rgb};
 use brdf::glint::binmap::BinMapParams;
@@ -22,6 +23,7 @@ use indicatif::ProgressBar;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// The sweep's settings.
@@ -83,14 +85,15 @@ struct Point {
     noise_a: f64,
 }
 
-const SIGMA_EPS: f32 = brdf::glint::mixture::DEFAULT_SIGMA_MIN;
 const MAPS: [&str; 4] = ["scratched", "brushed", "bumpy", "flakes"];
 const EVALS: [u32; 3] = [1, 4, 16];
 
-/// The glint models of one map with their build times: the mixture as a path tracer would use it
-/// (64 quadrature nodes per lobe and `lod_lobes` 256, examples/render.rs), the bin map and the
-/// position-normal map at their defaults.
-fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<(String, GlintModel, f64)>> {
+/// The glint models of one map with their build times, each given the scene's σ_ε the way its
+/// paper allows (examples/common/material.rs): the mixture as a path tracer would use it (lobe floor
+/// σ_ε, 64 quadrature nodes per lobe and `lod_lobes` 256, examples/render.rs), the bin map at its
+/// default bins smoothed by a Beckmann lobe of α = √2 σ_ε, the position-normal map with σ_r = σ_ε;
+/// and, as "paper default" rows, the bin map's one-bin resolution (σ = 0) and Yan's σ_r = 0.005.
+pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
     let t = Instant::now();
     let params = MixtureParams {
         sigma_min: SIGMA_EPS,
@@ -101,18 +104,58 @@ fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<(String, GlintModel, f6
         },
         ..MixtureParams::default()
     };
-    let mixture: GlintModel = BeckmannMixture::build(map, params)?.into();
+    let mixture = Configured::new(Arc::new(BeckmannMixture::build(map, params)?.into()));
     let mixture_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let binmap: GlintModel = BinMap::build(map, BinMapParams::default())?.into();
+    // The masking lobe's floor at σ_ε too.
+    let binmap_params = BinMapParams {
+        sigma_min: SIGMA_EPS,
+        ..BinMapParams::default()
+    };
+    let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, binmap_params)?.into());
     let binmap_s = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let pn: GlintModel = PositionNormalMap::build(map, PositionNormalParams::default())?.into();
-    let pn_s = t.elapsed().as_secs_f64();
+    let pn = |sigma_r| -> Res<(Configured, f64)> {
+        let t = Instant::now();
+        let params = PositionNormalParams {
+            sigma_r,
+            ..PositionNormalParams::default()
+        };
+        let m = PositionNormalMap::build(map, params)?;
+        Ok((
+            Configured::new(Arc::new(m.into())),
+            t.elapsed().as_secs_f64(),
+        ))
+    };
+    let (pn_eps, pn_eps_s) = pn(SIGMA_EPS)?;
+    let paper_r = PositionNormalParams::DEFAULT_SIGMA_R;
+    let (pn_paper, pn_paper_s) = pn(paper_r)?;
+    let row = |label: &str, glint, build_s, paper_sigma| OrbMethod {
+        label: label.to_string(),
+        glint,
+        build_s,
+        paper_sigma,
+    };
     Ok(vec![
-        ("mixture (lod 256)".to_string(), mixture, mixture_s),
-        ("bin map".to_string(), binmap, binmap_s),
-        ("position-normal".to_string(), pn, pn_s),
+        row("mixture (lod 256)", mixture, mixture_s, None),
+        row(
+            "bin map",
+            Configured::binmap(binmap.clone(), SIGMA_EPS),
+            binmap_s,
+            None,
+        ),
+        row(
+            "bin map σ = 0 (paper default)",
+            Configured::binmap(binmap, 0.0),
+            binmap_s,
+            Some(0.0),
+        ),
+        row("position-normal", pn_eps, pn_eps_s, None),
+        row(
+            "position-normal σ_r = 0.005 (paper default)",
+            pn_paper,
+            pn_paper_s,
+            Some(paper_r),
+        ),
     ])
 }
 
@@ -136,7 +179,7 @@ fn texels_per_pixel(scene: &Scene, mask: &[bool], map_w: usize, map_h: usize) ->
 
 /// Projected render time of `model` at `evals` evaluations per pixel, from 64 covered pixels spread
 /// over the image.
-fn pilot_seconds(scene: &Scene, mask: &[bool], model: &GlintModel, evals: u32) -> f64 {
+fn pilot_seconds(scene: &Scene, mask: &[bool], model: &Configured, evals: u32) -> f64 {
     let covered: Vec<u32> = (0..scene.size * scene.size)
         .filter(|&k| mask[k as usize])
         .collect();
@@ -247,7 +290,13 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
                 points.push(point("naive", spp, 0.0, s, &img));
                 spp *= 4;
             }
-            for (label, model, build_s) in &models {
+            for OrbMethod {
+                label,
+                glint: model,
+                build_s,
+                ..
+            } in &models
+            {
                 for evals in EVALS {
                     let projected = pilot_seconds(&scene, &mask, model, evals);
                     if projected > opts.budget_s {
@@ -380,6 +429,13 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
 /// A grid of log-log panels, maps × scales.
 fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res<()> {
     register_font();
+    // The glint models, in first-seen order.
+    let mut labels: Vec<String> = Vec::new();
+    for p in points {
+        if p.method != "naive" && !p.method.starts_with("(b)") && !labels.contains(&p.method) {
+            labels.push(p.method.clone());
+        }
+    }
     let (cols, rows) = (opts.scales.len() as u32, MAPS.len() as u32);
     let (pw, ph) = (360u32, 260u32);
     let (w, h) = (cols * pw, rows * ph + 30);
@@ -396,7 +452,13 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res
             ("sans-serif", 15).into_font(),
         ))?;
         let panels = body.split_evenly((rows as usize, cols as usize));
-        let colours = [BLUE, RED, RGBColor(0, 150, 0), MAGENTA];
+        let colours = [
+            BLUE,
+            RED,
+            RGBColor(240, 150, 150),
+            RGBColor(0, 150, 0),
+            RGBColor(140, 210, 140),
+        ];
         for (pi, area) in panels.iter().enumerate() {
             let (map, scale) = (MAPS[pi / cols as usize], opts.scales[pi % cols as usize]);
             let here: Vec<&Point> = points
@@ -456,12 +518,9 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res
                 3,
                 BLACK.mix(0.5).into(),
             ))?;
-            for (mi, m) in ["mixture (lod 256)", "bin map", "position-normal"]
-                .iter()
-                .enumerate()
-            {
-                let col = colours[mi];
-                let pts: Vec<&&Point> = here.iter().filter(|p| p.method == *m).collect();
+            for (mi, m) in labels.iter().enumerate() {
+                let col = colours[mi % colours.len()];
+                let pts: Vec<&&Point> = here.iter().filter(|p| &p.method == m).collect();
                 if pts.is_empty() {
                     continue;
                 }
@@ -470,7 +529,7 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res
                         .map(|p| (p.render_s, y(p.vs_a.rel_rmse_denoised))),
                     col.stroke_width(2),
                 ))?
-                .label(*m)
+                .label(m.as_str())
                 .legend(move |(x, yy)| {
                     PathElement::new(vec![(x, yy), (x + 14, yy)], col.stroke_width(3))
                 });

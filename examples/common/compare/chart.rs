@@ -48,7 +48,7 @@ pub(super) fn accuracy_vs_time(
         let mut chart = Chart::new(
             &title,
             "BRDF eval time (µs, geometric mean)",
-            "mean TV (64² bins)",
+            "mean TV (63² bins)",
         );
         chart.x_scale = Scale::Log;
         chart.markers = true;
@@ -56,7 +56,7 @@ pub(super) fn accuracy_vs_time(
         artifacts.push(Artifact::new(
             path,
             format!(
-                "Accuracy against cost: mean total variation to the {truth} (64² bins) over the \
+                "Accuracy against cost: mean total variation to the {truth} (63² bins) over the \
                  four maps and footprints of 1 texel and more, against the geometric-mean time of \
                  one BRDF evaluation; the line joins the methods no other beats on both."
             ),
@@ -93,7 +93,7 @@ fn by_area(
         .collect()
 }
 
-/// Error against footprint size, per truth (mean TV over the maps and centres, 64² bins).
+/// Error against footprint size, per truth (mean TV over the maps and centres, 63² bins).
 pub(super) fn error_vs_footprint(
     results: &Results,
     settings: &Settings,
@@ -114,15 +114,15 @@ pub(super) fn error_vs_footprint(
         let series = by_area(results, settings, methods, &value, &|v| mean(v));
         let path = out.join(file);
         let title = format!("P-NDF error against footprint size, {truth}");
-        let mut chart = Chart::new(&title, "footprint (texels)", "mean TV (64² bins)");
+        let mut chart = Chart::new(&title, "footprint (texels)", "mean TV (63² bins)");
         chart.x_scale = Scale::Log;
         chart.markers = true;
         line_chart(&path, &chart, &series)?;
         artifacts.push(Artifact::new(
             path,
             format!(
-                "Total variation to the {truth} (64² bins) against footprint size, mean over the \
-                 four maps and the footprint centres (noise floors, 128² bins and the quadrature used are \
+                "Total variation to the {truth} (63² bins) against footprint size, mean over the \
+                 four maps and the footprint centres (noise floors, 127² bins and the quadrature used are \
                  in compare_accuracy.csv)."
             ),
         ));

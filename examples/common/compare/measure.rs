@@ -35,18 +35,18 @@ pub struct Settings {
     pub max_quadrature: usize,
     /// Tolerance of the adaptive quadrature (change of the bin masses in TV).
     pub quadrature_tolerance: f64,
-    /// Footprints up to this many texels are also compared on 128² bins.
+    /// Footprints up to this many texels are also compared on 127² bins.
     pub fine_up_to: f32,
     /// Footprint centres averaged over (1 to 3, from [`CENTERS`]).
     pub centers: usize,
 }
 
 impl Settings {
-    /// `--quick`: 1024² maps, footprints up to 256 texels, one footprint centre, 128² bins up to 1
+    /// `--quick`: 1024² maps, footprints up to 256 texels, one footprint centre, 127² bins up to 1
     /// texel (the adaptive quadrature needs ≥ 20 evaluations per bin where a fixed 2 × 2 rule took 4,
     /// and one `d` costs 0.3-1.3 ms at 4096 texels: that size alone took ~5 minutes per map);
     /// otherwise 2048² maps, footprints up to 65536 texels (beyond the default level of detail), 4×
-    /// the reference samples, three centres and 128² bins up to 16 texels. The quick run also stops
+    /// the reference samples, three centres and 127² bins up to 16 texels. The quick run also stops
     /// the per-bin quadrature at 16 × 16 points and a TV change of 5·10⁻³ (the full run: 64 × 64 and
     /// 10⁻³), which keeps the gallery's run to minutes; its TV figures are then good to ~0.005, and
     /// spiky models that have not converged at 16 × 16 say so in the `quad_change` column.
@@ -90,6 +90,15 @@ impl Settings {
     }
 }
 
+/// Bins per axis of the coarse binning of the truths (63² bins of ~0.045 in slope near the pole).
+/// Odd, so that the pole is the centre of a bin: with an even count it is the corner of four bins,
+/// and the Dirac truth would put every flat texel into one of them while any model with σ > 0
+/// splits that mass four ways.
+pub const COARSE_BINS: usize = 63;
+
+/// Bins per axis of the fine binning (odd for the same reason).
+pub const FINE_BINS: usize = 127;
+
 /// Footprint centres (uv); TV is averaged over them.
 const CENTERS: [[f32; 2]; 3] = [[0.43, 0.57], [0.71, 0.23], [0.17, 0.81]];
 
@@ -99,9 +108,9 @@ pub struct AccuracyRow {
     pub map: &'static str,
     pub method: String,
     pub area: f32,
-    /// On 64² bins.
+    /// On 63² bins.
     pub tv: TwoTruths,
-    /// On 128² bins (footprints up to [`Settings::fine_up_to`] texels).
+    /// On 127² bins (footprints up to [`Settings::fine_up_to`] texels).
     pub tv_fine: Option<TwoTruths>,
     pub patch_s: f64,
     pub d_s: f64,
@@ -180,7 +189,7 @@ fn eval_pairs(patch: &(dyn Ndf + Sync), n: usize) -> Vec<(Vec3, Vec3)> {
         .collect()
 }
 
-/// Ground truths of one footprint: 64² bins, and 128² bins (4× the positions, for the same noise
+/// Ground truths of one footprint: 63² bins, and 127² bins (4× the positions, for the same noise
 /// per bin) when the footprint is small enough.
 struct Reference {
     fp: Footprint,
@@ -190,7 +199,7 @@ struct Reference {
 
 /// Runs the comparison; `progress` receives one line per step.
 pub fn measure(settings: &Settings, progress: &mut dyn FnMut(&str)) -> Res<Results> {
-    let bins = HemisphereBins::new(64)?;
+    let bins = HemisphereBins::new(COARSE_BINS)?;
     let mut results = Results::default();
     let n = settings.size;
     for (map_name, map) in maps(n)? {
@@ -271,9 +280,9 @@ fn references(map: &NormalMap, settings: &Settings) -> Res<Vec<(f32, Vec<Referen
             let fp = Footprint::isotropic_texels(Vec2::new(c[0], c[1]), area, n, n);
             let samples = settings.reference_samples;
             let seed = 17 + k as u64;
-            let coarse = Truths::new(map, &fp, 64, samples, seed)?;
+            let coarse = Truths::new(map, &fp, COARSE_BINS, samples, seed)?;
             let fine = if area <= settings.fine_up_to {
-                Some(Truths::new(map, &fp, 128, 4 * samples, seed)?)
+                Some(Truths::new(map, &fp, FINE_BINS, 4 * samples, seed)?)
             } else {
                 None
             };
@@ -284,8 +293,8 @@ fn references(map: &NormalMap, settings: &Settings) -> Res<Vec<(f32, Vec<Referen
     Ok(references)
 }
 
-/// A method's TV to both truths at one footprint size, mean over the centres: on 64² bins, and on
-/// 128² bins where the footprint has them.
+/// A method's TV to both truths at one footprint size, mean over the centres: on 63² bins, and on
+/// 127² bins where the footprint has them.
 fn accuracy(
     method: &dyn Method,
     per_centre: &[Reference],

@@ -7,8 +7,10 @@
 //!   - the **convolved truth** (`convolved_pndf`): the same surface with the material's micro-roughness,
 //!     each position's normal spread by the slope Gaussian of σ_ε = 0.01 ([`truth::SIGMA_EPS`]);
 //!
-//!   both on 64² bins, and on 128² bins as well for footprints up to [`Settings::fine_up_to`] texels,
-//!   where 64² bins (~0.044 in slope near the pole, 4.4 σ_ε) blur the glints. Each model's bin masses
+//!   both on 63² bins, and on 127² bins as well for footprints up to [`Settings::fine_up_to`] texels,
+//!   where 63² bins (~0.045 in slope near the pole, 4.5 σ_ε) blur the glints. The bin counts are odd
+//!   ([`measure::COARSE_BINS`]): the pole is the centre of a bin, not the corner of four, so the
+//!   flat texels of the Dirac truth do not favour σ = 0 models over those that add σ_ε. Each model's bin masses
 //!   come from `adaptive_bin_masses` (midpoint grids refined per bin 2 × 2 → 4 × 4 → … until the
 //!   masses change by less than 10⁻³ in TV), and the grid reached is reported;
 //! - the cost: build time, bytes per texel, patch construction, one `d` and one BRDF evaluation
@@ -22,7 +24,9 @@
 //! footprint size, error and energy against view angle) and prints markdown tables.
 //!
 //! Methods plug in through [`methods::Method`] (an object-safe view of `brdf::glint::GlintNdf` plus
-//! the method's own BRDF); [`methods::builders`] lists them.
+//! the method's own BRDF); [`methods::builders`] lists them. Every method renders the one material
+//! of the convolved truth, σ_ε included ([`crate::common::material`]); the bin map and the
+//! position-normal baseline are also shown at their papers' own σ, labelled "paper default".
 //!
 //! Layout: [`methods`] (the methods compared), [`truth`] (the ground truths and the TV to them),
 //! [`measure`](mod@measure) (running the methods), [`table`] (CSV files and markdown tables),
@@ -76,9 +80,9 @@ struct MethodSummary {
     method: String,
     /// BRDF eval time, µs (geometric mean).
     eval_us: f64,
-    /// Mean TV to the Dirac truth (64² bins).
+    /// Mean TV to the Dirac truth (63² bins).
     tv_dirac: f64,
-    /// Mean TV to the convolved truth (64² bins).
+    /// Mean TV to the convolved truth (63² bins).
     tv_convolved: f64,
 }
 

@@ -1,5 +1,5 @@
 //! The comparison's tables: the three CSV files (accuracy and costs, view angles, builds) and the
-//! markdown tables (summary per method, TV per footprint size on 64² and 128² bins, `d` time per
+//! markdown tables (summary per method, TV per footprint size on 63² and 127² bins, `d` time per
 //! footprint size, visible-area error and furnace per view angle).
 
 use super::{AccuracyRow, MethodSummary, Results, Settings, TwoTruths, ViewRow, geo_mean, mean};
@@ -15,13 +15,18 @@ pub(super) fn write_csv(results: &Results, out: &Path) -> Res<()> {
     Ok(())
 }
 
+/// A CSV field in double quotes (method labels hold commas), inner quotes doubled.
+fn quoted(s: &str) -> String {
+    format!("\"{}\"", s.replace('"', "\"\""))
+}
+
 /// One line per map, method and footprint size: TV to both truths, their noise and the quadrature
-/// on 64² and 128² bins, and the costs.
+/// on 63² and 127² bins, and the costs.
 fn accuracy_csv(results: &Results) -> Res<String> {
     let mut csv = String::from(
         "map,method,footprint_texels,tv_dirac,tv_convolved,noise_dirac,noise_convolved,quad_k,\
-         quad_change,tv_dirac_128,tv_convolved_128,noise_dirac_128,noise_convolved_128,quad_k_128,\
-         quad_change_128,patch_s,d_s,eval_s\n",
+         quad_change,tv_dirac_127,tv_convolved_127,noise_dirac_127,noise_convolved_127,quad_k_127,\
+         quad_change_127,patch_s,d_s,eval_s\n",
     );
     let cols = |t: &TwoTruths| {
         format!(
@@ -34,7 +39,7 @@ fn accuracy_csv(results: &Results) -> Res<String> {
             csv,
             "{},{},{},{},{},{:.3e},{:.3e},{:.3e}",
             r.map,
-            r.method,
+            quoted(&r.method),
             r.area,
             cols(&r.tv),
             r.tv_fine.as_ref().map_or(",,,,,".to_string(), cols),
@@ -53,7 +58,11 @@ fn view_csv(results: &Results) -> Res<String> {
         writeln!(
             csv,
             "{},{},{},{:.5},{:.5}",
-            r.map, r.method, r.theta, r.v_rel_error, r.furnace
+            r.map,
+            quoted(&r.method),
+            r.theta,
+            r.v_rel_error,
+            r.furnace
         )?;
     }
     Ok(csv)
@@ -66,7 +75,11 @@ fn build_csv(results: &Results) -> Res<String> {
         writeln!(
             csv,
             "{},{},{},{:.3},{:.2}",
-            r.map, r.family, r.method, r.build_s, r.bytes_per_texel
+            r.map,
+            r.family,
+            quoted(&r.method),
+            r.build_s,
+            r.bytes_per_texel
         )?;
     }
     Ok(csv)
@@ -90,12 +103,13 @@ pub(super) fn markdown(
     .join("\n"))
 }
 
-/// Per method: mean TV to both truths (≥ 1 texel), BRDF eval time, bytes per texel, build time.
+/// Per method: mean TV to both truths (≥ 1 texel; the convolved truth first: the material every
+/// method is given), BRDF eval time, bytes per texel, build time.
 fn summary_table(results: &Results, summary: &[MethodSummary]) -> Res<String> {
     let mut md = String::new();
     writeln!(
         md,
-        "| method | mean TV, Dirac (≥ 1 texel) | mean TV, convolved | BRDF eval (µs, geo. mean) | \
+        "| method | mean TV, convolved (≥ 1 texel) | mean TV, Dirac | BRDF eval (µs, geo. mean) | \
          bytes/texel | build (s, mean over maps) |"
     )?;
     writeln!(md, "|---|---|---|---|---|---|")?;
@@ -104,7 +118,7 @@ fn summary_table(results: &Results, summary: &[MethodSummary]) -> Res<String> {
         let b = || results.build.iter().filter(|r| &r.method == m);
         writeln!(
             md,
-            "| {m} | {e:.3} | {c:.3} | {t:.2} | {:.1} | {:.1} |",
+            "| {m} | {c:.3} | {e:.3} | {t:.2} | {:.1} | {:.1} |",
             mean(b().map(|r| r.bytes_per_texel)),
             mean(b().map(|r| r.build_s))
         )?;
@@ -112,8 +126,9 @@ fn summary_table(results: &Results, summary: &[MethodSummary]) -> Res<String> {
     Ok(md)
 }
 
-/// Markdown table of the TV to both truths per footprint size (means over maps and centres), on 64²
-/// bins or (`fine`) on 128² bins for the footprints that have them; the last columns give the finest
+/// Markdown table of the TV to both truths per footprint size (convolved first, means over maps and
+/// centres), on 63²
+/// bins or (`fine`) on 127² bins for the footprints that have them; the last columns give the finest
 /// quadrature grid any bin needed (k of k × k, over maps, centres and sizes) and the largest final
 /// change of the masses.
 fn tv_table(results: &Results, settings: &Settings, methods: &[String], fine: bool) -> String {
@@ -125,10 +140,10 @@ fn tv_table(results: &Results, settings: &Settings, methods: &[String], fine: bo
         .filter(|&a| !fine || a <= settings.fine_up_to)
         .collect();
     let mut md = String::new();
-    let bins = if fine { "128²" } else { "64²" };
+    let bins = if fine { "127²" } else { "63²" };
     md.push_str(&format!("| method ({bins} bins) |"));
     for a in &areas {
-        md.push_str(&format!(" {a}: Dirac | {a}: conv. |"));
+        md.push_str(&format!(" {a}: conv. | {a}: Dirac |"));
     }
     md.push_str(" quadrature k | change |\n");
     md.push_str(&format!(
@@ -153,8 +168,8 @@ fn tv_table(results: &Results, settings: &Settings, methods: &[String], fine: bo
                 .collect();
             md.push_str(&format!(
                 " {:.3} | {:.3} |",
-                mean(rows.iter().map(|t| t.dirac)),
-                mean(rows.iter().map(|t| t.convolved))
+                mean(rows.iter().map(|t| t.convolved)),
+                mean(rows.iter().map(|t| t.dirac))
             ));
             if m == &methods[0] {
                 noise_d.push(mean(rows.iter().map(|t| t.noise_dirac)));
@@ -167,7 +182,7 @@ fn tv_table(results: &Results, settings: &Settings, methods: &[String], fine: bo
     }
     md.push_str("| *reference noise* |");
     for (d, c) in noise_d.iter().zip(&noise_c) {
-        md.push_str(&format!(" {d:.3} | {c:.3} |"));
+        md.push_str(&format!(" {c:.3} | {d:.3} |"));
     }
     md.push_str(" | |\n");
     md

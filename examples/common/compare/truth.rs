@@ -10,11 +10,10 @@ use brdf::glint::{
 };
 use brdf::ndf::Ndf;
 
-/// σ_ε of the convolved truth: the paper's material (\[Chermain2019\] §5.2.2) and the mixture's default
-/// variance floor (`MixtureParams::sigma_min`, which floors each lobe's slope σ rather than adding to
-/// it). The position-normal baseline adds its own σ_r = 0.005 and the smoothed bin map α = 0.02
-/// (σ ≈ 0.014); one truth for all keeps the comparison about the surface, not each model's roughness.
-pub const SIGMA_EPS: f64 = brdf::ndf::DEFAULT_SIGMA_MIN as f64;
+/// σ_ε of the convolved truth: the scene's material (\[Chermain2019\] §5.2.2), the σ every method
+/// is given ([`crate::common::material::SIGMA_EPS`]); one truth for all keeps the comparison about
+/// the surface, not each model's roughness.
+pub const SIGMA_EPS: f64 = crate::common::material::SIGMA_EPS as f64;
 
 /// TV of a model to both truths on one binning, each truth's noise floor (`tv_error`), and the
 /// quadrature used (means over the footprint centres; `k` the finest grid, `change` the largest

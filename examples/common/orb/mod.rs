@@ -31,8 +31,8 @@ pub mod table;
 pub use chart::exposure_of;
 pub use metrics::{Errors, coverage, errors, gap_errors, reference_noise};
 pub use render::{
-    Image, References, Rendered, glint_pixel, mean_image, render_all, render_glint_evals,
-    render_naive, render_references,
+    Image, OrbMethod, References, Rendered, glint_pixel, mean_image, render_all,
+    render_glint_evals, render_naive, render_references,
 };
 pub use scene::Scene;
 
@@ -92,7 +92,8 @@ pub struct OrbOptions {
     pub spp: u32,
     /// Samples per pixel of the naive "equal-time" row (0: no such row).
     pub naive_spp: u32,
-    /// Slope standard deviation σ_ε of the reference's near-specular lobe, and the mixture's floor.
+    /// The scene's intrinsic roughness σ_ε (per-axis slope standard deviation): the references' and
+    /// naive sampling's near-specular lobe, and every glint model's (examples/common/material.rs).
     pub sigma_eps: f32,
     /// Seed of the procedural map and of the reference's jitter.
     pub seed: u64,
@@ -111,7 +112,7 @@ impl Default for OrbOptions {
             tiles: Vec2::new(8.0, 4.0),
             spp: 512,
             naive_spp: 16,
-            sigma_eps: brdf::glint::mixture::DEFAULT_SIGMA_MIN,
+            sigma_eps: super::material::SIGMA_EPS,
             seed: 7,
             mixture_samples: 64,
             progress: true,

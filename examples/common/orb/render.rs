@@ -1,22 +1,25 @@
 //! Rendering the orb: each glint model with one (or q × q) BRDF evaluations per pixel, the two
-//! footprint references as independent halves, naive sampling of the normal map, and
-//! [`render_all`], which builds every method and renders every row of the comparison.
+//! footprint references as independent halves, naive sampling of the normal map, [`build_methods`],
+//! which builds every glint method at the scene's σ_ε, and [`render_all`], which renders every row
+//! of the comparison.
 
 use super::OrbOptions;
 use super::scene::{Scene, ShadingPoint};
 use crate::common::Res;
+use crate::common::material::{Configured, beckmann_alpha};
 use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf};
 use brdf::fresnel::Fresnel;
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, Footprint, GlintNdf, Kernel, MixturePatch, NormalMap,
+    BeckmannMixture, BinMap, Footprint, GlintModel, GlintNdf, Kernel, MixturePatch, NormalMap,
     PositionNormalMap, footprint_brdf,
 };
 use glam::{Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// A linear RGB image (row major, row 0 at the top).
@@ -41,7 +44,7 @@ fn progress_bar(show: bool, len: u64, msg: &str) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let pb = ProgressBar::new(len);
-    if let Ok(style) = ProgressStyle::with_template("{msg:>34} [{bar:30}] {pos}/{len} {elapsed}") {
+    if let Ok(style) = ProgressStyle::with_template("{msg:>44} [{bar:30}] {pos}/{len} {elapsed}") {
         pb.set_style(style.progress_chars("=> "));
     }
     pb.set_message(msg.to_string());
@@ -289,57 +292,136 @@ pub struct Rendered {
     pub render_s: f64,
 }
 
-/// Renders both references and every glint method available. Returns the references, their render
-/// time (s) and the methods' images (the naive equal-time row included when `naive_spp > 0`).
-pub fn render_all(opts: &OrbOptions, map: &NormalMap) -> Res<(References, f64, Vec<Rendered>)> {
-    let scene = Scene::new(opts.size, opts.tiles);
-    let rows = opts.size as u64;
-    let mut out = Vec::new();
+/// One glint method of the orb: its label, the model with the options of its patches, its build
+/// time, and for a row kept at its paper's own σ (labelled "paper default"), that σ.
+pub struct OrbMethod {
+    /// Label.
+    pub label: String,
+    /// The model and its patch options.
+    pub glint: Configured,
+    /// Precomputation time (s).
+    pub build_s: f64,
+    /// The paper's σ of a "paper default" row; `None` for a row at the scene's σ_ε.
+    pub paper_sigma: Option<f32>,
+}
 
+/// Builds every glint method of the orb, each given the scene's σ_ε (`opts.sigma_eps`) the way its
+/// paper allows (examples/common/material.rs): the mixture's lobe floor (exact masking, approximate
+/// masking, the filtered lobe), the bin map smoothed by a Beckmann lobe of α = √2 σ_ε, the
+/// position-normal elements' σ_r = σ_ε; and the bin map's one-bin resolution (σ = 0) and Yan's
+/// σ_r = 0.005 as "paper default" rows. Every model renders through the same `MicrofacetBrdf` (for
+/// the position-normal baseline this is its patch with the moments-lobe masking, not the published
+/// BRDF, so that every row differs only in the P-NDF and its masking).
+pub fn build_methods(opts: &OrbOptions, map: &NormalMap) -> Res<Vec<OrbMethod>> {
+    let sigma = opts.sigma_eps;
     let t = Instant::now();
     let build_bar = progress_bar(opts.progress, 1000, "building the Beckmann mixture");
     let progress = |f: f32| build_bar.set_position((f * 1000.0) as u64);
     let params = MixtureParams {
-        sigma_min: opts.sigma_eps,
+        sigma_min: sigma,
         samples: opts.mixture_samples,
         ..MixtureParams::default()
     };
-    let mixture = BeckmannMixture::build_with_progress(map, params, Some(&progress))?;
+    let mixture: Arc<GlintModel> =
+        Arc::new(BeckmannMixture::build_with_progress(map, params, Some(&progress))?.into());
     build_bar.finish();
     let mixture_build = t.elapsed().as_secs_f64();
-
-    let exact = MixtureVariant {
-        mixture: &mixture,
-        options: PatchOptions {
-            masking: MaskingMode::Exact,
+    let variant = |masking, lod_lobes| {
+        let mut c = Configured::new(mixture.clone());
+        c.options.mixture = PatchOptions {
+            masking,
+            lod_lobes,
             ..PatchOptions::default()
-        },
+        };
+        c
     };
-    let approximate = MixtureVariant {
-        mixture: &mixture,
-        options: PatchOptions {
-            masking: MaskingMode::Approximate,
-            ..PatchOptions::default()
-        },
-    };
-    let filtered = MixtureVariant {
-        mixture: &mixture,
-        options: PatchOptions {
-            masking: MaskingMode::Approximate,
-            lod_lobes: 0.0,
-            ..PatchOptions::default()
-        },
-    };
-    // The two other glint methods at their defaults, through the same `MicrofacetBrdf` (for the
-    // position-normal baseline this is its patch with the moments-lobe masking, not the published
-    // BRDF, so that every column differs only in the P-NDF and its masking).
+    let default_lod = PatchOptions::default().lod_lobes;
     let t = Instant::now();
-    let binmap = BinMap::build(map, BinMapParams::default())?;
+    // The masking lobe's floor at σ_ε too.
+    let binmap_params = BinMapParams {
+        sigma_min: sigma,
+        ..BinMapParams::default()
+    };
+    let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, binmap_params)?.into());
     let binmap_build = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let position_normal = PositionNormalMap::build(map, PositionNormalParams::default())?;
+    let pn = |sigma_r| {
+        PositionNormalMap::build(
+            map,
+            PositionNormalParams {
+                sigma_r,
+                ..PositionNormalParams::default()
+            },
+        )
+        .map(|m| Configured::new(Arc::new(m.into())))
+    };
+    let position_normal = pn(sigma)?;
     let position_normal_build = t.elapsed().as_secs_f64();
-    // The glint methods. Each is one line: a label, the build time, and the model (any GlintNdf).
+    let paper_r = PositionNormalParams::DEFAULT_SIGMA_R;
+    let t = Instant::now();
+    let position_normal_paper = pn(paper_r)?;
+    let position_normal_paper_build = t.elapsed().as_secs_f64();
+    let row = |label: &str, glint, build_s, paper_sigma| OrbMethod {
+        label: label.to_string(),
+        glint,
+        build_s,
+        paper_sigma,
+    };
+    Ok(vec![
+        row(
+            "mixture, exact masking",
+            variant(MaskingMode::Exact, default_lod),
+            mixture_build,
+            None,
+        ),
+        row(
+            "mixture, approx. masking",
+            variant(MaskingMode::Approximate, default_lod),
+            mixture_build,
+            None,
+        ),
+        row(
+            "filtered lobe (LOD 0)",
+            variant(MaskingMode::Approximate, 0.0),
+            mixture_build,
+            None,
+        ),
+        row(
+            &format!("bin map, α = {:.4}", beckmann_alpha(sigma)),
+            Configured::binmap(binmap.clone(), sigma),
+            binmap_build,
+            None,
+        ),
+        row(
+            "bin map, σ = 0 (paper default)",
+            Configured::binmap(binmap, 0.0),
+            binmap_build,
+            Some(0.0),
+        ),
+        row(
+            &format!("position-normal, σ_r = {sigma}"),
+            position_normal,
+            position_normal_build,
+            None,
+        ),
+        row(
+            &format!("position-normal, σ_r = {paper_r} (paper default)"),
+            position_normal_paper,
+            position_normal_paper_build,
+            Some(paper_r),
+        ),
+    ])
+}
+
+/// Renders both references and every glint method of [`build_methods`]. Returns the references,
+/// their render time (s) and the methods' images (the naive equal-time row, at the same σ_ε,
+/// included when `naive_spp > 0`).
+pub fn render_all(opts: &OrbOptions, map: &NormalMap) -> Res<(References, f64, Vec<Rendered>)> {
+    let scene = Scene::new(opts.size, opts.tiles);
+    let rows = opts.size as u64;
+    let mut out = Vec::new();
+    let methods = build_methods(opts, map)?;
+    // Each row: a label, the build time, and the render.
     let mut glint = |label: &str, build_s: f64, render: &dyn Fn(&ProgressBar) -> Image| {
         let bar = progress_bar(opts.progress, rows, label);
         let t = Instant::now();
@@ -352,21 +434,9 @@ pub fn render_all(opts: &OrbOptions, map: &NormalMap) -> Res<(References, f64, V
             render_s: t.elapsed().as_secs_f64(),
         });
     };
-    glint("mixture, exact masking", mixture_build, &|b| {
-        render_glint(&scene, &exact, b)
-    });
-    glint("mixture, approx. masking", mixture_build, &|b| {
-        render_glint(&scene, &approximate, b)
-    });
-    glint("filtered lobe (LOD 0)", mixture_build, &|b| {
-        render_glint(&scene, &filtered, b)
-    });
-    glint("bin map (Atanasov 2020)", binmap_build, &|b| {
-        render_glint(&scene, &binmap, b)
-    });
-    glint("position-normal (Yan 2016)", position_normal_build, &|b| {
-        render_glint(&scene, &position_normal, b)
-    });
+    for m in &methods {
+        glint(&m.label, m.build_s, &|b| render_glint(&scene, &m.glint, b));
+    }
     if opts.naive_spp > 0 {
         let k = ((opts.naive_spp as f64).sqrt().round() as u32).max(1);
         let label = format!("naive, {} spp", k * k);

@@ -19,7 +19,7 @@ pub fn print(
         map_width, map_height, opts.tiles.x, opts.tiles.y, opts.size, opts.sigma_eps
     );
     println!(
-        "{:<30} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}",
+        "{:<44} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}",
         "method (errors vs (a))",
         "build s",
         "render s",
@@ -31,13 +31,13 @@ pub fn print(
     );
     let (ref_label, ref_s, noise) = (&reference.label, reference.render_s, reference.noise);
     println!(
-        "{ref_label:<30} {:>8} {ref_s:>8.2} {noise:>9.3} {:>9} {:>9} {:>9} {:>9}",
+        "{ref_label:<44} {:>8} {ref_s:>8.2} {noise:>9.3} {:>9} {:>9} {:>9} {:>9}",
         "-", "(noise)", "-", "-", "-"
     );
     for row in rows {
         let (m, e, vs_b) = (row.rendered, &row.errors, row.vs_b);
         println!(
-            "{:<30} {:>8.2} {:>8.2} {:>9.3} {:>9.3} {:>9.3} {:>+9.3} {:>9.3}",
+            "{:<44} {:>8.2} {:>8.2} {:>9.3} {:>9.3} {:>9.3} {:>+9.3} {:>9.3}",
             m.label,
             m.build_s,
             m.render_s,
