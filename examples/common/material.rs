@@ -125,7 +125,7 @@ impl GlintNdf for Configured {
         &'b self,
         footprint: &Footprint,
         options: &GlintOptions,
-        scratch: Option<&'b mut GlintScratch>,
+        scratch: Option<&'b GlintScratch>,
     ) -> GlintPatch<'b> {
         self.model.patch_with(footprint, options, scratch)
     }
