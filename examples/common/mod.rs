@@ -10,6 +10,7 @@ pub mod curves;
 pub mod grazing;
 pub mod lobes;
 pub mod mixture_images;
+pub mod normal_mapping;
 pub mod orb;
 pub mod orb_curves;
 pub mod pndf_images;
