@@ -15,8 +15,11 @@ use support::totality::check_bxdf;
 /// Views of the convention and convergence tests (degrees).
 const THETAS: [f64; 5] = [0.0, 30.0, 60.0, 80.0, 89.0];
 
+/// A named mirror and its Fresnel term.
+type Mirror = (&'static str, Box<dyn Bxdf>, Box<dyn Fresnel>);
+
 /// Every mirror the tests use: conductors, a dielectric's reflection, Schlick, F = 1.
-fn mirrors() -> Vec<(&'static str, Box<dyn Bxdf>, Box<dyn Fresnel>)> {
+fn mirrors() -> Vec<Mirror> {
     let schlick = SchlickFresnel::new(Vec3::new(0.9, 0.6, 0.3)).unwrap();
     let glass = DielectricFresnel::new(1.5).unwrap();
     vec![

@@ -206,7 +206,7 @@ impl<B: Bxdf> NormalMapMicrofacet<B> {
     #[inline]
     fn choose(&self, wo: Vec3, uc: f32) -> Option<(u8, f32)> {
         let (lp, lt) = self.facet_probabilities(wo);
-        if !(lp + lt > 0.0) || !uc.is_finite() {
+        if lp + lt <= 0.0 || !uc.is_finite() {
             return None;
         }
         let beta = self.beta(wo);

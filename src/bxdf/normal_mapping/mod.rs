@@ -87,13 +87,13 @@ impl ShadingNormal {
 
     /// A direction of the geometric frame in the shading frame.
     #[inline]
-    pub(crate) fn to_shading(&self, w: Vec3) -> Vec3 {
+    pub(crate) fn to_shading(self, w: Vec3) -> Vec3 {
         self.frame.to_local(w)
     }
 
     /// A direction of the shading frame in the geometric frame.
     #[inline]
-    pub(crate) fn to_geometric(&self, w: Vec3) -> Vec3 {
+    pub(crate) fn to_geometric(self, w: Vec3) -> Vec3 {
         self.frame.to_world(w)
     }
 }
