@@ -42,8 +42,9 @@
 //!
 //! pdf(wi) = λ_p(1 − β) p(wo, wi) + λ_p β p(wo, H(wi)) [⟨wi, ω_t⟩ > 0] + λ_t p(H(wo), wi), with p
 //! the inner pdf in p's frame (the mirror H keeps solid angle). The pdf is positive wherever f is.
-//! The weight is not bounded by the inner weight (up to 4/3 of it on strategy A, more on B where
-//! 1 − G1 exceeds β); its mean is the albedo.
+//! The weight f cos θi / pdf is not bounded by the inner weight w: term by term (f is the sum of
+//! three terms, the pdf of three matching ones) it is at most w · max(G1(wi)/(1 − β),
+//! (1 − G1(H(wi)))/β, G1(wi)) ≤ w · max(4, 2/sin θp); its mean is the albedo.
 
 use super::ShadingNormal;
 use crate::bxdf::{Bxdf, BxdfSample, LobeFlags};
