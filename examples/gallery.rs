@@ -18,7 +18,7 @@ type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
 fn main() -> Res<()> {
     let out = common::out_dir()?;
     let quick = !common::has_flag("--full");
-    let parts: [(&str, &str, Part); 9] = [
+    let parts: [(&str, &str, Part); 10] = [
         (
             "Analytic core",
             "NDF slices, Smith masking and Fresnel curves.",
@@ -69,6 +69,12 @@ fn main() -> Res<()> {
              error, white furnace and the spread of the sample weight of every NDF and glint method \
              (the grazing example).",
             common::grazing::run,
+        ),
+        (
+            "Normal mapping at grazing views",
+            "Conventional (tilt the frame) against microfacet-based normal mapping (Schüssler 2017): \
+             directional albedo against the view angle and a lobe image (the normal_mapping example).",
+            common::normal_mapping::run,
         ),
         (
             "Glints in a path tracer",

@@ -40,8 +40,8 @@ pub mod ndf;
 pub mod warp;
 
 pub use bxdf::{
-    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, LayeredBrdf, MicrofacetBrdf, OriginalPhong, Phong,
-    PhongNormalization,
+    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet,
+    NormalMapTilt, OriginalPhong, Phong, PhongNormalization, ShadingNormal, SpecularReflection,
 };
 pub use error::{Error, Result};
 pub use fresnel::Fresnel;

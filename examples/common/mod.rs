@@ -11,6 +11,7 @@ pub mod grazing;
 pub mod lobes;
 pub mod material;
 pub mod mixture_images;
+pub mod normal_mapping;
 pub mod orb;
 pub mod orb_curves;
 pub mod pndf_images;

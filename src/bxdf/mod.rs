@@ -7,8 +7,10 @@
 //! [`PhongNormalization`], optional Schlick Fresnel) and [`OriginalPhong`] (cos^γ θr / cos θi); the
 //! [`BlinnPhongLobe`]; and [`MicrofacetBrdf`], generic over any [`crate::ndf::Ndf`] (centred NDFs,
 //! non-centred lobes, glint patches) and any [`crate::fresnel::Fresnel`]; [`LayeredBrdf`], a microfacet
-//! layer over a Lambertian base. Which are reciprocal and which
-//! conserve or normalise energy: docs/bxdf.md.
+//! layer over a Lambertian base; [`SpecularReflection`], the smooth limit (a delta lobe, see the
+//! convention on [`Bxdf`]); and the shading-normal adapters [`NormalMapTilt`] (conventional normal
+//! mapping) and [`NormalMapMicrofacet`] (microfacet-based normal mapping), each wrapping any inner
+//! [`Bxdf`]. Which are reciprocal and which conserve or normalise energy: docs/bxdf.md.
 
 use glam::{Vec2, Vec3};
 
@@ -17,16 +19,20 @@ mod lambert;
 mod layered;
 mod lobe;
 mod microfacet;
+mod normal_mapping;
 mod phong;
+mod specular;
 
 pub use blinn_phong::{BlinnPhongLobe, BlinnPhongNormalization};
 pub use lambert::Lambert;
 pub(crate) use lambert::unit_rgb;
 pub use layered::{LayeredBrdf, TRANSMISSION_SAMPLES};
 pub use microfacet::{Masking, MicrofacetBrdf, Sampling};
+pub use normal_mapping::{NormalMapMicrofacet, NormalMapTilt, ShadingNormal};
 pub use phong::{
     ARVO_MAX_GAMMA, OriginalPhong, OriginalPhongNormalization, Phong, PhongNormalization,
 };
+pub use specular::SpecularReflection;
 
 /// Which kinds of lobe a sample came from (a small bit set).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -41,7 +47,10 @@ impl LobeFlags {
     pub const DIFFUSE: LobeFlags = LobeFlags(2);
     /// A glossy lobe (Phong specular, rough microfacets, glint patches).
     pub const GLOSSY: LobeFlags = LobeFlags(4);
-    /// A delta lobe (perfect mirror). Not produced yet; reserved so that renderers can match on it.
+    /// A delta lobe (perfect mirror, [`SpecularReflection`]): the sample's `pdf` is the discrete
+    /// probability of the lobe, not a density, and `eval` / `pdf` return 0 at its direction. A
+    /// renderer multiplies the throughput by `weight()` and uses neither MIS nor next-event
+    /// estimation for it (the delta-lobe convention on [`Bxdf`]).
     pub const SPECULAR: LobeFlags = LobeFlags(8);
 
     /// Whether every flag of `other` is set in `self`.
@@ -77,9 +86,11 @@ impl std::ops::BitOrAssign for LobeFlags {
 pub struct BxdfSample {
     /// The sampled direction (unit, away from the surface, local frame).
     pub wi: Vec3,
-    /// f(wo, wi), without the cosine; agrees with [`Bxdf::eval`].
+    /// f(wo, wi), without the cosine; agrees with [`Bxdf::eval`] (for a `SPECULAR` sample: F / cos θi,
+    /// see the delta-lobe convention on [`Bxdf`]).
     pub f: Vec3,
-    /// Density of `wi` per unit solid angle; finite, > 0, agrees with [`Bxdf::pdf`].
+    /// Density of `wi` per unit solid angle; finite, > 0, agrees with [`Bxdf::pdf`] (for a `SPECULAR`
+    /// sample: the discrete probability of the lobe).
     pub pdf: f32,
     /// The lobe the sample came from.
     pub flags: LobeFlags,
@@ -127,6 +138,16 @@ fn weight_of(f: Vec3, wi: Vec3, pdf: f32) -> Vec3 {
 ///
 /// `eval` returns f (RGB, no cosine); `pdf` is per unit solid angle of `wi`. Below-horizon, degenerate
 /// or non-finite directions give 0 and pdf 0, and `sample` returns `None` instead of a zero-weight sample.
+///
+/// # Delta lobes
+/// A lobe that reflects into a single direction ([`SpecularReflection`]) has no value or density
+/// per unit solid angle. Its `eval` and `pdf` are 0 for every pair of directions; its `sample`
+/// returns that direction with [`LobeFlags::SPECULAR`] set, `pdf` = the discrete probability of
+/// choosing the lobe (1 for a lone lobe) and `f` = F / cos θi, so that [`BxdfSample::weight`] is
+/// the reflectance F. For such a sample, and only for it, `f` and `pdf` are not those of `eval` and
+/// `pdf` at its `wi`. A path tracer with MIS handles it as pbrt-v4 does: it multiplies the
+/// throughput by `weight()`, gives the sample an MIS weight of 1, and does no next-event estimation
+/// at the vertex (a light sample would find `eval` = 0 there anyway).
 pub trait Bxdf {
     /// f(wo, wi), without the cosine factor.
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3;
@@ -136,7 +157,8 @@ pub trait Bxdf {
 
     /// Draws `wi` given `wo`, using `uc` for the lobe choice and `u` for the direction.
     /// `Some` guarantees a finite positive pdf that agrees with [`Bxdf::pdf`] and an `f` that agrees
-    /// with [`Bxdf::eval`].
+    /// with [`Bxdf::eval`], except for a [`LobeFlags::SPECULAR`] sample (the delta-lobe convention
+    /// above).
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BxdfSample>;
 
     /// Both [`Bxdf::eval`] and [`Bxdf::pdf`], sharing work where a model can.

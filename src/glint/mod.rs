@@ -108,7 +108,7 @@ pub use surface::{
 pub use truth::{
     BinMasses, BinnedPndf, DEFAULT_MAX_QUADRATURE, DEFAULT_QUADRATURE_TOLERANCE, FootprintBrdf,
     HemisphereBins, JITTERS, Kernel, REFERENCE_BATCHES, adaptive_bin_masses, bin_masses,
-    binned_pndf, convolved_pndf, footprint_brdf, naive_brdf, tv_distance,
+    binned_pndf, convolved_pndf, footprint_brdf, for_each_footprint_slope, naive_brdf, tv_distance,
 };
 
 use crate::ndf::Ndf;

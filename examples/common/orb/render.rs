@@ -7,15 +7,17 @@ use super::OrbOptions;
 use super::scene::{Scene, ShadingPoint};
 use crate::common::Res;
 use crate::common::material::{Configured, beckmann_alpha};
-use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf};
-use brdf::fresnel::Fresnel;
+use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf, NormalMapTilt, ShadingNormal};
+use brdf::frame::slope_to_normal;
+use brdf::fresnel::{ConductorFresnel, Fresnel};
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
     BeckmannMixture, BinMap, Footprint, GlintModel, GlintNdf, Kernel, MixturePatch, NormalMap,
-    PositionNormalMap, footprint_brdf,
+    PositionNormalMap, footprint_brdf, for_each_footprint_slope,
 };
+use brdf::ndf::Beckmann;
 use glam::{Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -126,9 +128,14 @@ pub fn glint_pixel<G: GlintNdf>(scene: &Scene, model: &G, x: u32, y: u32, q: u32
     sum / (q * q) as f32
 }
 
-/// Both footprint references of one pixel from `samples` positions of its Gaussian footprint k_P
-/// ([`footprint_brdf`]), as radiances: (exact P-BRDF (a), normal-mapped (b)). The pixel-centre
-/// frame, wo, wi and linear uv are used for every position, as the glint models use them.
+/// Both footprint references of one pixel from `samples` positions of its Gaussian footprint k_P,
+/// as radiances: (exact P-BRDF (a), normal-mapped (b)). The pixel-centre frame, wo, wi and linear
+/// uv are used for every position, as the glint models use them.
+///
+/// (a) is [`footprint_brdf`]'s P-BRDF times Fresnel at the shared half vector. (b) is
+/// conventional normal mapping through the public [`NormalMapTilt`] adapter, averaged over the
+/// same positions ([`for_each_footprint_slope`], same seed): at each position the facet lobe of
+/// [`conventional_brdf`], with the scene's Fresnel, evaluated in the renderer's measure.
 pub fn reference_pixel(
     scene: &Scene,
     map: &NormalMap,
@@ -137,9 +144,10 @@ pub fn reference_pixel(
     samples: usize,
     seed: u64,
 ) -> (Vec3, Vec3) {
+    let fp = sp.footprint();
     let r = footprint_brdf(
         map,
-        &sp.footprint(),
+        &fp,
         Kernel::Gaussian,
         sp.wo,
         sp.wi,
@@ -150,13 +158,47 @@ pub fn reference_pixel(
     let Some(h) = (sp.wo + sp.wi).try_normalize() else {
         return (Vec3::ZERO, Vec3::ZERO);
     };
-    // eval × the geometric cos θi × I / r², times Fresnel at the (shared) half vector.
-    let scale = scene.fresnel.eval(sp.wo.dot(h)) * (sp.wi.z.max(0.0) * sp.irradiance);
+    let (mut sum, mut n) = (Vec3::ZERO, 0u32);
+    for_each_footprint_slope(map, &fp, Kernel::Gaussian, samples, seed, |slope| {
+        if let Some(brdf) = conventional_brdf(slope, sigma_eps, scene.fresnel) {
+            sum += brdf.eval(sp.wo, sp.wi);
+        }
+        n += 1;
+    });
+    // eval × the geometric cos θi × I / r².
+    let light = sp.wi.z.max(0.0) * sp.irradiance;
+    let fresnel_a = scene.fresnel.eval(sp.wo.dot(h));
     let finite = |v: Vec3| if v.is_finite() { v } else { Vec3::ZERO };
     (
-        finite(scale * r.pbrdf() as f32),
-        finite(scale * r.normal_mapped() as f32),
+        finite(fresnel_a * (r.pbrdf() as f32 * light)),
+        finite(sum / n.max(1) as f32 * light),
     )
+}
+
+/// Conventional normal mapping at one position of slope `slope`: a near-specular Beckmann lobe
+/// (separable masking, Fresnel `fresnel`) in the frame of the interpolated normal n, through
+/// [`NormalMapTilt`]; `None` where the slope gives no usable shading normal.
+///
+/// The lobe is the position's facet lobe of [`brdf::glint::FootprintBrdf`] (slope covariance
+/// σ_ε² I in the geometric frame, \[Chermain2019\] §5.2.2) carried into the shading frame: the
+/// Jacobian of the map from geometric slopes to shading-frame slopes at n is diag(n_z², n_z) along
+/// and across the lean, so the lobe is Beckmann with α_x = √2 σ_ε n_z² along the lean (the
+/// tangent) and α_y = √2 σ_ε n_z (D then also matches: D_u(n) = D_shading(n)/n_z). To first order in
+/// σ_ε the tilt adapter's value f_inner ⟨wi, n⟩ / cos θi is then the slope lobe's
+/// D G1 G1 A(wi) / (4 V(wo) V(wi) cos θi).
+pub fn conventional_brdf(
+    slope: Vec2,
+    sigma_eps: f32,
+    fresnel: ConductorFresnel,
+) -> Option<NormalMapTilt<MicrofacetBrdf<Beckmann, ConductorFresnel>>> {
+    let n = slope_to_normal(slope);
+    let lean = Vec3::new(n.x, n.y, 0.0);
+    let tangent = lean.try_normalize();
+    let shading = ShadingNormal::new(n, tangent).ok()?;
+    let a = std::f32::consts::SQRT_2 * sigma_eps;
+    let ndf = Beckmann::new(a * n.z * n.z, a * n.z).ok()?;
+    let inner = MicrofacetBrdf::new(ndf, fresnel).with_masking(Masking::Separable);
+    Some(NormalMapTilt::new(inner, shading))
 }
 
 /// The two references, each as two independent halves (their mean is the reference, their

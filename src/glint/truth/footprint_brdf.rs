@@ -213,6 +213,28 @@ pub fn footprint_brdf(
     if acc.wh.is_none() {
         return acc;
     }
+    for_each_footprint_slope(map, footprint, kernel, samples, seed, |slope| {
+        acc.add(slope)
+    });
+    acc
+}
+
+/// Calls `visit` with the slope at each of the positions [`footprint_brdf`] uses for the same
+/// `footprint`, `kernel`, `samples` and `seed`, in the same order: an m × m jittered
+/// stratification of the unit square (m = max(1, ⌊√samples⌋)) mapped by the kernel, the slope at
+/// each position being [`NormalMap::slope_at_texel`]. For evaluating another per-position BRDF
+/// (a normal-mapped one, say) at exactly the positions of the references.
+///
+/// # Reference
+/// \[Chermain2019\] §5.2.2 (naive sampling of the footprint).
+pub fn for_each_footprint_slope(
+    map: &NormalMap,
+    footprint: &Footprint,
+    kernel: Kernel,
+    samples: usize,
+    seed: u64,
+    mut visit: impl FnMut(Vec2),
+) {
     let m = (samples as f64).sqrt().floor().max(1.0) as usize;
     let position = kernel_position(map, footprint, kernel);
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
@@ -220,10 +242,9 @@ pub fn footprint_brdf(
         for col in 0..m {
             let s = (col as f64 + rng.random::<f64>()) / m as f64;
             let t = (row as f64 + rng.random::<f64>()) / m as f64;
-            acc.add(map.slope_at_texel(position(s, t)));
+            visit(map.slope_at_texel(position(s, t)));
         }
     }
-    acc
 }
 
 /// The BRDF of the interpolated normal map at one position, with a near-specular lobe around the

@@ -22,4 +22,4 @@ pub use convolved::{
     BinMasses, DEFAULT_MAX_QUADRATURE, DEFAULT_QUADRATURE_TOLERANCE, JITTERS, adaptive_bin_masses,
     bin_masses, convolved_pndf,
 };
-pub use footprint_brdf::{FootprintBrdf, footprint_brdf, naive_brdf};
+pub use footprint_brdf::{FootprintBrdf, footprint_brdf, for_each_footprint_slope, naive_brdf};
