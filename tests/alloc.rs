@@ -106,8 +106,8 @@ fn shading_allocates_nothing_after_warm_up() {
 }
 
 /// A renderer's path through `Material`: three live BSDFs of one scratch at once (a path's
-/// vertices), every kind of material (analytic, layered, each registered glint model alone and
-/// over a base), evaluated and sampled while the others are alive; nothing allocates once the
+/// vertices), every kind of material (analytic, layered, mirror, normal-mapped, each registered
+/// glint model alone and over a base), evaluated and sampled while the others are alive; nothing allocates once the
 /// scratch has grown to the largest footprint and the most live patches.
 #[test]
 fn materials_with_several_live_bsdfs_allocate_nothing() {
@@ -126,6 +126,13 @@ fn materials_with_several_live_bsdfs_allocate_nothing() {
             Vec3::new(0.8, 0.1, 0.1),
         )
         .unwrap(),
+        Material::mirror(ConductorFresnel::SILVER),
+        brdf::material::NormalMappedMaterial::new(
+            Arc::new(map.clone()),
+            Material::microfacet(Ggx::isotropic(0.2).unwrap(), ConductorFresnel::COPPER),
+        )
+        .unwrap()
+        .into(),
     ];
     for ex in support::registry::examples(&map) {
         let glint = GlintMaterial::new(Arc::new(ex.model), ConductorFresnel::SILVER)

@@ -62,8 +62,8 @@ pub fn binmap_sigma(map: &BinMap, options: &BinMapOptions) -> f32 {
 /// map's smoothing lobes).
 pub fn model_sigma(model: &GlintModel, options: &GlintOptions) -> f32 {
     let fp = Footprint::isotropic_texels(Vec2::splat(0.5), 4.0, 64, 64);
-    let mut scratch = GlintScratch::default();
-    match model.patch_with(&fp, options, Some(&mut scratch)) {
+    let scratch = GlintScratch::default();
+    match model.patch_with(&fp, options, Some(&scratch)) {
         GlintPatch::Mixture(_) => match model {
             GlintModel::Mixture(m) => m.params().sigma_min,
             _ => f32::NAN,

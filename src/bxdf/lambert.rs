@@ -42,6 +42,9 @@ pub struct Lambert {
 }
 
 impl Lambert {
+    /// The black BRDF (ρ = 0): a total stand-in where a valid material cannot be formed.
+    pub(crate) const BLACK: Lambert = Lambert { albedo: Vec3::ZERO };
+
     /// A Lambertian BRDF with RGB albedo ρ; every channel must be finite and in [0, 1]
     /// (`Error::InvalidParameter` naming `albedo` otherwise).
     pub fn new(albedo: Vec3) -> Result<Lambert> {

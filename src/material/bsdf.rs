@@ -3,14 +3,16 @@
 
 use super::{AnalyticNdf, AnyFresnel};
 use crate::bxdf::{
-    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, LayeredBrdf, MicrofacetBrdf, OriginalPhong, Phong,
+    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet,
+    NormalMapTilt, OriginalPhong, Phong, SpecularReflection,
 };
 use crate::glint::GlintPatch;
 use glam::{Vec2, Vec3};
 
 /// A material's BRDF at one shading point ([`Material::bsdf`](super::Material::bsdf)): evaluate,
 /// sample and take densities through [`Bxdf`], in the local shading frame (z = normal, x along
-/// ∂p/∂u, y along ∂p/∂v; crate-root conventions).
+/// ∂p/∂u, y along ∂p/∂v; crate-root conventions). Delta lobes (a mirror) follow the crate's delta
+/// convention: `eval` and `pdf` 0, samples flagged `SPECULAR` ([`Bxdf`]).
 ///
 /// It borrows the material and, for glint materials, buffers from the caller's
 /// [`GlintScratch`](crate::glint::GlintScratch), which it gives back when it drops; any number of
@@ -22,6 +24,16 @@ pub struct Bsdf<'a>(pub(super) Inner<'a>);
 /// The BRDF behind a [`Bsdf`].
 #[derive(Debug)]
 pub(super) enum Inner<'a> {
+    Plain(Plain<'a>),
+    Glint(MicrofacetBrdf<GlintPatch<'a>, AnyFresnel>),
+    GlintCoat(LayeredBrdf<GlintPatch<'a>, AnyFresnel>),
+    Tilt(NormalMapTilt<Plain<'a>>),
+    NormalMicrofacet(NormalMapMicrofacet<Plain<'a>>),
+}
+
+/// The BRDFs that do not depend on the footprint: what a normal-mapped material can wrap.
+#[derive(Debug)]
+pub(super) enum Plain<'a> {
     Lambert(&'a Lambert),
     Phong(&'a Phong),
     OriginalPhong(&'a OriginalPhong),
@@ -30,24 +42,54 @@ pub(super) enum Inner<'a> {
     /// A copy per shading point: the layered BRDF caches R̂(wo), which must not be shared between
     /// threads shading other points.
     Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
-    Glint(MicrofacetBrdf<GlintPatch<'a>, AnyFresnel>),
-    GlintCoat(LayeredBrdf<GlintPatch<'a>, AnyFresnel>),
+    Mirror(&'a SpecularReflection<AnyFresnel>),
 }
 
-/// Forwards one `Bxdf` method to the BRDF behind the `Bsdf`.
+/// Forwards one `Bxdf` method to the BRDF behind a [`Plain`].
+macro_rules! forward_plain {
+    ($self_:expr, $b:ident => $e:expr) => {
+        match $self_ {
+            Plain::Lambert($b) => $e,
+            Plain::Phong($b) => $e,
+            Plain::OriginalPhong($b) => $e,
+            Plain::BlinnPhong($b) => $e,
+            Plain::Microfacet($b) => $e,
+            Plain::Layered($b) => $e,
+            Plain::Mirror($b) => $e,
+        }
+    };
+}
+
+/// Forwards one `Bxdf` method to the BRDF behind a [`Bsdf`].
 macro_rules! forward {
     ($self_:ident, $b:ident => $e:expr) => {
         match &$self_.0 {
-            Inner::Lambert($b) => $e,
-            Inner::Phong($b) => $e,
-            Inner::OriginalPhong($b) => $e,
-            Inner::BlinnPhong($b) => $e,
-            Inner::Microfacet($b) => $e,
-            Inner::Layered($b) => $e,
+            Inner::Plain($b) => $e,
             Inner::Glint($b) => $e,
             Inner::GlintCoat($b) => $e,
+            Inner::Tilt($b) => $e,
+            Inner::NormalMicrofacet($b) => $e,
         }
     };
+}
+
+impl Bxdf for Plain<'_> {
+    #[inline]
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        forward_plain!(self, b => b.eval(wo, wi))
+    }
+    #[inline]
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        forward_plain!(self, b => b.pdf(wo, wi))
+    }
+    #[inline]
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BxdfSample> {
+        forward_plain!(self, b => b.sample(wo, uc, u))
+    }
+    #[inline]
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        forward_plain!(self, b => b.eval_pdf(wo, wi))
+    }
 }
 
 impl Bxdf for Bsdf<'_> {

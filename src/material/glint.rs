@@ -56,16 +56,7 @@ impl GlintMaterial {
     /// # Errors
     /// [`Error::InvalidParameter`] naming `uv_scale` unless both components are finite and > 0.
     pub fn with_uv_scale(mut self, scale: Vec2) -> Result<GlintMaterial> {
-        for s in [scale.x, scale.y] {
-            if !(s.is_finite() && s > 0.0) {
-                return Err(Error::InvalidParameter {
-                    name: "uv_scale",
-                    value: s as f64,
-                    reason: "must be finite and > 0",
-                });
-            }
-        }
-        self.uv_scale = scale;
+        self.uv_scale = checked_uv_scale(scale)?;
         Ok(self)
     }
 
@@ -113,4 +104,19 @@ impl GlintMaterial {
             footprint.duv_dy() * s,
         )
     }
+}
+
+/// `scale` if both components are finite and > 0; [`Error::InvalidParameter`] naming `uv_scale`
+/// otherwise.
+pub(super) fn checked_uv_scale(scale: Vec2) -> Result<Vec2> {
+    for s in [scale.x, scale.y] {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "uv_scale",
+                value: s as f64,
+                reason: "must be finite and > 0",
+            });
+        }
+    }
+    Ok(scale)
 }

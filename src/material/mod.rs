@@ -32,6 +32,13 @@
 //! # Ok::<(), brdf::Error>(())
 //! ```
 //!
+//! The variants: the analytic BRDFs ([`Material::Lambert`], the Phong family,
+//! [`Material::Microfacet`] over GGX or Beckmann, [`Material::Layered`]), the smooth limit
+//! ([`Material::Mirror`], a delta lobe), glints ([`GlintMaterial`]: any glint model, alone or as a
+//! coat over a Lambertian base) and normal mapping ([`NormalMappedMaterial`]: any
+//! footprint-independent material about a normal map's normals, through microfacet-based or
+//! conventional normal mapping).
+//!
 //! ## Design
 //! [`Material`] is a closed enum dispatched by `match`, not a trait object: its BSDF at a shading
 //! point ([`Bsdf`]) lives on the caller's stack, borrows the material and (for glints) buffers
@@ -49,16 +56,21 @@ mod analytic;
 mod bsdf;
 mod fresnel;
 mod glint;
+mod normal_mapped;
 
 pub use analytic::AnalyticNdf;
 pub use bsdf::Bsdf;
 pub use fresnel::AnyFresnel;
 pub use glint::GlintMaterial;
+pub use normal_mapped::{NormalMappedMaterial, NormalMapping};
 
-use crate::bxdf::{BlinnPhongLobe, Lambert, LayeredBrdf, MicrofacetBrdf, OriginalPhong, Phong};
+use crate::bxdf::{
+    BlinnPhongLobe, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet, NormalMapTilt,
+    OriginalPhong, Phong, SpecularReflection,
+};
 use crate::error::Result;
 use crate::glint::{Footprint, GlintNdf, GlintScratch};
-use bsdf::Inner;
+use bsdf::{Inner, Plain};
 use glam::Vec3;
 
 /// Any BRDF of the crate, chosen at run time (module docs): build it with the constructors or
@@ -78,8 +90,14 @@ pub enum Material {
     Microfacet(MicrofacetBrdf<AnalyticNdf, AnyFresnel>),
     /// An analytic microfacet layer over a Lambertian base ([`LayeredBrdf`]).
     Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
+    /// A perfectly smooth reflector, the α → 0 limit of the microfacet BRDF: a delta lobe
+    /// ([`SpecularReflection`]; samples flagged `SPECULAR`, `eval` and `pdf` 0).
+    Mirror(SpecularReflection<AnyFresnel>),
     /// Glints: a glint model seen through each shading point's footprint ([`GlintMaterial`]).
     Glint(GlintMaterial),
+    /// A footprint-independent material shaded about a normal map's normals
+    /// ([`NormalMappedMaterial`]).
+    NormalMapped(NormalMappedMaterial),
 }
 
 impl Material {
@@ -102,10 +120,30 @@ impl Material {
         Ok(Material::Layered(LayeredBrdf::new(specular, base)?))
     }
 
-    /// Whether the material's BSDF depends on the footprint given to [`Material::bsdf`] (glints):
-    /// a renderer may skip computing ray differentials or cones for the others.
+    /// A perfectly smooth reflector with Fresnel term `fresnel` (a delta lobe: [`Material::Mirror`]).
+    pub fn mirror(fresnel: impl Into<AnyFresnel>) -> Material {
+        Material::Mirror(SpecularReflection::new(fresnel.into()))
+    }
+
+    /// Whether the material's BSDF depends on the footprint given to [`Material::bsdf`] (glints
+    /// use all of it, normal-mapped materials its centre): a renderer may skip computing ray
+    /// differentials or cones for the others.
     pub fn uses_footprint(&self) -> bool {
-        matches!(self, Material::Glint(_))
+        matches!(self, Material::Glint(_) | Material::NormalMapped(_))
+    }
+
+    /// The BRDF of a footprint-independent material (`None` for glint and normal-mapped ones).
+    fn plain(&self) -> Option<Plain<'_>> {
+        Some(match self {
+            Material::Lambert(b) => Plain::Lambert(b),
+            Material::Phong(b) => Plain::Phong(b),
+            Material::OriginalPhong(b) => Plain::OriginalPhong(b),
+            Material::BlinnPhong(b) => Plain::BlinnPhong(b),
+            Material::Microfacet(b) => Plain::Microfacet(b),
+            Material::Layered(b) => Plain::Layered(b.clone()),
+            Material::Mirror(b) => Plain::Mirror(b),
+            Material::Glint(_) | Material::NormalMapped(_) => return None,
+        })
     }
 
     /// The material's BRDF at a shading point whose ray footprint on the surface is `footprint`
@@ -114,12 +152,6 @@ impl Material {
     /// Total: any footprint works.
     pub fn bsdf<'a>(&'a self, footprint: &Footprint, scratch: &'a GlintScratch) -> Bsdf<'a> {
         Bsdf(match self {
-            Material::Lambert(b) => Inner::Lambert(b),
-            Material::Phong(b) => Inner::Phong(b),
-            Material::OriginalPhong(b) => Inner::OriginalPhong(b),
-            Material::BlinnPhong(b) => Inner::BlinnPhong(b),
-            Material::Microfacet(b) => Inner::Microfacet(b),
-            Material::Layered(b) => Inner::Layered(b.clone()),
             Material::Glint(g) => {
                 let fp = g.map_footprint(footprint);
                 let patch = g.model().patch_with(&fp, g.options(), Some(scratch));
@@ -130,6 +162,19 @@ impl Material {
                     Some(base) => Inner::GlintCoat(LayeredBrdf::with_valid_base(layer, base)),
                 }
             }
+            Material::NormalMapped(nm) => {
+                // The base is footprint-independent (checked by `NormalMappedMaterial::new`).
+                let base = nm.base().plain().unwrap_or(Plain::Lambert(&Lambert::BLACK));
+                match (nm.shading_normal(footprint), nm.mapping()) {
+                    (None, _) => Inner::Plain(base),
+                    (Some(n), NormalMapping::Microfacet) => {
+                        Inner::NormalMicrofacet(NormalMapMicrofacet::new(base, n))
+                    }
+                    (Some(n), NormalMapping::Tilt) => Inner::Tilt(NormalMapTilt::new(base, n)),
+                }
+            }
+            // Every other material is footprint-independent (`plain` is `Some`).
+            plain => Inner::Plain(plain.plain().unwrap_or(Plain::Lambert(&Lambert::BLACK))),
         })
     }
 }
@@ -148,6 +193,8 @@ macro_rules! material_from {
 }
 
 material_from! {
+    Mirror(SpecularReflection<AnyFresnel>),
+    NormalMapped(NormalMappedMaterial),
     Lambert(Lambert),
     Phong(Phong),
     OriginalPhong(OriginalPhong),
