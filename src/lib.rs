@@ -9,6 +9,11 @@
 //!   (toward the light, or sampled) are unit vectors pointing *away* from the surface. Reflection needs
 //!   both strictly above the horizon; otherwise values and pdfs are 0. Use [`frame::Frame`] to move
 //!   directions between world space and the local frame.
+//! - **Handedness.** At a surface hit the local x runs along ∂p/∂u and y along +∂p/∂v, the axes of a
+//!   normal map's slopes and of a [`glint::Footprint`]: build the frame with
+//!   [`frame::Frame::from_surface`]`(n, ∂p/∂u, ∂p/∂v)`, which keeps that true for left-handed
+//!   parametrisations too (a frame of determinant −1; BRDFs only see local coordinates). A frame
+//!   built as y = n × x would mirror brushed or scratched maps there.
 //! - **Slopes.** A normal ω_n = (x, y, z) has slope ñ = (−x/z, −y/z); the inverse is
 //!   normalize(−x̃, −ỹ, 1).
 //! - **NDF normalisation.** ∫ D(m) (m·ω_g) dm = 1 over the hemisphere, for every NDF.

@@ -337,7 +337,7 @@ impl Scene {
                 total += throughput * self.sky.radiance(d) * w;
                 break;
             };
-            let frame = Frame::from_normal_tangent(hit.n, hit.dpdu);
+            let frame = Frame::from_surface(hit.n, hit.dpdu, hit.dpdv);
             let wo = frame.to_local(-d);
             if wo.z <= 0.0 {
                 break;
