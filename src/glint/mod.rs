@@ -103,7 +103,6 @@ pub use surface::{
     NormalMap, NormalRepair, ScratchedParams, TangentConvention, brushed, bumpy, flakes,
     moments_mean_covariance, scratched,
 };
-#[cfg(feature = "image")]
 pub use surface::{
     DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, ImageDecoding, ImageOptions,
     MAX_IMPLAUSIBLE_FRACTION, RAW_EVIDENCE_BELOW,

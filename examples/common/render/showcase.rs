@@ -151,7 +151,7 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
         &png,
         "the hammered normal map (OpenGL convention) that the render example writes, then loads",
     ));
-    let hammered = glint_model(&NormalMap::load(
+    let hammered = glint_model(&NormalMap::from_image_file(
         &png,
         TangentConvention::OpenGl,
         NormalRepair::Reject,
