@@ -10,7 +10,7 @@
 use brdf::bxdf::{Bxdf, LayeredBrdf, MicrofacetBrdf};
 use brdf::frame::Frame;
 use brdf::fresnel::{ConductorFresnel, Fresnel};
-use brdf::glint::{Footprint, GlintModel, GlintNdf, GlintScratch};
+use brdf::glint::{Footprint, GlintModel, GlintNdf, GlintScratch, RayCone};
 use brdf::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
 use brdf::{Ggx, Lambert, Vec2, Vec3};
 use indicatif::ProgressBar;
@@ -26,10 +26,6 @@ pub mod showcase;
 const RAY_EPSILON: f32 = 1e-4;
 /// Scattering events after the camera ray (the sphere and the plane see each other once or twice).
 pub const MAX_BOUNCES: usize = 4;
-/// Footprint growth per bounce: after a diffuse or glossy bounce the rays of one pixel spread far
-/// more than the camera's differentials say; ray cones would track it, this example widens the
-/// footprint by a fixed factor per bounce (secondary glints are then smooth, as they should be).
-const SECONDARY_FOOTPRINT_GROWTH: f32 = 16.0;
 
 /// A surface material. The glint variants hold the model behind an `Arc`, shared by every material
 /// that uses the same normal map; `tiles` repeats the map over the sphere's (u, v).
@@ -194,9 +190,9 @@ impl Camera {
     }
 
     /// ∂p/∂x, ∂p/∂y at a hit (p, n): the rays through the neighbouring pixels intersected with the
-    /// tangent plane (the Footprint docs' recipe), the rays aimed at p itself. For a camera hit this
-    /// is the ray differential; for a secondary hit it is pbrt-v4's approximation
-    /// (`Camera::Approximate_dp_dxy`). Zero where an offset ray runs parallel to the plane.
+    /// tangent plane (the Footprint docs' recipe), the rays aimed at p itself: for a camera hit, the
+    /// ray differential (secondary hits use the path's `RayCone`). Zero where an offset ray runs
+    /// parallel to the plane.
     fn dp_dxy(&self, p: Vec3, n: Vec3) -> (Vec3, Vec3) {
         let to_p = p - self.eye;
         let d = to_p / to_p.dot(self.forward).max(1e-6);
@@ -330,8 +326,10 @@ impl Scene {
         let mut throughput = Vec3::ONE;
         // (normal, BRDF pdf) of the previous vertex, for the MIS weight of a sky hit; None at the camera.
         let mut previous: Option<(Vec3, f32)> = None;
-        let mut spread = footprint_scale;
-        for _ in 0..=MAX_BOUNCES {
+        // Camera hits use the camera's ray differentials; later hits the ray cone of the path,
+        // started at one pixel's angle (one sample's share of it) and carried through every bounce.
+        let mut cone = RayCone::from_camera(self.camera.pixel_step().atan() * footprint_scale);
+        for bounce in 0..=MAX_BOUNCES {
             let Some(hit) = self.intersect(o, d) else {
                 let w = previous.map_or(1.0, |(n, pdf)| power_heuristic(pdf, Self::sky_pdf(n, d)));
                 total += throughput * self.sky.radiance(d) * w;
@@ -342,7 +340,13 @@ impl Scene {
             if wo.z <= 0.0 {
                 break;
             }
-            let (dpdx, dpdy) = self.camera.dp_dxy(hit.p, hit.n);
+            cone = cone.propagate((hit.p - o).length());
+            let (dpdx, dpdy) = if bounce == 0 {
+                let (dpdx, dpdy) = self.camera.dp_dxy(hit.p, hit.n);
+                (dpdx * footprint_scale, dpdy * footprint_scale)
+            } else {
+                cone.surface_differentials(d, hit.n)
+            };
             let material = if hit.sphere {
                 &self.sphere
             } else {
@@ -355,19 +359,20 @@ impl Scene {
                 rng.random(),
                 rng.random(),
             ];
-            let (direct, next) =
-                material.with_bxdf(&hit, (dpdx * spread, dpdy * spread), scratch, |bxdf| {
-                    let direct = self.direct(&hit, &frame, wo, bxdf, Vec2::new(u[0], u[1]));
-                    let s = bxdf.sample(wo, u[2], Vec2::new(u[3], u[4]));
-                    (direct, s.map(|s| (frame.to_world(s.wi), s.weight(), s.pdf)))
-                });
+            let (direct, next) = material.with_bxdf(&hit, (dpdx, dpdy), scratch, |bxdf| {
+                let direct = self.direct(&hit, &frame, wo, bxdf, Vec2::new(u[0], u[1]));
+                let s = bxdf.sample(wo, u[2], Vec2::new(u[3], u[4]));
+                (direct, s.map(|s| (frame.to_world(s.wi), s.weight(), s.pdf)))
+            });
             total += throughput * direct;
             let Some((wi, weight, pdf)) = next else { break };
             throughput *= weight;
             o = hit.p + hit.n * RAY_EPSILON;
             d = wi;
             previous = Some((hit.n, pdf));
-            spread *= SECONDARY_FOOTPRINT_GROWTH;
+            // The sphere, seen from outside, is convex of curvature 1/radius; the ground is flat.
+            let curvature = if hit.sphere { 1.0 / self.radius } else { 0.0 };
+            cone = cone.reflect(curvature).scatter(pdf);
         }
         if total.is_finite() {
             total.max(Vec3::ZERO)

@@ -8,6 +8,8 @@
 //! - pixels.rs: decoding normal maps from 8-bit, 16-bit or float pixel slices (always available).
 //! - image_io.rs: decoding PNG / EXR normal-map files into those pixels (feature `image`).
 //! - footprint.rs: [`Footprint`], a ray footprint as a parallelogram and a Gaussian.
+//! - ray_cone.rs: [`RayCone`], footprints for secondary rays (width and spread propagated through
+//!   reflections).
 
 mod footprint;
 #[cfg(feature = "image")]
@@ -16,6 +18,7 @@ mod moments;
 mod normal_map;
 mod pixels;
 mod procedural;
+mod ray_cone;
 
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 pub(crate) use moments::{MomentLevel, MomentPyramid};
@@ -31,3 +34,4 @@ pub use procedural::{
     BrushedParams, FlakesParams, MAX_CARVE_WORK_PER_TEXEL, MAX_GENERATED_TEXELS, MIN_CELL_TEXELS,
     ScratchedParams, brushed, bumpy, flakes, scratched,
 };
+pub use ray_cone::RayCone;
