@@ -200,14 +200,14 @@ pub(crate) fn decode_values(
         FloatEncoding::Encoded
     };
     let encoding = match encoding {
-        FloatEncoding::Detect => detect(&values, tol).map_err(implausible)?,
+        FloatEncoding::Detect => detect(values, tol).map_err(implausible)?,
         e => e,
     };
     let decode = match encoding {
         FloatEncoding::Raw => raw,
         _ => encoded,
     };
-    let (off_unit_fraction, max_length_error, below_horizon) = plausibility(&values, decode, tol);
+    let (off_unit_fraction, max_length_error, below_horizon) = plausibility(values, decode, tol);
     let report = ImageDecoding {
         float_channels,
         encoding,

@@ -134,15 +134,11 @@ impl RayCone {
     /// solid angle Ω = 1/pdf, 2 acos(1 − Ω/2π), at most π (Ω ≥ 2π, or pdf ≤ 0 or non-finite, which
     /// carries no information about the lobe's width). A near-specular sample (pdf → ∞) adds 0.
     pub fn scatter_spread(pdf: f32) -> f32 {
-        if !(pdf > 0.0) || !pdf.is_finite() {
-            return if pdf == f32::INFINITY {
-                0.0
-            } else {
-                MAX_SPREAD
-            };
+        if pdf == f32::INFINITY {
+            return 0.0;
         }
         let omega = 1.0 / pdf;
-        if omega >= 2.0 * PI {
+        if !pdf.is_finite() || pdf <= 0.0 || omega >= 2.0 * PI {
             return MAX_SPREAD;
         }
         2.0 * (1.0 - omega / (2.0 * PI)).acos()
