@@ -11,13 +11,13 @@ use libfuzzer_sys::fuzz_target;
 fuzz_target!(|data: &[u8]| {
     let input = StoreInput::parse(data);
     let bytes = input.bytes();
-    if let Ok(map) = PositionNormalMap::from_image_file(&mut bytes.as_slice()) {
+    if let Ok(map) = PositionNormalMap::load(&mut bytes.as_slice()) {
         // A file that loads is re-saved byte for byte, or upgraded to the current version.
         check_resave(
             &bytes,
             &map,
             |m, w| m.save(w),
-            |f| PositionNormalMap::from_image_file(&mut &f[..]),
+            |f| PositionNormalMap::load(&mut &f[..]),
         );
         let patch = map.patch(&input.footprint.build());
         check_ndf(&patch, &input.probe);
