@@ -67,6 +67,10 @@ pub const MAX_EXTENT_PERIODS: f32 = 2.0;
 /// 3. if the material scales uv (a map repeated k times: uv' = k uv), scale uv and both differentials
 ///    by k, or call [`Footprint::from_differentials`] with the scaled ∂uv directly.
 ///
+/// Secondary rays (after a diffuse or glossy bounce) have no ray differentials: carry a
+/// [`RayCone`](crate::glint::RayCone) along the path instead and read the footprint from it at each
+/// hit ([`RayCone::footprint`](crate::glint::RayCone::footprint)), which ends in step 2 too.
+///
 /// The shading frame of the same hit is [`Frame::from_surface`](crate::frame::Frame::from_surface)`(n,
 /// ∂p/∂u, ∂p/∂v)`.
 ///
