@@ -229,7 +229,7 @@ fn main() {
                 loads,
                 || NormalMap::from_slopes(n, n, map.slopes().to_vec()).unwrap(),
                 |m, f| m.save(f).unwrap(),
-                |f| NormalMap::load_binary(&mut &f[..]).unwrap(),
+                |f| NormalMap::load(&mut &f[..]).unwrap(),
                 |m| m.slopes().len() * 8,
             )
         }),

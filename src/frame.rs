@@ -1,7 +1,8 @@
 //! Shading-frame one-liners.
 //!
 //! Every direction is expressed in the local shading frame: z is the geometric normal ω_g = (0, 0, 1),
-//! x is the tangent along which `alpha_x` acts. Directions point *away* from the surface and are unit
+//! x is the tangent along which `alpha_x` acts (a surface's ∂p/∂u; y runs along +∂p/∂v, see
+//! [`Frame`]). Directions point *away* from the surface and are unit
 //! length unless a function says otherwise. Functions here are total: they never panic, and the ones that
 //! can meet a degenerate configuration return an `Option` or a documented 0.
 
@@ -139,8 +140,21 @@ pub fn slope_to_normal(s: Vec2) -> Vec3 {
         .unwrap_or(Vec3::Z)
 }
 
-/// A right-handed orthonormal frame (tangent, bitangent, normal) for moving directions between world
-/// space and the local shading frame.
+/// An orthonormal frame (tangent, bitangent, normal) for moving directions between world space and
+/// the local shading frame.
+///
+/// # Handedness
+/// The local x and y axes are the u and v axes of whatever the BRDF is defined over (a normal map's
+/// texels, an anisotropic roughness): a texel's slope (x̃, ỹ) is along (x, y). Build the frame of a
+/// surface hit with [`Frame::from_surface`]`(n, ∂p/∂u, ∂p/∂v)`: x runs along ∂p/∂u and y along +∂p/∂v
+/// whatever the handedness of the parametrisation, so a left-handed (u, v) — a mirrored mesh, a uv
+/// set flipped in u — gives a frame of determinant −1 ([`Frame::handedness`] = −1) rather than a map
+/// mirrored across its u axis. Every BRDF works on local coordinates, which an orthonormal frame of
+/// either handedness preserves (dot products and lengths), so nothing else changes.
+/// [`Frame::from_normal_tangent`] always builds y = n × x (determinant +1): it agrees with
+/// `from_surface` only for right-handed parametrisations ((∂p/∂u × ∂p/∂v)·n > 0), and on a
+/// left-handed one it silently mirrors v, which is invisible on isotropic maps and wrong on brushed
+/// or scratched ones.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
     /// Local x axis (tangent) in world space.
@@ -160,7 +174,11 @@ impl Frame {
     }
 
     /// A frame around the unit normal `n` whose x axis is `tangent` made orthogonal to `n`
-    /// (Gram-Schmidt). Falls back to [`Frame::from_normal`] when the tangent is parallel to `n`.
+    /// (Gram-Schmidt) and whose y axis is n × x (determinant +1). Falls back to
+    /// [`Frame::from_normal`] when the tangent is parallel to `n`.
+    ///
+    /// For a surface hit prefer [`Frame::from_surface`]: with a left-handed parametrisation this
+    /// frame's y runs along −∂p/∂v and mirrors anisotropic maps (see the type's docs).
     pub fn from_normal_tangent(n: Vec3, tangent: Vec3) -> Frame {
         match (tangent - n * n.dot(tangent)).try_normalize() {
             Some(x) => Frame {
@@ -169,6 +187,62 @@ impl Frame {
                 z: n,
             },
             None => Frame::from_normal(n),
+        }
+    }
+
+    /// The shading frame of a surface hit from its normal `n` and the parametrisation's ∂p/∂u,
+    /// ∂p/∂v: z = n, x = ∂p/∂u made orthogonal to n (Gram-Schmidt), y = ±(n × x) with the sign
+    /// that makes y·∂p/∂v ≥ 0. The map's u and v axes are then the local x and y for either
+    /// handedness of (u, v); a left-handed parametrisation gives [`Frame::handedness`] = −1 (see the
+    /// type's docs). `n` need not be unit length: it is normalised.
+    ///
+    /// Degenerate input is handled totally, from the best information left:
+    /// - ∂p/∂u zero, non-finite or parallel to n: y = ∂p/∂v made orthogonal to n, x = y × n
+    ///   (determinant +1: with one tangent direction known, the handedness is not);
+    /// - both tangents unusable: [`Frame::from_normal`] (an arbitrary tangent);
+    /// - `n` zero or non-finite: n = ∂p/∂u × ∂p/∂v normalised, and if that fails too the world
+    ///   axes (x, y, z). The result is always orthonormal and finite.
+    pub fn from_surface(n: Vec3, dpdu: Vec3, dpdv: Vec3) -> Frame {
+        let finite = |v: Vec3| Some(v).filter(|v| v.is_finite());
+        let Some(n) = finite(n)
+            .and_then(normalize_robust)
+            .or_else(|| finite(dpdu.cross(dpdv)).and_then(normalize_robust))
+        else {
+            return Frame {
+                x: Vec3::X,
+                y: Vec3::Y,
+                z: Vec3::Z,
+            };
+        };
+        let tangent = |t: Vec3| finite(t).and_then(|t| normalize_robust(t - n * n.dot(t)));
+        match (tangent(dpdu), tangent(dpdv)) {
+            (Some(x), v) => {
+                let y = n.cross(x);
+                // Flip y only on evidence: a usable ∂p/∂v on the other side of n × x.
+                let left = v.is_some_and(|v| v.dot(y) < 0.0);
+                Frame {
+                    x,
+                    y: if left { -y } else { y },
+                    z: n,
+                }
+            }
+            (None, Some(y)) => Frame {
+                x: y.cross(n),
+                y,
+                z: n,
+            },
+            (None, None) => Frame::from_normal(n),
+        }
+    }
+
+    /// The frame's handedness: +1 if (x × y)·z ≥ 0 (right-handed), −1 otherwise (a left-handed
+    /// parametrisation given to [`Frame::from_surface`]).
+    #[inline]
+    pub fn handedness(&self) -> f32 {
+        if self.x.cross(self.y).dot(self.z) >= 0.0 {
+            1.0
+        } else {
+            -1.0
         }
     }
 
@@ -235,5 +309,61 @@ mod tests {
         }
         let f = Frame::from_normal_tangent(Vec3::Z, Vec3::new(1.0, 0.0, 0.5));
         assert!((f.x - Vec3::X).length() < 1e-6);
+    }
+
+    fn assert_orthonormal(f: &Frame) {
+        for (a, b) in [(f.x, f.y), (f.y, f.z), (f.z, f.x)] {
+            assert!(a.dot(b).abs() < 1e-5, "{f:?}");
+        }
+        for v in [f.x, f.y, f.z] {
+            assert!((v.length() - 1.0).abs() < 1e-5, "{f:?}");
+        }
+    }
+
+    #[test]
+    fn from_surface_follows_u_and_v_for_both_handednesses() {
+        let n = Vec3::new(0.1, 0.2, 1.0).normalize();
+        let (dpdu, dpdv) = (Vec3::new(2.0, 0.1, 0.0), Vec3::new(0.3, 1.5, -0.2));
+        for (su, sv) in [(1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)] {
+            let (pu, pv) = (dpdu * su, dpdv * sv);
+            let f = Frame::from_surface(n, pu, pv);
+            assert_orthonormal(&f);
+            assert!(f.x.dot(pu) > 0.0 && f.y.dot(pv) > 0.0, "{su} {sv}: {f:?}");
+            assert!((f.z - n).length() < 1e-6);
+            let right = pu.cross(pv).dot(n) > 0.0;
+            assert_eq!(f.handedness(), if right { 1.0 } else { -1.0 });
+            // Right-handed parametrisations: the same frame as from_normal_tangent.
+            let g = Frame::from_normal_tangent(n, pu);
+            assert_eq!(right, (g.y - f.y).length() < 1e-6, "{su} {sv}");
+            let w = Vec3::new(0.3, -0.5, 0.6).normalize();
+            assert!((f.to_world(f.to_local(w)) - w).length() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn from_surface_is_total() {
+        let nan = Vec3::splat(f32::NAN);
+        let cases = [
+            (Vec3::Z, Vec3::ZERO, Vec3::Y),
+            (Vec3::Z, Vec3::Z * 3.0, -Vec3::Y),
+            (Vec3::Z, nan, Vec3::Y),
+            (Vec3::Z, Vec3::ZERO, Vec3::ZERO),
+            (Vec3::ZERO, Vec3::X, Vec3::Y),
+            (nan, Vec3::X, -Vec3::Y),
+            (nan, nan, nan),
+            (Vec3::Z * 1e-30, Vec3::X * 1e30, Vec3::Y),
+        ];
+        for (n, pu, pv) in cases {
+            let f = Frame::from_surface(n, pu, pv);
+            assert_orthonormal(&f);
+        }
+        // ∂p/∂u unusable: y follows ∂p/∂v.
+        let f = Frame::from_surface(Vec3::Z, Vec3::ZERO, -Vec3::Y);
+        assert!((f.y + Vec3::Y).length() < 1e-6);
+        // No normal: the parametrisation's.
+        let f = Frame::from_surface(nan, Vec3::X, -Vec3::Y);
+        assert!((f.z + Vec3::Z).length() < 1e-6);
+        assert!((f.y + Vec3::Y).length() < 1e-6);
+        assert_eq!(f.handedness(), 1.0);
     }
 }

@@ -1,6 +1,68 @@
 //! # brdf
 //!
-//! BRDF math and glint normal distribution functions for renderers.
+//! BRDF math and glint normal distribution functions for renderers: Fresnel, analytic NDFs, classic
+//! and microfacet BRDFs, and glints (the sparkle of scratched, brushed and flaky metal) from a
+//! high-definition normal map through one of three glint models.
+//!
+//! ## Quick start
+//!
+//! ```
+//! use brdf::ndf::Ndf;
+//! use brdf::{Vec2, Vec3};
+//!
+//! # fn main() -> Result<(), brdf::Error> {
+//! // Directions live in the local shading frame: z is the surface normal, vectors point away from it.
+//! let wo = Vec3::new(0.6, 0.0, 0.8);
+//! let ndf = brdf::ndf::Ggx::new(0.3, 0.1)?; // anisotropic GGX, α_x = 0.3, α_y = 0.1
+//! let m = ndf.sample_visible(wo, Vec2::new(0.25, 0.75));
+//! let density = ndf.pdf_visible(wo, m);
+//! assert!(density > 0.0 && density.is_finite());
+//! // Bad input is rejected at construction, with the parameter named:
+//! assert!(brdf::ndf::Ggx::isotropic(f32::NAN).is_err());
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! ## Glints in a renderer
+//!
+//! A glint material is a normal map made into a glint model once; then, at every shading point, a
+//! footprint (from the hit's uv, ∂p/∂u, ∂p/∂v and ray differentials ∂p/∂x, ∂p/∂y, or a
+//! [`glint::RayCone`] for secondary rays) and a BRDF that the renderer integrates as it integrates any
+//! BRDF, with the geometric cosine:
+//!
+//! ```
+//! use brdf::bxdf::{Bxdf, MicrofacetBrdf};
+//! use brdf::frame::Frame;
+//! use brdf::fresnel::ConductorFresnel;
+//! use brdf::glint::{BeckmannMixture, Footprint, GlintModel, GlintNdf, GlintScratch};
+//! use brdf::glint::mixture::MixtureParams;
+//! use brdf::{Vec2, Vec3};
+//!
+//! # fn main() -> Result<(), brdf::Error> {
+//! # let (n, uv, dpdu, dpdv) = (Vec3::Z, Vec2::new(0.3, 0.6), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 6.0, 0.0));
+//! # let (dpdx, dpdy) = (Vec3::new(0.2, 0.0, 0.0), Vec3::new(0.0, 0.2, 0.0));
+//! # let (to_eye, to_light) = (Vec3::new(0.3, 0.1, 0.95).normalize(), Vec3::new(-0.3, -0.1, 0.95).normalize());
+//! # let light = Vec3::splat(10.0);
+//! // Once per material: a normal map (`NormalMap::from_image_file` reads a PNG) made into a glint model.
+//! let map = brdf::glint::scratched(64, 64, Default::default(), 1)?;
+//! let model = GlintModel::from(BeckmannMixture::build(&map, MixtureParams::default())?);
+//! let mut scratch = GlintScratch::default(); // one per render thread
+//! // Per shading point: n, uv, ∂p/∂u, ∂p/∂v and the ray differentials ∂p/∂x, ∂p/∂y (world space).
+//! let footprint = Footprint::from_surface_differentials(uv, dpdu, dpdv, dpdx, dpdy);
+//! let brdf = MicrofacetBrdf::new(model.patch_in(&footprint, &mut scratch), ConductorFresnel::GOLD);
+//! // Then as any BRDF, in the local frame (x along ∂p/∂u, y along +∂p/∂v), cos θi = wi.z:
+//! let frame = Frame::from_surface(n, dpdu, dpdv);
+//! let (wo, wi) = (frame.to_local(to_eye), frame.to_local(to_light));
+//! let direct = brdf.eval(wo, wi) * wi.z * light;
+//! let bounce = brdf.sample(wo, 0.5, Vec2::new(0.3, 0.7)).map(|s| (frame.to_world(s.wi), s.weight()));
+//! # assert!(direct.is_finite() && direct.min_element() >= 0.0);
+//! # assert!(bounce.is_none_or(|(_, w)| w.is_finite()));
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! The `render` example is a small path tracer built this way (`cargo run --release --example
+//! render`).
 //!
 //! ## Conventions
 //!
@@ -9,6 +71,11 @@
 //!   (toward the light, or sampled) are unit vectors pointing *away* from the surface. Reflection needs
 //!   both strictly above the horizon; otherwise values and pdfs are 0. Use [`frame::Frame`] to move
 //!   directions between world space and the local frame.
+//! - **Handedness.** At a surface hit the local x runs along ∂p/∂u and y along +∂p/∂v, the axes of a
+//!   normal map's slopes and of a [`glint::Footprint`]: build the frame with
+//!   [`frame::Frame::from_surface`]`(n, ∂p/∂u, ∂p/∂v)`, which keeps that true for left-handed
+//!   parametrisations too (a frame of determinant −1; BRDFs only see local coordinates). A frame
+//!   built as y = n × x would mirror brushed or scratched maps there.
 //! - **Slopes.** A normal ω_n = (x, y, z) has slope ñ = (−x/z, −y/z); the inverse is
 //!   normalize(−x̃, −ỹ, 1).
 //! - **NDF normalisation.** ∫ D(m) (m·ω_g) dm = 1 over the hemisphere, for every NDF.
@@ -28,6 +95,29 @@
 //! - **Precision.** Public API in `f32`; builders and reference integrators accumulate in `f64`.
 //! - **Errors.** Constructors validate and return [`Result`]; evaluation never fails, never panics and
 //!   never returns NaN or infinity.
+//! - **Files.** `save(writer)` / `load(reader)` is the crate's binary format, on every glint model,
+//!   on [`glint::GlintModel`] (which loads whichever model a file holds) and on
+//!   [`glint::NormalMap`]; images decode with `NormalMap::from_image_file` / `from_image_bytes`
+//!   (feature `image`) or, always, from pixel slices with [`glint::NormalMap::from_pixels_u8`] and
+//!   its `u16` / `f32` forms.
+//!
+//! ## Which model when
+//!
+//! Provisional: the figures are those of docs/results.md, "Accuracy against speed" (four procedural
+//! maps at 1024², footprints of 0.25-256 texels, mean total-variation distance to the ground-truth
+//! P-NDF convolved by the material's σ_ε = 0.01; one thread, one run on a loaded machine, so times
+//! are inflated), "Memory per model" (bytes per texel at 2048²) and the sections named in the
+//! table; the like-for-like sweep of every
+//! model at matched settings is not in yet.
+//!
+//! | need | use | figures |
+//! |---|---|---|
+//! | no map: smooth to rough metal, plastic | [`MicrofacetBrdf`] over [`Ggx`] or [`Beckmann`], [`LayeredBrdf`] for a coat | closed forms; GGX 0.1 µs per eval ("Classic BRDFs") |
+//! | glints, the default | [`glint::BeckmannMixture`], approximate masking | TV 0.105 (best with position-normal rate 2), 5.6 µs per eval, 87 B/texel |
+//! | glints, many materials in memory | the mixture with `LobeStorage::Compact` | TV within 5·10⁻⁵ of full storage, 1.4-1.8× the query time, 15.4 B/texel ("Compact storage") |
+//! | glints, cost flat in footprint size | [`glint::BinMap`], B = 255², s = 2 | TV 0.22, 3.3 µs per eval, `d` 1.4 µs even at 256 texels, 29 B/texel |
+//! | the closest to the sharp (Dirac) truth, cost no object | [`glint::PositionNormalMap`], rate 2 | Dirac TV 0.101 (mixture 0.279), 38 µs per eval, 117 B/texel |
+//! | far away (footprints of thousands of texels) | any glint model's defaults: their levels of detail fall back to merged lobes or one filtered lobe | filtered lobe 0.1 µs per eval |
 
 pub mod bxdf;
 mod error;

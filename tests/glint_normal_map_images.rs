@@ -93,7 +93,7 @@ fn png8_round_trip_within_quantisation() {
                 .save(&path)
                 .unwrap();
         }
-        let map = NormalMap::load(&path, conv, NormalRepair::Reject).unwrap();
+        let map = NormalMap::from_image_file(&path, conv, NormalRepair::Reject).unwrap();
         assert_eq!((map.width(), map.height()), (W, H));
         // Each component is off by ≤ 1/255 after decoding (half a step of 2/255), so the vector
         // error is ≤ √3/255, and normalising at most doubles it for a unit target.
@@ -130,7 +130,9 @@ fn png16_round_trip_within_quantisation() {
                 .save(&path)
                 .unwrap();
         }
-        let map = NormalMap::load(&path, TangentConvention::OpenGl, NormalRepair::Reject).unwrap();
+        let map =
+            NormalMap::from_image_file(&path, TangentConvention::OpenGl, NormalRepair::Reject)
+                .unwrap();
         // As for 8 bits with a step of 2/65535, plus f32 round-off (1e-6).
         let tol = 2.0 * 3f32.sqrt() / 65535.0 + 1e-6;
         for (k, want) in normals.iter().enumerate() {
@@ -159,7 +161,7 @@ fn exr_round_trip_is_exact_and_conventions_flip_y() {
             length_tolerance: f32::INFINITY,
             ..Default::default()
         };
-        NormalMap::load_with(&path, &options).unwrap().0
+        NormalMap::from_image_file_with(&path, &options).unwrap().0
     };
     let gl = load(TangentConvention::OpenGl);
     let dx = load(TangentConvention::DirectX);
@@ -179,7 +181,8 @@ fn bottom_picture_row_is_texel_row_zero() {
         .unwrap()
         .save(&path)
         .unwrap();
-    let map = NormalMap::load(&path, TangentConvention::OpenGl, NormalRepair::Reject).unwrap();
+    let map =
+        NormalMap::from_image_file(&path, TangentConvention::OpenGl, NormalRepair::Reject).unwrap();
     assert!(
         map.texel_slope(0, 0).length() < 0.01,
         "row 0 = bottom pixel (flat)"
@@ -199,7 +202,8 @@ fn to_rgb8_is_the_inverse_of_loading() {
         .unwrap()
         .save(&path)
         .unwrap();
-    let back = NormalMap::load(&path, TangentConvention::DirectX, NormalRepair::Reject).unwrap();
+    let back = NormalMap::from_image_file(&path, TangentConvention::DirectX, NormalRepair::Reject)
+        .unwrap();
     let tol = 2.0 * 3f32.sqrt() / 255.0 + 1e-6; // 8-bit quantisation, as above
     for j in 0..4 {
         for i in 0..6 {
@@ -252,7 +256,7 @@ fn bad_files_give_errors_naming_the_file() {
     let conv = TangentConvention::OpenGl;
     // Missing file.
     let missing = dir.join("does_not_exist.png");
-    let e = NormalMap::load(&missing, conv, NormalRepair::Reject).unwrap_err();
+    let e = NormalMap::from_image_file(&missing, conv, NormalRepair::Reject).unwrap_err();
     assert!(
         matches!(e, Error::Io { .. }) && e.to_string().contains("does_not_exist.png"),
         "{e}"
@@ -260,7 +264,7 @@ fn bad_files_give_errors_naming_the_file() {
     // Not an image.
     let junk = dir.join("junk.png");
     std::fs::write(&junk, b"this is not a png").unwrap();
-    let e = NormalMap::load(&junk, conv, NormalRepair::Reject).unwrap_err();
+    let e = NormalMap::from_image_file(&junk, conv, NormalRepair::Reject).unwrap_err();
     assert!(
         matches!(e, Error::Image { .. }) && e.to_string().contains("junk.png"),
         "{e}"
@@ -271,7 +275,7 @@ fn bad_files_give_errors_naming_the_file() {
         .unwrap()
         .save(&grey)
         .unwrap();
-    let e = NormalMap::load(&grey, conv, NormalRepair::Reject).unwrap_err();
+    let e = NormalMap::from_image_file(&grey, conv, NormalRepair::Reject).unwrap_err();
     assert!(
         matches!(e, Error::Image { .. }) && e.to_string().contains("grey.png"),
         "{e}"
@@ -280,7 +284,7 @@ fn bad_files_give_errors_naming_the_file() {
     // refuse it): refused by the decoder or by our own check, and the error names the file.
     let empty = dir.join("empty.png");
     std::fs::write(&empty, png_rgb8_header_only(0, 1)).unwrap();
-    let e = NormalMap::load(&empty, conv, NormalRepair::Reject).unwrap_err();
+    let e = NormalMap::from_image_file(&empty, conv, NormalRepair::Reject).unwrap_err();
     assert!(
         matches!(e, Error::Image { .. }) && e.to_string().contains("empty.png"),
         "{e}"
@@ -295,13 +299,13 @@ fn bad_files_give_errors_naming_the_file() {
     .unwrap()
     .save(&below)
     .unwrap();
-    let e = NormalMap::load(&below, conv, NormalRepair::Reject).unwrap_err();
+    let e = NormalMap::from_image_file(&below, conv, NormalRepair::Reject).unwrap_err();
     assert!(
         matches!(e, Error::InvalidTexel { x: 1, y: 1, .. }) && e.to_string().contains("below.png"),
         "{e}"
     );
     // …which ClampZ repairs.
-    let m = NormalMap::load(&below, conv, NormalRepair::ClampZ(0.2)).unwrap();
+    let m = NormalMap::from_image_file(&below, conv, NormalRepair::ClampZ(0.2)).unwrap();
     assert!(m.texel_normal(1, 1).z > 0.19);
     // Non-finite EXR values, whatever the repair.
     let nan = dir.join("nan.exr");
@@ -309,7 +313,7 @@ fn bad_files_give_errors_naming_the_file() {
         .unwrap()
         .save(&nan)
         .unwrap();
-    let e = NormalMap::load(&nan, conv, NormalRepair::ClampZ(0.5)).unwrap_err();
+    let e = NormalMap::from_image_file(&nan, conv, NormalRepair::ClampZ(0.5)).unwrap_err();
     assert!(
         matches!(e, Error::InvalidTexel { .. }) && e.to_string().contains("nan.exr"),
         "{e}"

@@ -72,11 +72,12 @@ const ENCODED_TOL: f32 = 2.0 * 1.7321 * 3.0 / 8_388_608.0 + 1e-7;
 fn encoded_exr_is_decoded_as_two_c_minus_one_by_default() {
     let n = normals(W * H, 0.8, 1);
     let path = write_exr("encoded.exr", &n, colour);
-    // `load` (the default) and `load_with` (reporting) agree, and the report says what was done.
-    let map = NormalMap::load(&path, TangentConvention::OpenGl, NormalRepair::Reject).unwrap();
+    // `from_image_file` (the default) and `from_image_file_with` (reporting) agree, and the report says what was done.
+    let map =
+        NormalMap::from_image_file(&path, TangentConvention::OpenGl, NormalRepair::Reject).unwrap();
     let err = max_normal_error(&map, &n);
     assert!(err <= ENCODED_TOL, "{err}");
-    let (map2, report) = NormalMap::load_with(&path, &ImageOptions::default()).unwrap();
+    let (map2, report) = NormalMap::from_image_file_with(&path, &ImageOptions::default()).unwrap();
     assert_eq!(map.slopes(), map2.slopes());
     assert!(report.float_channels);
     assert_eq!(report.encoding, FloatEncoding::Encoded);
@@ -90,7 +91,8 @@ fn encoded_exr_is_decoded_as_two_c_minus_one_by_default() {
 fn raw_exr_needs_the_raw_option_and_the_default_refuses_it() {
     let n = normals(W * H, 0.8, 2);
     let path = write_exr("raw.exr", &n, |v| v);
-    let (map, report) = NormalMap::load_with(&path, &with_encoding(FloatEncoding::Raw)).unwrap();
+    let (map, report) =
+        NormalMap::from_image_file_with(&path, &with_encoding(FloatEncoding::Raw)).unwrap();
     assert_eq!(report.encoding, FloatEncoding::Raw);
     // Raw floats are the vector itself: the slope −x/z is exact up to one division's rounding.
     for (k, v) in n.iter().enumerate() {
@@ -104,7 +106,8 @@ fn raw_exr_needs_the_raw_option_and_the_default_refuses_it() {
     }
     // Read as the renderers' default (2c − 1), a raw map is far off unit length: refused, with a hint.
     let e =
-        NormalMap::load(&path, TangentConvention::OpenGl, NormalRepair::ClampZ(0.05)).unwrap_err();
+        NormalMap::from_image_file(&path, TangentConvention::OpenGl, NormalRepair::ClampZ(0.05))
+            .unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, Error::ImplausibleNormals { .. }), "{e}");
     assert!(
@@ -119,7 +122,7 @@ fn encoded_exr_read_as_raw_is_refused() {
     // around (−0.5, −0.5); the lengths (≈ 1.22 for flat texels) give it away.
     let n = normals(W * H, 0.3, 3);
     let path = write_exr("encoded_as_raw.exr", &n, colour);
-    let e = NormalMap::load_with(&path, &with_encoding(FloatEncoding::Raw)).unwrap_err();
+    let e = NormalMap::from_image_file_with(&path, &with_encoding(FloatEncoding::Raw)).unwrap_err();
     assert!(matches!(e, Error::ImplausibleNormals { .. }), "{e}");
     assert!(e.to_string().contains("FloatEncoding::Encoded"), "{e}");
 }
@@ -131,19 +134,22 @@ fn detection_is_conservative_and_reported() {
     let n = normals(W * H, 0.8, 4);
     let p = write_exr("detect_raw_neg.exr", &n, |v| v);
     assert_eq!(
-        NormalMap::load_with(&p, &detect).unwrap().1.encoding,
+        NormalMap::from_image_file_with(&p, &detect)
+            .unwrap()
+            .1
+            .encoding,
         FloatEncoding::Raw
     );
     // Raw without negative components (a flat map): decided by the lengths (√3 as 2c − 1, 1 raw).
     let flat = vec![Vec3::Z; W * H];
     let p = write_exr("detect_raw_flat.exr", &flat, |v| v);
-    let (map, report) = NormalMap::load_with(&p, &detect).unwrap();
+    let (map, report) = NormalMap::from_image_file_with(&p, &detect).unwrap();
     assert_eq!(report.encoding, FloatEncoding::Raw);
     assert!(map.slopes().iter().all(|s| *s == brdf::Vec2::ZERO));
     // Encoded: decided by the lengths (√1.5 for a flat texel read raw).
     let n = normals(W * H, 0.8, 5);
     let p = write_exr("detect_encoded.exr", &n, colour);
-    let (map, report) = NormalMap::load_with(&p, &detect).unwrap();
+    let (map, report) = NormalMap::from_image_file_with(&p, &detect).unwrap();
     assert_eq!(report.encoding, FloatEncoding::Encoded);
     assert!(max_normal_error(&map, &n) <= ENCODED_TOL);
     // Ambiguous: c = (a, a, b) with |c| = 1 and |2c − 1| = 1 (2a + b = 3/2, 2a² + b² = 1, so
@@ -153,16 +159,16 @@ fn detection_is_conservative_and_reported() {
     let c = Vec3::new(a as f32, a as f32, b as f32);
     assert!((c.length() - 1.0).abs() < 1e-6 && ((2.0 * c - Vec3::ONE).length() - 1.0).abs() < 1e-6);
     let p = write_exr("detect_ambiguous.exr", &vec![Vec3::ZERO; W * H], |_| c);
-    let e = NormalMap::load_with(&p, &detect).unwrap_err();
+    let e = NormalMap::from_image_file_with(&p, &detect).unwrap_err();
     assert!(
         matches!(e, Error::ImplausibleNormals { .. }) && e.to_string().contains("both"),
         "{e}"
     );
     // …but an explicit encoding is taken as given.
-    assert!(NormalMap::load_with(&p, &with_encoding(FloatEncoding::Encoded)).is_ok());
+    assert!(NormalMap::from_image_file_with(&p, &with_encoding(FloatEncoding::Encoded)).is_ok());
     // Neither: vectors of length 3 whichever way they are read.
     let p = write_exr("detect_neither.exr", &flat, |_| Vec3::new(0.0, 0.0, 3.0));
-    let e = NormalMap::load_with(&p, &detect).unwrap_err();
+    let e = NormalMap::from_image_file_with(&p, &detect).unwrap_err();
     assert!(e.to_string().contains("neither"), "{e}");
 }
 
@@ -179,7 +185,7 @@ fn mostly_below_the_horizon_is_refused_even_with_repair() {
         repair: NormalRepair::ClampZ(0.1),
         ..ImageOptions::default()
     };
-    let e = NormalMap::load_with(&p, &repair).unwrap_err();
+    let e = NormalMap::from_image_file_with(&p, &repair).unwrap_err();
     assert!(
         matches!(e, Error::ImplausibleNormals { .. }) && e.to_string().contains("horizon"),
         "{e}"
@@ -191,7 +197,7 @@ fn mostly_below_the_horizon_is_refused_even_with_repair() {
         v.z = -v.z;
     }
     let p = write_exr("below_minority.exr", &n, colour);
-    let (map, report) = NormalMap::load_with(&p, &repair).unwrap();
+    let (map, report) = NormalMap::from_image_file_with(&p, &repair).unwrap();
     assert_eq!(report.below_horizon, minority);
     assert!((0..W * H).all(|k| map.texel_normal((k % W) as i64, (k / W) as i64).z >= 0.1 - 1e-6));
 }
@@ -204,8 +210,8 @@ fn png_maps_are_checked_too_and_bad_options_are_errors() {
         .unwrap()
         .save(&path)
         .unwrap();
-    let e =
-        NormalMap::load(&path, TangentConvention::OpenGl, NormalRepair::ClampZ(0.1)).unwrap_err();
+    let e = NormalMap::from_image_file(&path, TangentConvention::OpenGl, NormalRepair::ClampZ(0.1))
+        .unwrap_err();
     assert!(
         matches!(e, Error::ImplausibleNormals { .. }) && e.to_string().contains("integer"),
         "{e}"
@@ -216,7 +222,8 @@ fn png_maps_are_checked_too_and_bad_options_are_errors() {
         .unwrap()
         .save(&flat)
         .unwrap();
-    let (_, report) = NormalMap::load_with(&flat, &with_encoding(FloatEncoding::Raw)).unwrap();
+    let (_, report) =
+        NormalMap::from_image_file_with(&flat, &with_encoding(FloatEncoding::Raw)).unwrap();
     assert!(!report.float_channels);
     assert_eq!(report.encoding, FloatEncoding::Encoded);
     for tol in [f32::NAN, -1.0] {
@@ -224,7 +231,7 @@ fn png_maps_are_checked_too_and_bad_options_are_errors() {
             length_tolerance: tol,
             ..ImageOptions::default()
         };
-        let e = NormalMap::load_with(&flat, &o).unwrap_err();
+        let e = NormalMap::from_image_file_with(&flat, &o).unwrap_err();
         assert!(e.to_string().contains("length_tolerance"), "{e}");
     }
 }

@@ -46,7 +46,7 @@ fn small_files() -> Vec<(&'static str, Vec<u8>, fn(&[u8]) -> brdf::Result<()>)> 
             load_mixture(b).map(drop)
         }),
         ("normal map", saved(|w| m.save(w)), |b| {
-            NormalMap::load_binary(&mut &b[..]).map(drop)
+            NormalMap::load(&mut &b[..]).map(drop)
         }),
         ("position-normal", saved(|w| pn.save(w)), |b| {
             PositionNormalMap::load(&mut &b[..]).map(drop)
@@ -165,7 +165,7 @@ fn header_errors_name_what_is_wrong() {
         "{msg}"
     );
     assert!(matches!(
-        NormalMap::load_binary(&mut file.as_slice()),
+        NormalMap::load(&mut file.as_slice()),
         Err(Error::WrongModelKind { .. })
     ));
     // A good file with trailing bytes after the checksum: read exactly, the rest left to the caller.
@@ -246,6 +246,6 @@ fn sizes_beyond_the_file_are_refused_before_allocating() {
     // A normal map of 2^31 × 2^31 texels: beyond the size limit.
     let mut nm = saved(|w| map(2).save(w));
     nm[24..32].copy_from_slice(&(1u64 << 31).to_le_bytes());
-    let e = NormalMap::load_binary(&mut &reseal(nm)[..]).unwrap_err();
+    let e = NormalMap::load(&mut &reseal(nm)[..]).unwrap_err();
     assert!(e.to_string().contains("width"), "{e}");
 }

@@ -115,7 +115,7 @@ fn lying_sizes_allocate_no_more_than_the_file_holds() {
     nm[32..40].copy_from_slice(&2u64.to_le_bytes());
     nm[40..48].copy_from_slice(&(1u64 << 31).to_le_bytes());
     nm[16..24].copy_from_slice(&(24 + (1u64 << 34)).to_le_bytes());
-    let (r, peak) = peak_during(|| NormalMap::load_binary(&mut reseal(nm).as_slice()));
+    let (r, peak) = peak_during(|| NormalMap::load(&mut reseal(nm).as_slice()));
     assert!(matches!(r, Err(Error::Truncated { .. })), "{r:?}");
     assert!(peak <= 4 * (1 << 16) + 4096, "peak {peak} bytes");
 }

@@ -67,7 +67,7 @@ fn normal_map_round_trip_is_exact() {
     let file = saved(|w| m.save(w));
     // 24-byte header + width, height, count (8 each) + 8 bytes per texel + checksum.
     assert_eq!(file.len(), 24 + 24 + 8 * 24 * 24 + 8);
-    let back = NormalMap::load_binary(&mut file.as_slice()).unwrap();
+    let back = NormalMap::load(&mut file.as_slice()).unwrap();
     assert_eq!((back.width(), back.height()), (24, 24));
     let bits = |m: &NormalMap| -> Vec<[u32; 2]> {
         m.slopes()

@@ -7,9 +7,9 @@
 //! then radiance = Σ f(wo, wi) · L · cos θi / pdf, with the geometric cosine (local `wi.z`). World space: y up, lengths in scene units; BRDFs see
 //! directions in the local frame of the hit (z = normal, x = ∂p/∂u). See docs/render.md.
 
-use brdf::bxdf::Bxdf;
+use brdf::bxdf::{Bxdf, LobeFlags};
 use brdf::frame::Frame;
-use brdf::glint::{Footprint, GlintScratch};
+use brdf::glint::{Footprint, GlintScratch, RayCone};
 use brdf::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
 use brdf::{Material, Vec2, Vec3};
 use indicatif::ProgressBar;
@@ -24,10 +24,6 @@ pub mod showcase;
 const RAY_EPSILON: f32 = 1e-4;
 /// Scattering events after the camera ray (the sphere and the plane see each other once or twice).
 pub const MAX_BOUNCES: usize = 4;
-/// Footprint growth per bounce: after a diffuse or glossy bounce the rays of one pixel spread far
-/// more than the camera's differentials say; ray cones would track it, this example widens the
-/// footprint by a fixed factor per bounce (secondary glints are then smooth, as they should be).
-const SECONDARY_FOOTPRINT_GROWTH: f32 = 16.0;
 
 /// The ground's checkerboard: squares of side `square` scene units alternating between the
 /// materials `a` and `b` (indices into [`Scene::materials`]).
@@ -119,9 +115,9 @@ impl Camera {
     }
 
     /// ∂p/∂x, ∂p/∂y at a hit (p, n): the rays through the neighbouring pixels intersected with the
-    /// tangent plane (the Footprint docs' recipe), the rays aimed at p itself. For a camera hit this
-    /// is the ray differential; for a secondary hit it is pbrt-v4's approximation
-    /// (`Camera::Approximate_dp_dxy`). Zero where an offset ray runs parallel to the plane.
+    /// tangent plane (the Footprint docs' recipe), the rays aimed at p itself: for a camera hit, the
+    /// ray differential (secondary hits use the path's `RayCone`). Zero where an offset ray runs
+    /// parallel to the plane.
     fn dp_dxy(&self, p: Vec3, n: Vec3) -> (Vec3, Vec3) {
         let to_p = p - self.eye;
         let d = to_p / to_p.dot(self.forward).max(1e-6);
@@ -267,21 +263,28 @@ impl Scene {
         let mut throughput = Vec3::ONE;
         // (normal, BRDF pdf) of the previous vertex, for the MIS weight of a sky hit; None at the camera.
         let mut previous: Option<(Vec3, f32)> = None;
-        let mut spread = footprint_scale;
-        for _ in 0..=MAX_BOUNCES {
+        // Camera hits use the camera's ray differentials; later hits the ray cone of the path,
+        // started at one pixel's angle (one sample's share of it) and carried through every bounce.
+        let mut cone = RayCone::from_camera(self.camera.pixel_step().atan() * footprint_scale);
+        for bounce in 0..=MAX_BOUNCES {
             let Some(hit) = self.intersect(o, d) else {
                 let w = previous.map_or(1.0, |(n, pdf)| power_heuristic(pdf, Self::sky_pdf(n, d)));
                 total += throughput * self.sky.radiance(d) * w;
                 break;
             };
-            let frame = Frame::from_normal_tangent(hit.n, hit.dpdu);
+            let frame = Frame::from_surface(hit.n, hit.dpdu, hit.dpdv);
             let wo = frame.to_local(-d);
             if wo.z <= 0.0 {
                 break;
             }
+            cone = cone.propagate((hit.p - o).length());
+            let (dpdx, dpdy) = if bounce == 0 {
+                let (dpdx, dpdy) = self.camera.dp_dxy(hit.p, hit.n);
+                (dpdx * footprint_scale, dpdy * footprint_scale)
+            } else {
+                cone.surface_differentials(d, hit.n)
+            };
             let material = &self.materials[self.material_at(&hit)];
-            let (dpdx, dpdy) = self.camera.dp_dxy(hit.p, hit.n);
-            let (dpdx, dpdy) = (dpdx * spread, dpdy * spread);
             let footprint =
                 Footprint::from_surface_differentials(hit.uv, hit.dpdu, hit.dpdv, dpdx, dpdy);
             let bsdf = material.bsdf(&footprint, scratch);
@@ -300,8 +303,18 @@ impl Scene {
             throughput *= weight;
             o = hit.p + hit.n * RAY_EPSILON;
             d = wi;
-            previous = Some((hit.n, pdf));
-            spread *= SECONDARY_FOOTPRINT_GROWTH;
+            // The sphere, seen from outside, is convex of curvature 1/radius; the ground is flat.
+            let curvature = if hit.sphere { 1.0 / self.radius } else { 0.0 };
+            cone = cone.reflect(curvature);
+            // A delta sample (a mirror) has no density to weigh against the sky sampler (its pdf
+            // is a convention, not a density: the crate's delta-lobe convention) and does not
+            // widen the cone.
+            if s.flags.contains(LobeFlags::SPECULAR) {
+                previous = None;
+            } else {
+                previous = Some((hit.n, pdf));
+                cone = cone.scatter(pdf);
+            }
         }
         if total.is_finite() {
             total.max(Vec3::ZERO)

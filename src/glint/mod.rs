@@ -47,7 +47,10 @@
 //! - **Tangent frame.** The slope x̃ is along +u (increasing column), ỹ along +v (increasing row). A
 //!   slope ñ = (x̃, ỹ) is the slope of the normal ω_n = normalize(−x̃, −ỹ, 1) (crate convention), so for a
 //!   height field h the slope is its gradient (∂h/∂u, ∂h/∂v) in texel units (see
-//!   [`NormalMap::from_heights`]).
+//!   [`NormalMap::from_heights`]). On a surface, +u and +v are ∂p/∂u and ∂p/∂v: build the shading frame
+//!   with [`Frame::from_surface`](crate::frame::Frame::from_surface)`(n, ∂p/∂u, ∂p/∂v)`, whose x and y
+//!   follow them for either handedness of the parametrisation (a frame built as y = n × x would
+//!   mirror the map on a left-handed one).
 //! - **Image files.** Files are stored top row first, but texture coordinates conventionally put v = 0
 //!   at the *bottom* of the picture (OpenGL, pbrt, Blender). The loader follows that convention: the
 //!   **bottom row of the file is texel row 0** (v = 0) and the top row is row `height − 1`, so +v (and the
@@ -97,10 +100,9 @@ pub use scratch::GlintScratch;
 pub use surface::{
     BrushedParams, FlakesParams, Footprint, MAX_ANISOTROPY, MAX_CARVE_WORK_PER_TEXEL,
     MAX_EXTENT_PERIODS, MAX_GENERATED_TEXELS, MAX_SLOPE, MIN_CELL_TEXELS, MIN_WIDTH_TEXELS,
-    NormalMap, NormalRepair, ScratchedParams, TangentConvention, brushed, bumpy, flakes,
+    NormalMap, NormalRepair, RayCone, ScratchedParams, TangentConvention, brushed, bumpy, flakes,
     moments_mean_covariance, scratched,
 };
-#[cfg(feature = "image")]
 pub use surface::{
     DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, ImageDecoding, ImageOptions,
     MAX_IMPLAUSIBLE_FRACTION, RAW_EVIDENCE_BELOW,

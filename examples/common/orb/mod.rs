@@ -131,7 +131,7 @@ pub fn load_map(opts: &OrbOptions) -> Res<NormalMap> {
             _ => scratched(s, s, ScratchedParams::default(), opts.seed)?,
         },
         MapSource::File(path) => {
-            NormalMap::load(path, TangentConvention::OpenGl, NormalRepair::ClampZ(0.01))?
+            NormalMap::from_image_file(path, TangentConvention::OpenGl, NormalRepair::ClampZ(0.01))?
         }
     })
 }

@@ -90,7 +90,7 @@ impl Scene {
                 dpv.dot(hit.dpdv) / hit.dpdv.length_squared(),
             )
         };
-        let frame = Frame::from_normal_tangent(hit.n, hit.dpdu);
+        let frame = Frame::from_surface(hit.n, hit.dpdu, hit.dpdv);
         let to_light = self.light - hit.p;
         let r2 = to_light.length_squared();
         Some(ShadingPoint {

@@ -1,5 +1,5 @@
-//! The showcase of the render example: four materials on the same sphere (analytic gold, two glint
-//! conductors, a glint coat over paint), the normal map PNG it writes first, tone mapping and the
+//! The showcase of the render example: five materials on the same sphere (analytic gold, a mirror,
+//! two glint conductors, a glint coat over paint), the normal map PNG it writes first, tone mapping and the
 //! progress bar.
 
 use super::{Camera, Checker, Image, PointLight, Scene, Sky, render};
@@ -156,7 +156,7 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
         &png,
         "the hammered normal map (OpenGL convention) that the render example writes, then loads",
     ));
-    let hammered = glint_model(&NormalMap::load(
+    let hammered = glint_model(&NormalMap::from_image_file(
         &png,
         TangentConvention::OpenGl,
         NormalRepair::Reject,
@@ -172,11 +172,16 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
         3,
     )?)?;
     type Make = Box<dyn FnOnce(Vec2) -> Res<Material>>;
-    let shots: [(&str, &str, Make); 4] = [
+    let shots: [(&str, &str, Make); 5] = [
         (
             "render_gold.png",
             "analytic gold: GGX α = 0.15, conductor Fresnel",
             Box::new(|_| Ok(Material::microfacet(Ggx::isotropic(0.15)?, ConductorFresnel::GOLD))),
+        ),
+        (
+            "render_mirror.png",
+            "the smooth limit: a perfect silver mirror (a delta lobe, no MIS on its samples)",
+            Box::new(|_| Ok(Material::mirror(ConductorFresnel::SILVER))),
         ),
         (
             "render_scratched.png",

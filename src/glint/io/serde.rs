@@ -62,7 +62,7 @@ macro_rules! serde_via_file {
     };
 }
 
-serde_via_file!(NormalMap, NormalMap::load_binary);
+serde_via_file!(NormalMap, NormalMap::load);
 serde_via_file!(BeckmannMixture, BeckmannMixture::load);
 serde_via_file!(PositionNormalMap, PositionNormalMap::load);
 serde_via_file!(BinMap, BinMap::load);

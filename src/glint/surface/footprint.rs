@@ -67,6 +67,22 @@ pub const MAX_EXTENT_PERIODS: f32 = 2.0;
 /// 3. if the material scales uv (a map repeated k times: uv' = k uv), scale uv and both differentials
 ///    by k, or call [`Footprint::from_differentials`] with the scaled ∂uv directly.
 ///
+/// Secondary rays (after a diffuse or glossy bounce) have no ray differentials: carry a
+/// [`RayCone`](crate::glint::RayCone) along the path instead and read the footprint from it at each
+/// hit ([`RayCone::footprint`](crate::glint::RayCone::footprint)), which ends in step 2 too.
+///
+/// The shading frame of the same hit is [`Frame::from_surface`](crate::frame::Frame::from_surface)`(n,
+/// ∂p/∂u, ∂p/∂v)`.
+///
+/// # Handedness
+/// A footprint lives in the map's (u, v) coordinates, and step 2 solves for ∂uv/∂x in those
+/// coordinates directly: a left-handed parametrisation (∂p/∂u × ∂p/∂v pointing against n, e.g. u
+/// mirrored) gives the footprint of the mirrored map region, with no sign to choose. The
+/// frame must agree: [`Frame::from_surface`](crate::frame::Frame::from_surface) puts the local x
+/// along ∂p/∂u and y along +∂p/∂v for either handedness, so a slope (x̃, ỹ) of the map and the
+/// footprint's axes are the same (u, v) axes. (`Frame::from_normal_tangent(n, ∂p/∂u)` instead mirrors
+/// v on a left-handed parametrisation: its slopes would no longer match the footprint's texels.)
+///
 /// Then read it in texel units of a map with [`Footprint::gaussian_texels`] or
 /// [`Footprint::parallelogram_texels`] (the glint models do this). See the
 /// [`glint` module docs](crate::glint) and the constants for the two views and the clamps. Map
@@ -140,6 +156,9 @@ impl Footprint {
     /// ∂p/∂y (any common world frame and unit; the recipe is in the type's docs): ∂uv/∂x is the
     /// least-squares solution of ∂p/∂u ∂u/∂x + ∂p/∂v ∂v/∂x = ∂p/∂x (normal equations in `f64`), the
     /// same for y, then [`Footprint::from_differentials`].
+    ///
+    /// Any handedness of (∂p/∂u, ∂p/∂v) is fine: the solve is in (u, v) coordinates, the axes of
+    /// [`Frame::from_surface`](crate::frame::Frame::from_surface) (the type's docs, "Handedness").
     ///
     /// Degenerate cases: a singular parametrisation (∂p/∂u ∥ ∂p/∂v, or either zero) or non-finite
     /// input gives zero differentials, i.e. the minimal footprint ([`MIN_WIDTH_TEXELS`]); the result

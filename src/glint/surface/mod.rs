@@ -5,28 +5,33 @@
 //! - normal_map.rs: [`NormalMap`], the tiled grid of per-texel slopes and the interpolated surface.
 //! - moments.rs: the mip chain of slope moments behind [`NormalMap::moments`] and friends.
 //! - procedural.rs: the seeded generators [`scratched`], [`brushed`], [`bumpy`], [`flakes`].
-//! - image_io.rs: decoding PNG / EXR normal maps (feature `image`).
+//! - pixels.rs: decoding normal maps from 8-bit, 16-bit or float pixel slices (always available).
+//! - image_io.rs: decoding PNG / EXR normal-map files into those pixels (feature `image`).
 //! - footprint.rs: [`Footprint`], a ray footprint as a parallelogram and a Gaussian.
+//! - ray_cone.rs: [`RayCone`], footprints for secondary rays (width and spread propagated through
+//!   reflections).
 
 mod footprint;
 #[cfg(feature = "image")]
 mod image_io;
 mod moments;
 mod normal_map;
+mod pixels;
 mod procedural;
+mod ray_cone;
 
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
-#[cfg(feature = "image")]
-pub use image_io::{
-    DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, ImageDecoding, ImageOptions,
-    MAX_IMPLAUSIBLE_FRACTION, RAW_EVIDENCE_BELOW,
-};
 pub(crate) use moments::{MomentLevel, MomentPyramid};
 pub(crate) use normal_map::texel_count;
 pub use normal_map::{
     MAX_SLOPE, NormalMap, NormalRepair, TangentConvention, moments_mean_covariance,
 };
+pub use pixels::{
+    DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, ImageDecoding, ImageOptions,
+    MAX_IMPLAUSIBLE_FRACTION, RAW_EVIDENCE_BELOW,
+};
 pub use procedural::{
     BrushedParams, FlakesParams, MAX_CARVE_WORK_PER_TEXEL, MAX_GENERATED_TEXELS, MIN_CELL_TEXELS,
     ScratchedParams, brushed, bumpy, flakes, scratched,
 };
+pub use ray_cone::RayCone;

@@ -399,7 +399,7 @@ impl NormalMap {
 
     /// The map as 8-bit RGB (3 bytes per texel, file order: top row of the picture first), with the usual
     /// encoding c = round(255 (n + 1) / 2) and the y channel written for `convention`. This is the layout
-    /// [`NormalMap::load`] reads back (up to quantisation).
+    /// [`NormalMap::from_image_bytes`] decodes (up to quantisation) once written as a PNG.
     pub fn to_rgb8(&self, convention: TangentConvention) -> Vec<u8> {
         let enc = |c: f32| ((c.clamp(-1.0, 1.0) + 1.0) * 127.5).round() as u8;
         let mut out = Vec::with_capacity(self.slopes.len() * 3);
@@ -492,14 +492,15 @@ impl NormalMap {
     }
 
     /// Reads a map written by [`NormalMap::save`]; the slopes are bit-identical to the saved ones.
-    /// (Named apart from [`NormalMap::load`], which decodes image files.)
+    /// Image files are decoded by `NormalMap::from_image_file` / `from_image_bytes` (feature
+    /// `image`); `save` / `load` are the crate's own binary format, as for every glint model.
     ///
     /// # Errors
     /// [`Error::BadMagic`], [`Error::UnsupportedVersion`], [`Error::WrongModelKind`],
     /// [`Error::Truncated`], [`Error::ChecksumMismatch`], [`Error::Stream`]; [`Error::InvalidFile`]
     /// for a size that is zero, too large or does not match the slope count, and for slopes that
     /// [`NormalMap::from_slopes`] refuses (non-finite or above [`MAX_SLOPE`]).
-    pub fn load_binary(r: &mut impl std::io::Read) -> Result<NormalMap> {
+    pub fn load(r: &mut impl std::io::Read) -> Result<NormalMap> {
         let mut d = format::Decoder::open(r, Kind::NormalMap)?;
         let width = d.len("width", i32::MAX as usize)?;
         let height = d.len("height", i32::MAX as usize)?;
