@@ -46,10 +46,10 @@
 //! // Once per material: a normal map (`NormalMap::from_image_file` reads a PNG) made into a glint model.
 //! let map = brdf::glint::scratched(64, 64, Default::default(), 1)?;
 //! let model = GlintModel::from(BeckmannMixture::build(&map, MixtureParams::default())?);
-//! let mut scratch = GlintScratch::default(); // one per render thread
+//! let scratch = GlintScratch::default(); // one per render thread
 //! // Per shading point: n, uv, ∂p/∂u, ∂p/∂v and the ray differentials ∂p/∂x, ∂p/∂y (world space).
 //! let footprint = Footprint::from_surface_differentials(uv, dpdu, dpdv, dpdx, dpdy);
-//! let brdf = MicrofacetBrdf::new(model.patch_in(&footprint, &mut scratch), ConductorFresnel::GOLD);
+//! let brdf = MicrofacetBrdf::new(model.patch_in(&footprint, &scratch), ConductorFresnel::GOLD);
 //! // Then as any BRDF, in the local frame (x along ∂p/∂u, y along +∂p/∂v), cos θi = wi.z:
 //! let frame = Frame::from_surface(n, dpdu, dpdv);
 //! let (wo, wi) = (frame.to_local(to_eye), frame.to_local(to_light));
@@ -61,8 +61,10 @@
 //! # }
 //! ```
 //!
-//! The `render` example is a small path tracer built this way (`cargo run --release --example
-//! render`).
+//! A renderer that mixes analytic, layered, normal-mapped and glint materials keeps them in one
+//! `Vec<`[`Material`]`>` and shades every hit with `material.bsdf(&footprint, &scratch)` (module
+//! [`material`]). The `render` example is a small path tracer built this way (`cargo run --release
+//! --example render`).
 //!
 //! ## Conventions
 //!
@@ -103,29 +105,32 @@
 //!
 //! ## Which model when
 //!
-//! Provisional: the figures are those of docs/results.md, "Accuracy against speed" (four procedural
-//! maps at 1024², footprints of 0.25-256 texels, mean total-variation distance to the ground-truth
-//! P-NDF convolved by the material's σ_ε = 0.01; one thread, one run on a loaded machine, so times
-//! are inflated), "Memory per model" (bytes per texel at 2048²) and the sections named in the
-//! table; the like-for-like sweep of every
-//! model at matched settings is not in yet.
+//! From docs/results.md, "Accuracy against speed": every glint model renders the same material
+//! (intrinsic roughness σ_ε = 0.01), four procedural maps at 1024², footprints of 0.25-256 texels,
+//! mean total-variation distance to the ground-truth P-NDF convolved by σ_ε (TV), one thread on a
+//! loaded machine (times are inflated; ratios hold); memory from "Memory per model" (2048²). The
+//! full sweep against rendered error is in "Error against time". Provisional where a model's level
+//! of detail is still set by hand (the mixture's `lod_lobes`).
 //!
 //! | need | use | figures |
 //! |---|---|---|
-//! | no map: smooth to rough metal, plastic | [`MicrofacetBrdf`] over [`Ggx`] or [`Beckmann`], [`LayeredBrdf`] for a coat | closed forms; GGX 0.1 µs per eval ("Classic BRDFs") |
-//! | glints, the default | [`glint::BeckmannMixture`], approximate masking | TV 0.105 (best with position-normal rate 2), 5.6 µs per eval, 87 B/texel |
-//! | glints, many materials in memory | the mixture with `LobeStorage::Compact` | TV within 5·10⁻⁵ of full storage, 1.4-1.8× the query time, 15.4 B/texel ("Compact storage") |
-//! | glints, cost flat in footprint size | [`glint::BinMap`], B = 255², s = 2 | TV 0.22, 3.3 µs per eval, `d` 1.4 µs even at 256 texels, 29 B/texel |
-//! | the closest to the sharp (Dirac) truth, cost no object | [`glint::PositionNormalMap`], rate 2 | Dirac TV 0.101 (mixture 0.279), 38 µs per eval, 117 B/texel |
-//! | far away (footprints of thousands of texels) | any glint model's defaults: their levels of detail fall back to merged lobes or one filtered lobe | filtered lobe 0.1 µs per eval |
+//! | no map: smooth to rough metal, plastic | [`Material::microfacet`] over [`Ggx`] or [`Beckmann`], [`Material::layered`] for a coat, [`Material::mirror`] for the smooth limit | closed forms; GGX 0.1 µs per eval ("Classic BRDFs") |
+//! | a normal map, no glints (pixels cover many texels, or the look is smooth) | [`material::NormalMappedMaterial`] (microfacet-based normal mapping) | one map lookup per shading point |
+//! | glints, the default | [`glint::BeckmannMixture`], approximate masking | TV 0.098, 0.27 µs per eval, 87 B/texel |
+//! | glints, many materials in memory | the mixture with `LobeStorage::Compact` | TV within 5·10⁻⁵ of full storage, 1.3-1.7× the query time, 15.4 B/texel ("Compact storage") |
+//! | glints, cost flat in footprint size | [`glint::BinMap`], B = 255², s = 2, smoothed at α = √2 σ_ε | TV 0.138, 0.45 µs per eval, `d` ≤ 0.6 µs up to 256 texels, 29 B/texel |
+//! | the closest to the material, cost no object | [`glint::PositionNormalMap`], rate 2 | TV 0.012, 4.4 µs per eval (16× the mixture), `d` 93 µs at 256 texels, 117 B/texel |
+//! | far away (footprints of thousands of texels) | any glint model's level of detail: merged lobes or one filtered lobe | filtered lobe 0.06 µs per eval, TV 0.30 |
+//!
+//! Any of them as one run-time type: [`Material`] (module [`material`]).
 
 pub mod bxdf;
 mod error;
 pub mod frame;
 pub mod fresnel;
 pub mod glint;
-mod math;
 pub mod material;
+mod math;
 pub mod ndf;
 pub mod warp;
 
@@ -135,8 +140,8 @@ pub use bxdf::{
 };
 pub use error::{Error, Result};
 pub use fresnel::Fresnel;
-pub use material::{Bsdf, GlintMaterial, Material};
 pub use glam::{Mat2, Vec2, Vec3};
+pub use material::{Bsdf, GlintMaterial, Material};
 pub use ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
 
 /// The README's examples, compiled and run as doctests so that the quick start stays true.

@@ -53,12 +53,24 @@ fn analytic_variants_are_their_brdfs() {
     let gold = ConductorFresnel::GOLD;
     let ggx = Ggx::new(0.2, 0.35).unwrap();
     let m = Material::microfacet(ggx, gold);
-    same(&m.bsdf(&fp, &scratch), &MicrofacetBrdf::new(ggx, gold), "GGX");
+    same(
+        &m.bsdf(&fp, &scratch),
+        &MicrofacetBrdf::new(ggx, gold),
+        "GGX",
+    );
     let beckmann = Beckmann::isotropic(0.4).unwrap();
     let m = Material::microfacet(beckmann, gold);
-    same(&m.bsdf(&fp, &scratch), &MicrofacetBrdf::new(beckmann, gold), "Beckmann");
+    same(
+        &m.bsdf(&fp, &scratch),
+        &MicrofacetBrdf::new(beckmann, gold),
+        "Beckmann",
+    );
     let lambert = Lambert::new(Vec3::new(0.2, 0.5, 0.8)).unwrap();
-    same(&Material::from(lambert).bsdf(&fp, &scratch), &lambert, "Lambert");
+    same(
+        &Material::from(lambert).bsdf(&fp, &scratch),
+        &lambert,
+        "Lambert",
+    );
     let coat = SchlickFresnel::new(Vec3::splat(0.04)).unwrap();
     let base = Vec3::new(0.7, 0.2, 0.1);
     let m = Material::layered(ggx, coat, base).unwrap();
@@ -67,7 +79,9 @@ fn analytic_variants_are_their_brdfs() {
     let mirror = Material::mirror(gold);
     let direct = brdf::bxdf::SpecularReflection::new(gold);
     same(&mirror.bsdf(&fp, &scratch), &direct, "mirror");
-    let s = mirror.bsdf(&fp, &scratch).sample(support::dir(40.0, 10.0), 0.5, Vec2::splat(0.5));
+    let s = mirror
+        .bsdf(&fp, &scratch)
+        .sample(support::dir(40.0, 10.0), 0.5, Vec2::splat(0.5));
     assert!(s.is_some_and(|s| s.flags.contains(LobeFlags::SPECULAR)));
 }
 
@@ -92,7 +106,11 @@ fn glint_variants_are_their_patches() {
             .with_uv_scale(scale)
             .unwrap();
         let direct = MicrofacetBrdf::new(model.patch_with(&scaled, &ex.options, None), silver);
-        same(&Material::from(material.clone()).bsdf(&fp, &scratch), &direct, ex.label);
+        same(
+            &Material::from(material.clone()).bsdf(&fp, &scratch),
+            &direct,
+            ex.label,
+        );
         let base = Vec3::new(0.4, 0.3, 0.2);
         let coat = Material::from(material.over_base(base).unwrap());
         let layer = MicrofacetBrdf::new(model.patch_with(&scaled, &ex.options, None), silver);
@@ -102,7 +120,11 @@ fn glint_variants_are_their_patches() {
     // Without explicit options the material uses the model's own.
     let model: Arc<GlintModel> = Arc::new(support::registry::examples(&map).remove(0).model);
     let m = Material::from(GlintMaterial::new(model.clone(), silver));
-    same(&m.bsdf(&fp, &scratch), &MicrofacetBrdf::new(model.patch(&fp), silver), "own options");
+    same(
+        &m.bsdf(&fp, &scratch),
+        &MicrofacetBrdf::new(model.patch(&fp), silver),
+        "own options",
+    );
 }
 
 /// A normal-mapped material is the adapter over its base at the map's normal at the footprint's

@@ -206,11 +206,7 @@ pub trait GlintNdf {
 
     /// [`GlintNdf::patch_with`] with the model's [`options`](GlintNdf::options) and the buffers of
     /// a caller's [`GlintScratch`].
-    fn patch_in<'a>(
-        &'a self,
-        footprint: &Footprint,
-        scratch: &'a GlintScratch,
-    ) -> Self::Patch<'a> {
+    fn patch_in<'a>(&'a self, footprint: &Footprint, scratch: &'a GlintScratch) -> Self::Patch<'a> {
         self.patch_with(footprint, &self.options(), Some(scratch))
     }
 }

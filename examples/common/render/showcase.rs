@@ -10,7 +10,7 @@ use brdf::glint::{
     BeckmannMixture, FlakesParams, GlintModel, NormalMap, NormalRepair, ScratchedParams,
     TangentConvention, flakes, scratched,
 };
-use brdf::{GlintMaterial, Ggx, Lambert, Material, Vec2, Vec3};
+use brdf::{Ggx, GlintMaterial, Lambert, Material, Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
@@ -176,7 +176,12 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
         (
             "render_gold.png",
             "analytic gold: GGX α = 0.15, conductor Fresnel",
-            Box::new(|_| Ok(Material::microfacet(Ggx::isotropic(0.15)?, ConductorFresnel::GOLD))),
+            Box::new(|_| {
+                Ok(Material::microfacet(
+                    Ggx::isotropic(0.15)?,
+                    ConductorFresnel::GOLD,
+                ))
+            }),
         ),
         (
             "render_mirror.png",
