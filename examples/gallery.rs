@@ -18,7 +18,7 @@ type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
 fn main() -> Res<()> {
     let out = common::out_dir()?;
     let quick = !common::has_flag("--full");
-    let parts: [(&str, &str, Part); 9] = [
+    let parts: [(&str, &str, Part); 10] = [
         (
             "Analytic core",
             "NDF slices, Smith masking and Fresnel curves.",
@@ -29,6 +29,13 @@ fn main() -> Res<()> {
             "f·cos in the plane of incidence (polar plots) and over the projected hemisphere, for \
              Lambert, the Phong family, Blinn-Phong and the microfacet BRDF.",
             common::lobes::run,
+        ),
+        (
+            "Energy compensation",
+            "The white furnace of the microfacet BRDF before and after Kulla-Conty compensation \
+             against α and θo, and rough gold spheres uncompensated against compensated (the \
+             energy example).",
+            common::energy::run,
         ),
         (
             "Normal maps and ground-truth P-NDFs",
