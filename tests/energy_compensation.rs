@@ -143,7 +143,7 @@ fn white_furnace_is_one_on_a_coarse_grid() {
 }
 
 #[test]
-#[ignore = "full grid, ~1 min: cargo test --release --test energy_compensation -- --ignored"]
+#[ignore = "full grid, ~2 min: cargo test --release --test energy_compensation -- --ignored"]
 fn white_furnace_is_one_on_the_full_grid() {
     let alphas: Vec<f32> = (0..=24)
         .map(|k| 0.01 * 100f32.powf(k as f32 / 24.0))
