@@ -31,6 +31,13 @@ fn main() -> Res<()> {
             common::lobes::run,
         ),
         (
+            "Energy compensation",
+            "The white furnace of the microfacet BRDF before and after Kulla-Conty compensation \
+             against α and θo, and rough gold spheres uncompensated against compensated (the \
+             energy example).",
+            common::energy::run,
+        ),
+        (
             "Normal maps and ground-truth P-NDFs",
             "The four procedural maps and the P-NDF of their interpolated normals seen through \
              footprints of 1 to 4096 texels (projected hemisphere, log scale).",

@@ -7,6 +7,7 @@
 
 pub mod compare;
 pub mod curves;
+pub mod energy;
 pub mod grazing;
 pub mod lobes;
 pub mod material;

@@ -6,7 +6,8 @@
 //! Models: [`Lambert`]; the Phong family — [`Phong`] (modified form, normalisations in
 //! [`PhongNormalization`], optional Schlick Fresnel) and [`OriginalPhong`] (cos^γ θr / cos θi); the
 //! [`BlinnPhongLobe`]; and [`MicrofacetBrdf`], generic over any [`crate::ndf::Ndf`] (centred NDFs,
-//! non-centred lobes, glint patches) and any [`crate::fresnel::Fresnel`]; [`LayeredBrdf`], a microfacet
+//! non-centred lobes, glint patches) and any [`crate::fresnel::Fresnel`], with opt-in multiple-scattering
+//! energy compensation in [`EnergyCompensated`] (tables: [`AlbedoTable`]); [`LayeredBrdf`], a microfacet
 //! layer over a Lambertian base; [`SpecularReflection`], the smooth limit (a delta lobe, see the
 //! convention on [`Bxdf`]); and the shading-normal adapters [`NormalMapTilt`] (conventional normal
 //! mapping) and [`NormalMapMicrofacet`] (microfacet-based normal mapping), each wrapping any inner
@@ -14,7 +15,10 @@
 
 use glam::{Vec2, Vec3};
 
+mod albedo;
+mod albedo_tables;
 mod blinn_phong;
+mod compensated;
 mod lambert;
 mod layered;
 mod lobe;
@@ -23,7 +27,13 @@ mod normal_mapping;
 mod phong;
 mod specular;
 
+pub use albedo::{
+    ALBEDO_ALPHA_MAX, ALBEDO_ALPHA_MIN, ALBEDO_GRID, ALBEDO_MU_EPSILON, AlbedoTable, average_of_row,
+};
 pub use blinn_phong::{BlinnPhongLobe, BlinnPhongNormalization};
+pub use compensated::{
+    EnergyCompensated, TabulatedAlbedo, average_fresnel, multiple_scattering_fresnel,
+};
 pub use lambert::Lambert;
 pub(crate) use lambert::unit_rgb;
 pub use layered::{LayeredBrdf, TRANSMISSION_SAMPLES};
