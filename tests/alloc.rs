@@ -127,6 +127,8 @@ fn materials_with_several_live_bsdfs_allocate_nothing() {
         )
         .unwrap(),
         Material::mirror(ConductorFresnel::SILVER),
+        Material::microfacet_compensated(Ggx::isotropic(0.6).unwrap(), ConductorFresnel::GOLD)
+            .unwrap(),
         brdf::material::NormalMappedMaterial::new(
             Arc::new(map.clone()),
             Material::microfacet(Ggx::isotropic(0.2).unwrap(), ConductorFresnel::COPPER),

@@ -76,6 +76,9 @@ fn analytic_variants_are_their_brdfs() {
     let m = Material::layered(ggx, coat, base).unwrap();
     let direct = brdf::LayeredBrdf::new(MicrofacetBrdf::new(ggx, coat), base).unwrap();
     same(&m.bsdf(&fp, &scratch), &direct, "layered");
+    let m = Material::microfacet_compensated(ggx, gold).unwrap();
+    let direct = brdf::bxdf::EnergyCompensated::new(MicrofacetBrdf::new(ggx, gold)).unwrap();
+    same(&m.bsdf(&fp, &scratch), &direct, "compensated");
     let mirror = Material::mirror(gold);
     let direct = brdf::bxdf::SpecularReflection::new(gold);
     same(&mirror.bsdf(&fp, &scratch), &direct, "mirror");
@@ -169,6 +172,7 @@ fn white_furnace_through_materials() {
     let ggx = Ggx::isotropic(0.3).unwrap();
     let materials = [
         Material::microfacet(ggx, NoFresnel),
+        Material::microfacet_compensated(Ggx::isotropic(0.9).unwrap(), NoFresnel).unwrap(),
         Material::mirror(NoFresnel),
         GlintMaterial::new(model, NoFresnel).into(),
         NormalMappedMaterial::new(Arc::new(map), Material::microfacet(ggx, NoFresnel))
@@ -226,6 +230,8 @@ fn bad_construction_input_is_an_error() {
         let e = glint.clone().over_base(base).unwrap_err();
         assert!(e.to_string().contains("base"), "{e}");
     }
+    let e = Material::microfacet_compensated(Ggx::new(0.5, 1.5).unwrap(), NoFresnel).unwrap_err();
+    assert!(e.to_string().contains("alpha"), "{e}");
     let e = NormalMappedMaterial::new(map.clone(), Material::from(glint)).unwrap_err();
     assert!(e.to_string().contains("base"), "{e}");
     let lambert = Material::from(Lambert::new(Vec3::splat(0.5)).unwrap());

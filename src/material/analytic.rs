@@ -1,5 +1,6 @@
 //! The analytic NDFs a material can hold, as one enum implementing [`Ndf`] by dispatch.
 
+use crate::bxdf::{AlbedoTable, TabulatedAlbedo};
 use crate::ndf::{Beckmann, Ggx, Ndf};
 use glam::{Vec2, Vec3};
 
@@ -80,5 +81,14 @@ impl Ndf for AnalyticNdf {
     #[inline]
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
         forward!(self, n => n.pdf_visible(wo, m))
+    }
+}
+
+impl TabulatedAlbedo for AnalyticNdf {
+    fn albedo_table(&self) -> &'static AlbedoTable {
+        forward!(self, n => n.albedo_table())
+    }
+    fn table_alpha(&self) -> f32 {
+        forward!(self, n => n.table_alpha())
     }
 }

@@ -3,8 +3,8 @@
 
 use super::{AnalyticNdf, AnyFresnel};
 use crate::bxdf::{
-    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet,
-    NormalMapTilt, OriginalPhong, Phong, SpecularReflection,
+    BlinnPhongLobe, Bxdf, BxdfSample, EnergyCompensated, Lambert, LayeredBrdf, MicrofacetBrdf,
+    NormalMapMicrofacet, NormalMapTilt, OriginalPhong, Phong, SpecularReflection,
 };
 use crate::glint::GlintPatch;
 use glam::{Vec2, Vec3};
@@ -39,6 +39,7 @@ pub(super) enum Plain<'a> {
     OriginalPhong(&'a OriginalPhong),
     BlinnPhong(&'a BlinnPhongLobe),
     Microfacet(&'a MicrofacetBrdf<AnalyticNdf, AnyFresnel>),
+    Compensated(&'a EnergyCompensated<AnalyticNdf, AnyFresnel>),
     /// A copy per shading point: the layered BRDF caches R̂(wo), which must not be shared between
     /// threads shading other points.
     Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
@@ -54,6 +55,7 @@ macro_rules! forward_plain {
             Plain::OriginalPhong($b) => $e,
             Plain::BlinnPhong($b) => $e,
             Plain::Microfacet($b) => $e,
+            Plain::Compensated($b) => $e,
             Plain::Layered($b) => $e,
             Plain::Mirror($b) => $e,
         }

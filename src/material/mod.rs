@@ -33,7 +33,8 @@
 //! ```
 //!
 //! The variants: the analytic BRDFs ([`Material::Lambert`], the Phong family,
-//! [`Material::Microfacet`] over GGX or Beckmann, [`Material::Layered`]), the smooth limit
+//! [`Material::Microfacet`] over GGX or Beckmann, [`Material::Compensated`] with the energy of
+//! multiple scattering given back, [`Material::Layered`]), the smooth limit
 //! ([`Material::Mirror`], a delta lobe), glints ([`GlintMaterial`]: any glint model, alone or as a
 //! coat over a Lambertian base) and normal mapping ([`NormalMappedMaterial`]: any
 //! footprint-independent material about a normal map's normals, through microfacet-based or
@@ -65,8 +66,8 @@ pub use glint::GlintMaterial;
 pub use normal_mapped::{NormalMappedMaterial, NormalMapping};
 
 use crate::bxdf::{
-    BlinnPhongLobe, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet, NormalMapTilt,
-    OriginalPhong, Phong, SpecularReflection,
+    BlinnPhongLobe, EnergyCompensated, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet,
+    NormalMapTilt, OriginalPhong, Phong, SpecularReflection,
 };
 use crate::error::Result;
 use crate::glint::{Footprint, GlintNdf, GlintScratch};
@@ -86,8 +87,11 @@ pub enum Material {
     OriginalPhong(OriginalPhong),
     /// The Blinn-Phong lobe ([`BlinnPhongLobe`]).
     BlinnPhong(BlinnPhongLobe),
-    /// An analytic microfacet BRDF (GGX or Beckmann, any Fresnel term).
+    /// An analytic microfacet BRDF (GGX or Beckmann, any Fresnel term), single scattering.
     Microfacet(MicrofacetBrdf<AnalyticNdf, AnyFresnel>),
+    /// An analytic microfacet BRDF with the energy it loses to single scattering given back
+    /// ([`EnergyCompensated`], Kulla-Conty): rough metals stay bright and saturated.
+    Compensated(EnergyCompensated<AnalyticNdf, AnyFresnel>),
     /// An analytic microfacet layer over a Lambertian base ([`LayeredBrdf`]).
     Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
     /// A perfectly smooth reflector, the α → 0 limit of the microfacet BRDF: a delta lobe
@@ -105,6 +109,19 @@ impl Material {
     /// (any model of [`crate::fresnel`]), with the default masking and sampling.
     pub fn microfacet(ndf: impl Into<AnalyticNdf>, fresnel: impl Into<AnyFresnel>) -> Material {
         Material::Microfacet(MicrofacetBrdf::new(ndf.into(), fresnel.into()))
+    }
+
+    /// [`Material::microfacet`] with multiple-scattering energy compensation
+    /// ([`Material::Compensated`]).
+    ///
+    /// # Errors
+    /// Those of [`EnergyCompensated::new`]: a table α (√((αx² + αy²)/2)) above 1.
+    pub fn microfacet_compensated(
+        ndf: impl Into<AnalyticNdf>,
+        fresnel: impl Into<AnyFresnel>,
+    ) -> Result<Material> {
+        let brdf = MicrofacetBrdf::new(ndf.into(), fresnel.into());
+        Ok(Material::Compensated(EnergyCompensated::new(brdf)?))
     }
 
     /// A microfacet layer (`ndf`, `fresnel`) over a Lambertian base of RGB albedo `base`.
@@ -140,6 +157,7 @@ impl Material {
             Material::OriginalPhong(b) => Plain::OriginalPhong(b),
             Material::BlinnPhong(b) => Plain::BlinnPhong(b),
             Material::Microfacet(b) => Plain::Microfacet(b),
+            Material::Compensated(b) => Plain::Compensated(b),
             Material::Layered(b) => Plain::Layered(b.clone()),
             Material::Mirror(b) => Plain::Mirror(b),
             Material::Glint(_) | Material::NormalMapped(_) => return None,
@@ -200,6 +218,7 @@ material_from! {
     OriginalPhong(OriginalPhong),
     BlinnPhong(BlinnPhongLobe),
     Microfacet(MicrofacetBrdf<AnalyticNdf, AnyFresnel>),
+    Compensated(EnergyCompensated<AnalyticNdf, AnyFresnel>),
     Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
     Glint(GlintMaterial),
 }
