@@ -38,7 +38,9 @@ fn main() -> Res<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::common::render::showcase::{Options, glint_model, progress_bar, showcase};
+    use super::common::render::showcase::{
+        Options, glint_model, glint_options, progress_bar, showcase,
+    };
     use super::common::render::{Camera, Material, Scene, Sky, render};
     use brdf::fresnel::NoFresnel;
     use brdf::glint::{ScratchedParams, bumpy, scratched};
@@ -62,6 +64,7 @@ mod tests {
             |tiles| {
                 Ok(Material::Glint {
                     model,
+                    options: glint_options(),
                     fresnel: Box::new(brdf::fresnel::ConductorFresnel::GOLD),
                     tiles,
                 })
@@ -94,6 +97,7 @@ mod tests {
             radius: 1.0,
             sphere: Material::Glint {
                 model,
+                options: glint_options(),
                 fresnel: Box::new(NoFresnel),
                 tiles: Vec2::new(2.0, 1.0),
             },

@@ -8,6 +8,7 @@
 //! ‖m − r‖² minus the reference's own noise variance ‖a − b‖²/4 (E‖r − E r‖²), clamped at 0,
 //! over ‖r‖² — an unbiased estimate of the squared error against the reference's expectation.
 
+use super::orb::render::WithOptions;
 use super::orb::{
     Errors, Image, MapSource, OrbOptions, Scene, coverage, errors, gap_errors, glint_pixel,
     load_map, reference_noise, render_glint_evals, render_naive, render_references,
@@ -16,7 +17,7 @@ use super::{Artifact, Res, register_font, save_rgb};
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{MixtureParams, PatchOptions};
 use brdf::glint::position_normal::PositionNormalParams;
-use brdf::glint::{BeckmannMixture, BinMap, GlintModel, PositionNormalMap};
+use brdf::glint::{BeckmannMixture, BinMap, GlintModel, GlintOptions, PositionNormalMap};
 use glam::Vec2;
 use indicatif::ProgressBar;
 use plotters::prelude::*;
@@ -87,19 +88,20 @@ const SIGMA_EPS: f32 = brdf::glint::mixture::DEFAULT_SIGMA_MIN;
 const MAPS: [&str; 4] = ["scratched", "brushed", "bumpy", "flakes"];
 const EVALS: [u32; 3] = [1, 4, 16];
 
-/// The glint models of one map with their build times: the mixture as a path tracer would use it
-/// (64 quadrature nodes per lobe and `lod_lobes` 256, examples/render.rs), the bin map and the
-/// position-normal map at their defaults.
-fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<(String, GlintModel, f64)>> {
+/// The glint models of one map with their per-query options and build times: the mixture as a path
+/// tracer would use it (64 quadrature nodes per lobe, queried with `lod_lobes` 256,
+/// examples/render.rs), the bin map and the position-normal map at their defaults.
+fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<(String, GlintModel, GlintOptions, f64)>> {
     let t = Instant::now();
     let params = MixtureParams {
         sigma_min: SIGMA_EPS,
         samples: 64,
-        patch: PatchOptions {
-            lod_lobes: 256.0,
-            ..PatchOptions::default()
-        },
         ..MixtureParams::default()
+    };
+    let mut lod_256 = GlintOptions::default();
+    lod_256.mixture = PatchOptions {
+        lod_lobes: 256.0,
+        ..PatchOptions::default()
     };
     let mixture: GlintModel = BeckmannMixture::build(map, params)?.into();
     let mixture_s = t.elapsed().as_secs_f64();
@@ -110,9 +112,19 @@ fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<(String, GlintModel, f6
     let pn: GlintModel = PositionNormalMap::build(map, PositionNormalParams::default())?.into();
     let pn_s = t.elapsed().as_secs_f64();
     Ok(vec![
-        ("mixture (lod 256)".to_string(), mixture, mixture_s),
-        ("bin map".to_string(), binmap, binmap_s),
-        ("position-normal".to_string(), pn, pn_s),
+        ("mixture (lod 256)".to_string(), mixture, lod_256, mixture_s),
+        (
+            "bin map".to_string(),
+            binmap,
+            GlintOptions::default(),
+            binmap_s,
+        ),
+        (
+            "position-normal".to_string(),
+            pn,
+            GlintOptions::default(),
+            pn_s,
+        ),
     ])
 }
 
@@ -136,7 +148,12 @@ fn texels_per_pixel(scene: &Scene, mask: &[bool], map_w: usize, map_h: usize) ->
 
 /// Projected render time of `model` at `evals` evaluations per pixel, from 64 covered pixels spread
 /// over the image.
-fn pilot_seconds(scene: &Scene, mask: &[bool], model: &GlintModel, evals: u32) -> f64 {
+fn pilot_seconds(
+    scene: &Scene,
+    mask: &[bool],
+    model: &WithOptions<'_, GlintModel>,
+    evals: u32,
+) -> f64 {
     let covered: Vec<u32> = (0..scene.size * scene.size)
         .filter(|&k| mask[k as usize])
         .collect();
@@ -247,7 +264,11 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
                 points.push(point("naive", spp, 0.0, s, &img));
                 spp *= 4;
             }
-            for (label, model, build_s) in &models {
+            for (label, model, options, build_s) in &models {
+                let model = &WithOptions {
+                    model,
+                    options: options.clone(),
+                };
                 for evals in EVALS {
                     let projected = pilot_seconds(&scene, &mask, model, evals);
                     if projected > opts.budget_s {

@@ -3,14 +3,14 @@
 //! point light and an environment light, multiple importance sampling against BRDF sampling).
 //!
 //! Every BRDF is used the same way: radiance = Σ f(wo, wi) · L · cos θi / pdf, with the geometric
-//! cosine (local `wi.z`); the glint materials are `MicrofacetBrdf::new(model.patch_in(&footprint,
-//! scratch), fresnel)` and need nothing else. World space: y up, lengths in scene units; BRDFs see
+//! cosine (local `wi.z`); the glint materials are `MicrofacetBrdf::new(model.patch_with(&footprint,
+//! &options, Some(scratch)), fresnel)` (the material's per-query options) and need nothing else. World space: y up, lengths in scene units; BRDFs see
 //! directions in the local frame of the hit (z = normal, x = ∂p/∂u). See docs/render.md.
 
 use brdf::bxdf::{Bxdf, LayeredBrdf, MicrofacetBrdf};
 use brdf::frame::Frame;
 use brdf::fresnel::{ConductorFresnel, Fresnel};
-use brdf::glint::{Footprint, GlintModel, GlintNdf, GlintScratch};
+use brdf::glint::{Footprint, GlintModel, GlintNdf, GlintOptions, GlintScratch};
 use brdf::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
 use brdf::{Ggx, Lambert, Vec2, Vec3};
 use indicatif::ProgressBar;
@@ -38,15 +38,17 @@ pub enum Material {
     Checker { a: Lambert, b: Lambert, square: f32 },
     /// An analytic microfacet conductor.
     Conductor(MicrofacetBrdf<Ggx, ConductorFresnel>),
-    /// A glint microfacet BRDF over a normal map.
+    /// A glint microfacet BRDF over a normal map, queried with `options`.
     Glint {
         model: Arc<GlintModel>,
+        options: GlintOptions,
         fresnel: Box<dyn Fresnel + Send + Sync>,
         tiles: Vec2,
     },
     /// A glint specular layer over a Lambertian base of albedo `base` ([`LayeredBrdf`]).
     GlintCoat {
         model: Arc<GlintModel>,
+        options: GlintOptions,
         fresnel: Box<dyn Fresnel + Send + Sync>,
         tiles: Vec2,
         base: Vec3,
@@ -89,20 +91,22 @@ impl Material {
             Material::Conductor(brdf) => f(brdf),
             Material::Glint {
                 model,
+                options,
                 fresnel,
                 tiles,
             } => f(&MicrofacetBrdf::new(
-                model.patch_in(&footprint(*tiles), scratch),
+                model.patch_with(&footprint(*tiles), options, Some(scratch)),
                 fresnel,
             )),
             Material::GlintCoat {
                 model,
+                options,
                 fresnel,
                 tiles,
                 base,
             } => {
-                let coat =
-                    MicrofacetBrdf::new(model.patch_in(&footprint(*tiles), scratch), fresnel);
+                let patch = model.patch_with(&footprint(*tiles), options, Some(scratch));
+                let coat = MicrofacetBrdf::new(patch, fresnel);
                 match LayeredBrdf::new(coat, *base) {
                     Ok(layered) => f(&layered),
                     Err(_) => f(&Black),

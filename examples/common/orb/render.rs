@@ -11,8 +11,8 @@ use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, Footprint, GlintNdf, Kernel, MixturePatch, NormalMap,
-    PositionNormalMap, footprint_brdf,
+    BeckmannMixture, BinMap, Footprint, GlintNdf, Kernel, NormalMap, PositionNormalMap,
+    footprint_brdf,
 };
 use glam::{Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -246,34 +246,34 @@ pub fn mean_image(a: &Image, b: &Image) -> Image {
     }
 }
 
-/// A [`BeckmannMixture`] seen with fixed patch options (exact / approximate masking, level of
-/// detail), so that each variant is a [`GlintNdf`] of its own.
-pub struct MixtureVariant<'a> {
-    /// The mixture.
-    pub mixture: &'a BeckmannMixture,
-    /// The patch options of this variant.
-    pub options: PatchOptions,
+/// A glint model seen with fixed per-query options (for the mixture: exact / approximate masking,
+/// level of detail), so that each variant is a [`GlintNdf`] of its own: its queries take no options
+/// (`()`) and pass the variant's to the model, as a renderer's material would.
+pub struct WithOptions<'a, G: GlintNdf> {
+    /// The model.
+    pub model: &'a G,
+    /// The per-query options of this variant.
+    pub options: G::Options,
 }
 
-impl GlintNdf for MixtureVariant<'_> {
+/// A [`BeckmannMixture`] with fixed [`PatchOptions`].
+pub type MixtureVariant<'a> = WithOptions<'a, BeckmannMixture>;
+
+impl<G: GlintNdf> GlintNdf for WithOptions<'_, G> {
     type Patch<'b>
-        = MixturePatch<'b>
+        = G::Patch<'b>
     where
         Self: 'b;
 
-    type Options = PatchOptions;
-
-    fn options(&self) -> PatchOptions {
-        self.options
-    }
+    type Options = ();
 
     fn patch_with<'b>(
         &'b self,
         footprint: &Footprint,
-        options: &PatchOptions,
+        _options: &(),
         scratch: Option<&'b mut brdf::glint::GlintScratch>,
-    ) -> MixturePatch<'b> {
-        self.mixture.patch_with(footprint, options, scratch)
+    ) -> G::Patch<'b> {
+        self.model.patch_with(footprint, &self.options, scratch)
     }
 }
 
@@ -309,21 +309,21 @@ pub fn render_all(opts: &OrbOptions, map: &NormalMap) -> Res<(References, f64, V
     let mixture_build = t.elapsed().as_secs_f64();
 
     let exact = MixtureVariant {
-        mixture: &mixture,
+        model: &mixture,
         options: PatchOptions {
             masking: MaskingMode::Exact,
             ..PatchOptions::default()
         },
     };
     let approximate = MixtureVariant {
-        mixture: &mixture,
+        model: &mixture,
         options: PatchOptions {
             masking: MaskingMode::Approximate,
             ..PatchOptions::default()
         },
     };
     let filtered = MixtureVariant {
-        mixture: &mixture,
+        model: &mixture,
         options: PatchOptions {
             masking: MaskingMode::Approximate,
             lod_lobes: 0.0,

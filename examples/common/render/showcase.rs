@@ -8,8 +8,8 @@ use brdf::bxdf::MicrofacetBrdf;
 use brdf::fresnel::{ConductorFresnel, DielectricFresnel};
 use brdf::glint::mixture::{MixtureParams, PatchOptions};
 use brdf::glint::{
-    BeckmannMixture, FlakesParams, GlintModel, NormalMap, NormalRepair, ScratchedParams,
-    TangentConvention, flakes, scratched,
+    BeckmannMixture, FlakesParams, GlintModel, GlintOptions, NormalMap, NormalRepair,
+    ScratchedParams, TangentConvention, flakes, scratched,
 };
 use brdf::{Ggx, Lambert, Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -59,19 +59,26 @@ impl Options {
 }
 
 /// A glint model of `map`: the Beckmann mixture of \[Chermain2019\] with 64 quadrature nodes per
-/// lobe (the orb example's setting, 4× faster to build than the default) and its level of detail at
-/// 256 lobes, so that the wide footprints of secondary hits cost one filtered lobe (the default
-/// threshold, 16384, lets a bounce off the ground query thousands of lobes: minutes per image).
+/// lobe (the orb example's setting, 4× faster to build than the default), queried with
+/// [`glint_options`].
 pub fn glint_model(map: &NormalMap) -> Res<Arc<GlintModel>> {
     let params = MixtureParams {
         samples: 64,
-        patch: PatchOptions {
-            lod_lobes: 256.0,
-            ..PatchOptions::default()
-        },
         ..MixtureParams::default()
     };
     Ok(Arc::new(BeckmannMixture::build(map, params)?.into()))
+}
+
+/// The per-query options of the glint materials: the mixture's level of detail at 256 lobes, so
+/// that the wide footprints of secondary hits cost one filtered lobe (the default threshold, 16384,
+/// lets a bounce off the ground query thousands of lobes: minutes per image).
+pub fn glint_options() -> GlintOptions {
+    let mut options = GlintOptions::default();
+    options.mixture = PatchOptions {
+        lod_lobes: 256.0,
+        ..PatchOptions::default()
+    };
+    options
 }
 
 /// A hammered-metal height field (overlapping parabolic dents, the deepest wins), `n` × `n`, tiled,
@@ -184,6 +191,7 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
             Box::new(move |tiles| {
                 Ok(Material::Glint {
                     model: scratched,
+                    options: glint_options(),
                     fresnel: Box::new(ConductorFresnel::SILVER),
                     tiles,
                 })
@@ -195,6 +203,7 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
             Box::new(move |tiles| {
                 Ok(Material::Glint {
                     model: hammered,
+                    options: glint_options(),
                     fresnel: Box::new(ConductorFresnel::COPPER),
                     tiles,
                 })
@@ -207,6 +216,7 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
                 let fresnel = Box::new(DielectricFresnel::new(1.5)?);
                 Ok(Material::GlintCoat {
                     model: flakes,
+                    options: glint_options(),
                     fresnel,
                     tiles,
                     base: Vec3::new(0.5, 0.03, 0.02),
