@@ -112,7 +112,7 @@ proptest::proptest! {
         let (name, mix) = &block_mixtures()[which];
         let fp = Footprint::anisotropic_texels(
             Vec2::new(cx, cy), log_area.exp2(), aspect, angle, N, N);
-        let patch = exact_patch(&mix, &fp);
+        let patch = exact_patch(mix, &fp);
         let m = if own {
             patch.sample_normal(Vec2::new(u0, u1))
         } else {

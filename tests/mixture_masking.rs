@@ -251,7 +251,7 @@ proptest::proptest! {
     ) {
         let (name, mix) = &block_mixtures()[which];
         let fp = Footprint::isotropic_texels(Vec2::new(cx, cy), log_area.exp2(), N, N);
-        let patch = exact_patch(&mix, &fp);
+        let patch = exact_patch(mix, &fp);
         let w = support::dir(theta as f64, phi as f64);
         let reference: f64 = patch
             .weighted_lobes()
