@@ -132,7 +132,9 @@ use crate::ndf::Ndf;
 /// its file (`save` / `load`) stores no options, so a patch depends on the model, the footprint and
 /// the options passed, and on nothing else: a loaded model with the same options gives bit-identical
 /// patches, and [`GlintNdf::patch`] always means the documented defaults. A renderer that wants
-/// other options keeps them with its material and passes them to every query.
+/// other options keeps them with its material and passes them to every query. There is no
+/// accessor for "the model's options": a model has none to report, and a `patch` whose meaning
+/// depended on how the model was built or loaded is the hidden state this design rules out.
 ///
 /// # Example
 ///
