@@ -56,17 +56,22 @@ fn maps() -> Vec<(&'static str, NormalMap)> {
     ]
 }
 
-/// Exact masking, the level of detail off, in the given storage.
+/// Default build parameters in the given storage.
 fn params(storage: LobeStorage) -> MixtureParams {
     MixtureParams {
-        patch: PatchOptions {
-            masking: MaskingMode::Exact,
-            lod_lobes: f32::INFINITY,
-            lod_tolerance: 0.0,
-            ..PatchOptions::default()
-        },
         storage,
         ..MixtureParams::default()
+    }
+}
+
+/// Exact masking, the level of detail off: the patch options of every bench but the level-of-detail
+/// ones.
+fn exact() -> PatchOptions {
+    PatchOptions {
+        masking: MaskingMode::Exact,
+        lod_lobes: f32::INFINITY,
+        lod_tolerance: 0.0,
+        ..PatchOptions::default()
     }
 }
 
@@ -155,7 +160,7 @@ fn queries(c: &mut Criterion) {
             let f = footprint(area);
             for (label, mix) in &mixes {
                 g.bench_with_input(BenchmarkId::new(*label, area), &f, |b, f| {
-                    b.iter(|| mix.patch(black_box(f)).lobe_count())
+                    b.iter(|| mix.patch_with(black_box(f), &exact(), None).lobe_count())
                 });
             }
         }
@@ -164,9 +169,9 @@ fn queries(c: &mut Criterion) {
         let mut g = c.benchmark_group(format!("mixture_d/{name}"));
         g.throughput(Throughput::Elements(BATCH as u64));
         for area in AREAS {
-            let m = normals(&full.patch(&footprint(area)), 7);
+            let m = normals(&full.patch_with(&footprint(area), &exact(), None), 7);
             for (label, mix) in &mixes {
-                let patch = mix.patch(&footprint(area));
+                let patch = mix.patch_with(&footprint(area), &exact(), None);
                 g.bench_with_input(BenchmarkId::new(*label, area), &m, |b, m| {
                     b.iter(|| m.iter().map(|&h| patch.d(black_box(h))).sum::<f32>())
                 });
@@ -179,7 +184,7 @@ fn queries(c: &mut Criterion) {
         g.throughput(Throughput::Elements(BATCH as u64));
         for area in AREAS {
             for (label, mix) in &mixes {
-                let patch = mix.patch(&footprint(area));
+                let patch = mix.patch_with(&footprint(area), &exact(), None);
                 g.bench_with_input(BenchmarkId::new(*label, area), &w, |b, w| {
                     b.iter(|| {
                         w.iter()
@@ -195,7 +200,7 @@ fn queries(c: &mut Criterion) {
         g.throughput(Throughput::Elements(BATCH as u64));
         for area in AREAS {
             for (label, mix) in &mixes {
-                let patch = mix.patch(&footprint(area));
+                let patch = mix.patch_with(&footprint(area), &exact(), None);
                 g.bench_with_input(BenchmarkId::new(*label, area), &w, |b, w| {
                     b.iter(|| {
                         w.iter()
@@ -210,9 +215,12 @@ fn queries(c: &mut Criterion) {
         let mut g = c.benchmark_group(format!("mixture_eval_pdf/{name}"));
         g.throughput(Throughput::Elements(BATCH as u64));
         for area in AREAS {
-            let io = pairs(&full.patch(&footprint(area)));
+            let io = pairs(&full.patch_with(&footprint(area), &exact(), None));
             for (label, mix) in &mixes {
-                let brdf = MicrofacetBrdf::new(mix.patch(&footprint(area)), NoFresnel);
+                let brdf = MicrofacetBrdf::new(
+                    mix.patch_with(&footprint(area), &exact(), None),
+                    NoFresnel,
+                );
                 g.bench_with_input(BenchmarkId::new(*label, area), &io, |b, io| {
                     b.iter(|| {
                         io.iter()
@@ -232,7 +240,7 @@ fn queries(c: &mut Criterion) {
         for area in AREAS {
             let options = PatchOptions {
                 masking: MaskingMode::Approximate,
-                ..params(LobeStorage::Full).patch
+                ..exact()
             };
             let patch = full.patch_with(&footprint(area), &options, None);
             g.bench_with_input(BenchmarkId::from_parameter(area), &w, |b, w| {

@@ -18,7 +18,7 @@ type Part = fn(&Path, bool) -> Res<Vec<Artifact>>;
 fn main() -> Res<()> {
     let out = common::out_dir()?;
     let quick = !common::has_flag("--full");
-    let parts: [(&str, &str, Part); 10] = [
+    let parts: [(&str, &str, Part); 11] = [
         (
             "Analytic core",
             "NDF slices, Smith masking and Fresnel curves.",
@@ -86,9 +86,10 @@ fn main() -> Res<()> {
         (
             "Glints in a path tracer",
             "A small path tracer (point light + sky, next-event estimation with MIS, a few bounces) \
-             shading one sphere with analytic gold, two glint conductors (a procedural scratched map \
-             and a PNG normal map the example writes first) and a glint clear coat over red paint, \
-             through the public API only (the render example, quick setting).",
+             shading one sphere with analytic gold, a perfect mirror, two glint conductors (a \
+             procedural scratched map and a PNG normal map the example writes first) and a glint \
+             clear coat over red paint, every material a `brdf::Material`, through the public API \
+             only (the render example, quick setting).",
             common::render::showcase::run,
         ),
     ];

@@ -77,7 +77,7 @@ mod tests {
 
     fn variants(m: &BeckmannMixture) -> [MixtureVariant<'_>; 3] {
         let v = |masking, lod_lobes| MixtureVariant {
-            mixture: m,
+            model: m,
             // Tolerance 0: the full mixture (or the filtered lobe), not a level of detail.
             options: PatchOptions {
                 masking,

@@ -38,9 +38,8 @@ fn main() -> Res<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::common::render::showcase::{Options, glint_model, progress_bar, showcase};
+    use super::common::render::showcase::{Options, glint_material, progress_bar, showcase};
     use super::common::render::{Camera, Scene, Sky, render};
-    use brdf::GlintMaterial;
     use brdf::fresnel::NoFresnel;
     use brdf::glint::{ScratchedParams, bumpy, scratched};
     use brdf::{Vec2, Vec3};
@@ -57,16 +56,9 @@ mod tests {
             texels_per_pixel: 3.0,
             progress: false,
         };
-        let model =
-            glint_model(&scratched(32, 32, ScratchedParams::default(), 1).unwrap()).unwrap();
-        let scene = showcase(
-            |tiles| {
-                let glints = GlintMaterial::new(model, brdf::fresnel::ConductorFresnel::GOLD);
-                Ok(glints.with_uv_scale(tiles)?.into())
-            },
-            &opts,
-        )
-        .unwrap();
+        let map = scratched(32, 32, ScratchedParams::default(), 1).unwrap();
+        let glints = glint_material(&map, brdf::fresnel::ConductorFresnel::GOLD).unwrap();
+        let scene = showcase(|tiles| Ok(glints.with_uv_scale(tiles)?.into()), &opts).unwrap();
         let img = render(&scene, opts.spp, 1, &progress_bar(false, 16, ""));
         assert_eq!(img.pixels.len(), 256);
         assert!(
@@ -86,8 +78,9 @@ mod tests {
     fn white_furnace_glint_sphere_is_at_most_one() {
         let (w, h, spp) = (32u32, 32u32, 16u32);
         // A rough map (RMS slope 0.3), so that both the sky sampler and BRDF sampling carry weight.
-        let model = glint_model(&bumpy(64, 64, 0.3, 4.0, 2).unwrap()).unwrap();
-        let glints = GlintMaterial::new(model, NoFresnel).with_uv_scale(Vec2::new(2.0, 1.0));
+        let map = bumpy(64, 64, 0.3, 4.0, 2).unwrap();
+        let glints = glint_material(&map, NoFresnel).unwrap();
+        let glints = glints.with_uv_scale(Vec2::new(2.0, 1.0));
         let scene = Scene {
             materials: vec![glints.unwrap().into()],
             center: Vec3::ZERO,

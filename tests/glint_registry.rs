@@ -76,7 +76,7 @@ fn glint_model_load_refuses_what_is_no_glint_model() {
 }
 
 /// Options are per query: the same model answers with the options it is given, and `patch` uses
-/// the model's own.
+/// the defaults.
 #[test]
 fn options_are_per_query() {
     let map = brdf::glint::scratched(32, 32, Default::default(), 11).unwrap();
@@ -93,12 +93,63 @@ fn options_are_per_query() {
     let fp = Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 9.0, 32, 32);
     let w = Vec3::new(0.3, 0.1, 0.95).normalize();
     for ex in &examples {
-        let own = ex.model.options();
         assert_eq!(
             ex.model.patch(&fp).d(w).to_bits(),
-            ex.model.patch_with(&fp, &own, None).d(w).to_bits(),
+            ex.model
+                .patch_with(&fp, &GlintOptions::default(), None)
+                .d(w)
+                .to_bits(),
             "{}",
             ex.label
+        );
+    }
+}
+
+/// Options survive save/load because no file holds them: a loaded model given the same non-default
+/// options answers bit-identically to the built one, and its `patch` is the built model's patch at
+/// the defaults (no option travels hidden in the file). Every registered model has an example whose
+/// options change its answers, so the comparison can fail.
+#[test]
+fn options_survive_save_load() {
+    let map = brdf::glint::scratched(32, 32, Default::default(), 11).unwrap();
+    let defaults = GlintOptions::default();
+    let mut changed = Vec::new();
+    for ex in support::registry::examples(&map) {
+        let mut bytes = Vec::new();
+        ex.model.save(&mut bytes).unwrap();
+        let loaded = GlintModel::load(&mut bytes.as_slice()).unwrap();
+        let with_options = fingerprint(&ex.model, &ex.options);
+        let at_defaults = fingerprint(&ex.model, &defaults);
+        assert_eq!(
+            fingerprint(&loaded, &ex.options),
+            with_options,
+            "{}: the loaded model answers differently with the same options",
+            ex.label
+        );
+        assert_eq!(
+            fingerprint(&loaded, &defaults),
+            at_defaults,
+            "{}: the loaded model's defaults differ from the built model's",
+            ex.label
+        );
+        let (fp, w) = (
+            Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 200.0, 32, 32),
+            Vec3::new(0.3, 0.1, 0.95).normalize(),
+        );
+        assert_eq!(
+            loaded.patch(&fp).d(w).to_bits(),
+            ex.model.patch_with(&fp, &defaults, None).d(w).to_bits(),
+            "{}: the loaded model's `patch` is not the default patch",
+            ex.label
+        );
+        if with_options != at_defaults {
+            changed.push(ex.model.name());
+        }
+    }
+    for name in GlintModel::NAMES {
+        assert!(
+            changed.contains(name),
+            "{name}: no example whose options change its answers (tests/support/registry.rs)"
         );
     }
 }

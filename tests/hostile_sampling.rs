@@ -388,18 +388,18 @@ fn position_normal_weights_are_bounded() {
 fn mixture_weights_are_bounded() {
     let map = bumpy(16, 16, 0.3, 3.0, 11).unwrap();
     let us = u_values(4, 8);
+    let params = MixtureParams {
+        samples: 16,
+        ..MixtureParams::default()
+    };
+    let mixture = BeckmannMixture::build(&map, params).unwrap();
     for masking in [MaskingMode::Exact, MaskingMode::Approximate] {
-        let params = MixtureParams {
-            samples: 16,
-            patch: MixtureOptions {
-                masking,
-                ..MixtureOptions::default()
-            },
-            ..MixtureParams::default()
+        let options = MixtureOptions {
+            masking,
+            ..MixtureOptions::default()
         };
-        let mixture = BeckmannMixture::build(&map, params).unwrap();
         for fp in footprints() {
-            let patch = mixture.patch(&fp);
+            let patch = mixture.patch_with(&fp, &options, None);
             let worst = check_patch(&format!("mixture {masking:?}"), patch, &us, 1.0);
             eprintln!("mixture {masking:?} {fp:?}: worst weight = {worst}");
         }

@@ -120,7 +120,7 @@ fn glint_variants_are_their_patches() {
         let direct = brdf::LayeredBrdf::new(layer, base).unwrap();
         same(&coat.bsdf(&fp, &scratch), &direct, ex.label);
     }
-    // Without explicit options the material uses the model's own.
+    // Without explicit options the material queries with the defaults, as `patch` does.
     let model: Arc<GlintModel> = Arc::new(support::registry::examples(&map).remove(0).model);
     let m = Material::from(GlintMaterial::new(model.clone(), silver));
     same(

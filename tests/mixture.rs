@@ -16,10 +16,10 @@ use support::mixture::*;
 #[test]
 fn weights_sum_to_one_and_cover_the_footprint() {
     let map = glint::bumpy(N, N, 0.25, 4.0, 1).unwrap();
-    let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
+    let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
     for area in [0.0, 1e-6, 1.0, 16.0, 4096.0, 1e9] {
         for c in [Vec2::new(0.5, 0.5), Vec2::new(0.001, 0.999)] {
-            let p = mix.patch(&footprint(area, c));
+            let p = exact_patch(&mix, &footprint(area, c));
             let sum: f64 = p.weighted_lobes().map(|(w, _)| w as f64).sum();
             // f32 weights summed in f64: ≤ slots × 2⁻²⁴ relative rounding (≤ 4096 slots → 2.4e-4,
             // in practice ~1e-6).
@@ -53,9 +53,9 @@ fn hierarchy_d_equals_the_brute_force_sum() {
     let mut rng = support::rng(9);
     let mut max_touched_frac = 0.0f64;
     for (name, map) in maps() {
-        let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
+        let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
         for area in AREAS {
-            let patch = mix.patch(&footprint(area, Vec2::new(0.37, 0.61)));
+            let patch = exact_patch(&mix, &footprint(area, Vec2::new(0.37, 0.61)));
             let lobes: Vec<_> = patch.weighted_lobes().collect();
             for k in 0..200 {
                 let m = probe_normal(&patch, &mut rng, k);
@@ -112,7 +112,7 @@ proptest::proptest! {
         let (name, mix) = &block_mixtures()[which];
         let fp = Footprint::anisotropic_texels(
             Vec2::new(cx, cy), log_area.exp2(), aspect, angle, N, N);
-        let patch = mix.patch(&fp);
+        let patch = exact_patch(mix, &fp);
         let m = if own {
             patch.sample_normal(Vec2::new(u0, u1))
         } else {
@@ -188,26 +188,6 @@ fn bad_input() {
             "slope_tail",
             MixtureParams {
                 slope_tail: 1.0,
-                ..Default::default()
-            },
-        ),
-        (
-            "lod_tolerance",
-            MixtureParams {
-                patch: PatchOptions {
-                    lod_tolerance: -0.1,
-                    ..Default::default()
-                },
-                ..Default::default()
-            },
-        ),
-        (
-            "lod_tolerance",
-            MixtureParams {
-                patch: PatchOptions {
-                    lod_tolerance: f32::NAN,
-                    ..Default::default()
-                },
                 ..Default::default()
             },
         ),
@@ -377,11 +357,11 @@ fn accuracy_table() {
     );
     println!("|---|---|---|---|---|---|---|");
     for (name, map) in &maps {
-        let mix = BeckmannMixture::build(map, exact_params()).unwrap();
+        let mix = BeckmannMixture::build(map, MixtureParams::default()).unwrap();
         for area in [1.0f32, 16.0, 256.0, 4096.0] {
             let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
             let t = truths(map, &fp, 4_000_000);
-            let exact = mix.patch(&fp);
+            let exact = exact_patch(&mix, &fp);
             let lod = mix.patch_with(
                 &fp,
                 &PatchOptions {
@@ -416,7 +396,7 @@ fn accuracy_table() {
             &small,
             MixtureParams {
                 samples: 16384,
-                ..exact_params()
+                ..MixtureParams::default()
             },
         )
         .unwrap();
@@ -425,7 +405,7 @@ fn accuracy_table() {
                 &small,
                 MixtureParams {
                     samples,
-                    ..exact_params()
+                    ..MixtureParams::default()
                 },
             )
             .unwrap();
@@ -463,11 +443,11 @@ fn lod_table() {
     );
     println!("|---|---|---|---|---|---|");
     for (name, map) in &maps {
-        let mix = BeckmannMixture::build(map, exact_params()).unwrap();
+        let mix = BeckmannMixture::build(map, MixtureParams::default()).unwrap();
         for area in [1024.0f32, 4096.0, 16384.0, 65536.0] {
             let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
             let reference = binned_pndf(map, &fp, Kernel::Gaussian, &bins, 4_000_000, 17);
-            let exact = mix.patch(&fp);
+            let exact = exact_patch(&mix, &fp);
             let filtered = mix.patch_with(
                 &fp,
                 &PatchOptions {

@@ -8,7 +8,7 @@ mod support;
 
 use brdf::bxdf::Masking;
 use brdf::fresnel::NoFresnel;
-use brdf::glint::mixture::{MaskingMode, PatchOptions};
+use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
 use brdf::glint::{BeckmannMixture, Footprint, GlintNdf, MixturePatch};
 use brdf::ndf::Ndf;
 use brdf::{MicrofacetBrdf, Vec2};
@@ -39,7 +39,7 @@ fn lod_against_full(
             // The continuous bound: this compares continuous TVs (tests/mixture_lod.rs checks the
             // bounds at r > 0 against blurred TVs).
             lod_resolution: 0.0,
-            ..exact_params().patch
+            ..exact_options()
         },
         None,
     );
@@ -60,9 +60,9 @@ fn level_of_detail_respects_its_tolerance() {
     let centre = Vec2::new(0.43, 0.57);
     let mut merged = 0;
     for (name, map) in procedural_maps() {
-        let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
+        let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
         let fp = footprint(256.0, centre);
-        let full = mix.patch(&fp);
+        let full = exact_patch(&mix, &fp);
         assert_eq!(full.level(), 0);
         let gv = grid_values(&full);
         for tol in [0.02f32, 0.3] {
@@ -104,7 +104,7 @@ fn merged_patch<'a>(mix: &'a BeckmannMixture, area: f32, masking: MaskingMode) -
 fn level_d_equals_the_brute_force_sum() {
     let mut rng = support::rng(19);
     for (name, map) in maps() {
-        let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
+        let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
         for area in [256.0, 4096.0] {
             let patch = merged_patch(&mix, area, MaskingMode::Exact);
             let lobes: Vec<_> = patch.weighted_lobes().collect();
@@ -133,7 +133,7 @@ fn level_d_equals_the_brute_force_sum() {
 /// lobes go through the same D, masking and sampling code, with the same guarantees.
 #[test]
 fn chi_square_and_furnace_at_a_merged_level() {
-    let mix = BeckmannMixture::build(&noise(N, 4), exact_params()).unwrap();
+    let mix = BeckmannMixture::build(&noise(N, 4), MixtureParams::default()).unwrap();
     // The cost cap forces level 1 on a 16-texel footprint (16 / 4 nodes ≤ 8 < 16): few nodes, so the
     // 10⁶-draw chi-square of the O(nodes) visible sampler stays cheap in the default debug build.
     let patch = mix.patch_with(
@@ -149,7 +149,7 @@ fn chi_square_and_furnace_at_a_merged_level() {
     assert_eq!(patch.level(), 1);
     support::chi2_patch_samplers(&patch, "level-1", &[60.0], true);
     for (name, map) in procedural_maps() {
-        let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
+        let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
         for masking in [MaskingMode::Exact, MaskingMode::Approximate] {
             let patch = merged_patch(&mix, 1024.0, masking);
             for theta in [0.0, 70.0, 85.0] {
@@ -179,10 +179,10 @@ fn lod_check() {
     println!("| map | texels | tolerance | level | bound | TV to the full mixture |");
     println!("|---|---|---|---|---|---|");
     for (name, map) in support::procedural_maps(n) {
-        let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
+        let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
         for area in [64.0f32, 256.0, 1024.0] {
             let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
-            let full = mix.patch(&fp);
+            let full = exact_patch(&mix, &fp);
             let gv = grid_values(&full);
             for tol in [0.03f32, 0.1, 0.3] {
                 let (level, bound, tv, q) = lod_against_full(&mix, &fp, tol, &gv);

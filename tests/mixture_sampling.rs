@@ -5,7 +5,8 @@ mod support;
 
 use brdf::bxdf::Masking;
 use brdf::fresnel::NoFresnel;
-use brdf::glint::{self, BeckmannMixture, GlintNdf};
+use brdf::glint::mixture::MixtureParams;
+use brdf::glint::{self, BeckmannMixture};
 use brdf::ndf::Ndf;
 use brdf::{Bxdf, MicrofacetBrdf, Vec2};
 use rand::RngExt;
@@ -18,9 +19,12 @@ fn chi_square_of_both_samplers() {
     // expected count is 1e-4 … 1e-3 at every grid resolution tried, below the harness's "zero
     // support" threshold (1e-3 expected draws), which then fails the test. Smooth maps get a support
     // check instead: every draw has a finite positive pdf.
-    let smooth =
-        BeckmannMixture::build(&glint::bumpy(N, N, 0.25, 4.0, 4).unwrap(), exact_params()).unwrap();
-    let smooth_patch = smooth.patch(&footprint(16.0, Vec2::new(0.3, 0.3)));
+    let smooth = BeckmannMixture::build(
+        &glint::bumpy(N, N, 0.25, 4.0, 4).unwrap(),
+        MixtureParams::default(),
+    )
+    .unwrap();
+    let smooth_patch = exact_patch(&smooth, &footprint(16.0, Vec2::new(0.3, 0.3)));
     let mut rng = support::rng(21);
     for theta in [0.0, 30.0, 60.0, 75.0] {
         let wo = support::dir(theta, 20.0);
@@ -34,18 +38,18 @@ fn chi_square_of_both_samplers() {
             assert!(p > 0.0 && p.is_finite(), "{m}: {p}");
         }
     }
-    let mix = BeckmannMixture::build(&noise(N, 4), exact_params()).unwrap();
-    let patch = mix.patch(&footprint(16.0, Vec2::new(0.3, 0.3)));
+    let mix = BeckmannMixture::build(&noise(N, 4), MixtureParams::default()).unwrap();
+    let patch = exact_patch(&mix, &footprint(16.0, Vec2::new(0.3, 0.3)));
     support::chi2_patch_samplers(&patch, "mixture", &[30.0, 75.0], true);
 }
 
 #[test]
 fn reciprocity_and_sample_eval_pdf_agreement() {
     let map = glint::bumpy(N, N, 0.25, 4.0, 3).unwrap();
-    let mix = BeckmannMixture::build(&map, exact_params()).unwrap();
+    let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
     let mut rng = support::rng(11);
     for area in [1.0, 64.0] {
-        let patch = mix.patch(&footprint(area, Vec2::new(0.2, 0.8)));
+        let patch = exact_patch(&mix, &footprint(area, Vec2::new(0.2, 0.8)));
         for masking in [Masking::Separable, Masking::HeightCorrelated] {
             let brdf = MicrofacetBrdf::new(&patch, NoFresnel).with_masking(masking);
             for _ in 0..200 {

@@ -320,20 +320,18 @@ fn issue_cases() {
 #[test]
 fn mixture_patch_pdfs_vanish_where_d_does() {
     let map = bumpy(16, 16, 0.3, 3.0, 5).unwrap();
-    let mut patches: Vec<(String, BeckmannMixture)> = Vec::new();
+    let quick = MixtureParams {
+        samples: 16,
+        ..MixtureParams::default()
+    };
+    let bumpy_mixture = BeckmannMixture::build(&map, quick).unwrap();
+    let mut patches: Vec<(String, &BeckmannMixture, MixtureOptions)> = Vec::new();
     for masking in [MaskingMode::Exact, MaskingMode::Approximate] {
-        let params = MixtureParams {
-            samples: 16,
-            patch: MixtureOptions {
-                masking,
-                ..MixtureOptions::default()
-            },
-            ..MixtureParams::default()
+        let options = MixtureOptions {
+            masking,
+            ..MixtureOptions::default()
         };
-        patches.push((
-            format!("mixture {masking:?}"),
-            BeckmannMixture::build(&map, params).unwrap(),
-        ));
+        patches.push((format!("mixture {masking:?}"), &bumpy_mixture, options));
     }
     // A 2×2 map of isolated lobes, seen through sub-texel footprints: patches of one or two lobes,
     // whose truncated tails are not covered by any other lobe.
@@ -348,23 +346,21 @@ fn mixture_patch_pdfs_vanish_where_d_does() {
         ],
     )
     .unwrap();
+    let sparse_mixture = BeckmannMixture::build(&sparse, quick).unwrap();
     patches.push((
         "mixture sparse".into(),
-        BeckmannMixture::build(
-            &sparse,
-            MixtureParams {
-                samples: 16,
-                ..MixtureParams::default()
-            },
-        )
-        .unwrap(),
+        &sparse_mixture,
+        MixtureOptions::default(),
     ));
     let ndfs: Vec<Named<'_>> = patches
         .iter()
-        .flat_map(|(label, m)| {
+        .flat_map(|(label, m, options)| {
             let n = m.map_size().0;
             [0.25f32, 0.5, 8.0, 200.0].map(|t| -> Named<'_> {
-                (format!("{label} {t}"), Box::new(m.patch(&footprint(t, n))))
+                (
+                    format!("{label} {t}"),
+                    Box::new(m.patch_with(&footprint(t, n), options, None)),
+                )
             })
         })
         .collect();

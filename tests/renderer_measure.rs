@@ -84,28 +84,19 @@ fn assert_at_most_one(what: &str, (e, se): (f64, f64)) {
 
 /// The glint models of one map, built once.
 struct Models {
-    mixture_exact: BeckmannMixture,
-    mixture_approx: BeckmannMixture,
+    mixture: BeckmannMixture,
     bin_map: BinMap,
     position_normal: PositionNormalMap,
 }
 
 impl Models {
     fn build(map: &NormalMap) -> Models {
-        let mixture = |masking| {
-            let params = MixtureParams {
-                samples: 64,
-                patch: PatchOptions {
-                    masking,
-                    ..PatchOptions::default()
-                },
-                ..MixtureParams::default()
-            };
-            BeckmannMixture::build(map, params).unwrap()
+        let params = MixtureParams {
+            samples: 64,
+            ..MixtureParams::default()
         };
         Models {
-            mixture_exact: mixture(MaskingMode::Exact),
-            mixture_approx: mixture(MaskingMode::Approximate),
+            mixture: BeckmannMixture::build(map, params).unwrap(),
             bin_map: BinMap::build(map, BinMapParams::default()).unwrap(),
             position_normal: PositionNormalMap::build(map, PositionNormalParams::default())
                 .unwrap(),
@@ -114,8 +105,15 @@ impl Models {
 
     /// Runs `f(name, patch)` for every glint patch of a footprint.
     fn for_each_patch(&self, fp: &Footprint, mut f: impl FnMut(&str, &dyn Ndf)) {
-        f("mixture exact", &self.mixture_exact.patch(fp));
-        f("mixture approximate", &self.mixture_approx.patch(fp));
+        let approximate = PatchOptions {
+            masking: MaskingMode::Approximate,
+            ..PatchOptions::default()
+        };
+        f("mixture exact", &self.mixture.patch(fp));
+        f(
+            "mixture approximate",
+            &self.mixture.patch_with(fp, &approximate, None),
+        );
         f("bin map", &self.bin_map.patch(fp));
         f(
             "bin map smoothed",
@@ -413,29 +411,27 @@ fn glint_model_patches_equal_their_models_patches() {
     let map = brdf::glint::scratched(32, 32, Default::default(), 5).unwrap();
     let models = Models::build(&map);
     let bin_map: Arc<GlintModel> = Arc::new(models.bin_map.clone().into());
-    let mut smoothed = bin_map.options();
+    let mut smoothed = GlintOptions::default();
     smoothed.bin_map.smoothing_alpha = SMOOTHING;
     // (material, per-query options): the smoothed bin map is the bin map with smoothing options.
     let materials: Vec<(Arc<GlintModel>, GlintOptions)> = vec![
-        {
-            let m: Arc<GlintModel> = Arc::new(models.mixture_exact.clone().into());
-            let o = m.options();
-            (m, o)
-        },
-        (bin_map.clone(), bin_map.options()),
+        (
+            Arc::new(models.mixture.clone().into()),
+            GlintOptions::default(),
+        ),
+        (bin_map.clone(), GlintOptions::default()),
         (bin_map, smoothed),
-        {
-            let m: Arc<GlintModel> = Arc::new(models.position_normal.clone().into());
-            let o = m.options();
-            (m, o)
-        },
+        (
+            Arc::new(models.position_normal.clone().into()),
+            GlintOptions::default(),
+        ),
     ];
     let scratch = GlintScratch::default();
     let mut rng = support::rng(41);
     for area in [400.0f32, 2.0, 64.0] {
         let fp = Footprint::isotropic_texels(Vec2::new(0.3, 0.8), area, 32, 32);
         let own: [&dyn Ndf; 4] = [
-            &models.mixture_exact.patch(&fp),
+            &models.mixture.patch(&fp),
             &models.bin_map.patch(&fp),
             &models.bin_map.patch_with(
                 &fp,

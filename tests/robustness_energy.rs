@@ -6,7 +6,7 @@ mod support;
 
 use brdf::bxdf::{BlinnPhongNormalization, Masking, PhongNormalization, Sampling};
 use brdf::fresnel::NoFresnel;
-use brdf::glint::mixture::{MaskingMode, PatchOptions};
+use brdf::glint::mixture::MaskingMode;
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{BeckmannMixture, BinMap, GlintNdf, PositionNormalMap};
 use brdf::ndf::{Beckmann, Ggx, Ndf};
@@ -14,7 +14,7 @@ use brdf::{BlinnPhongLobe, Lambert, MicrofacetBrdf, Phong, Vec3};
 use proptest::prelude::*;
 use support::robustness::{
     albedo, any_alpha, any_footprint, any_map, assert_energy, grazing_dir, grazing_dir_from,
-    quick_mixture_params, small_bins,
+    mixture_options, quick_mixture_params, small_bins,
 };
 
 proptest! {
@@ -62,12 +62,13 @@ proptest! {
         map in any_map(), footprint in any_footprint(), smoothing in 0.01f32..1.0,
         wo in grazing_dir_from(1.75e-3), // θo ≤ 89.9°
     ) {
-        let mixture = BeckmannMixture::build(&map, quick_mixture_params(MaskingMode::Exact, f32::INFINITY)).unwrap();
-        let approximate = PatchOptions { masking: MaskingMode::Approximate, lod_lobes: f32::INFINITY, ..PatchOptions::default() };
+        let mixture = BeckmannMixture::build(&map, quick_mixture_params()).unwrap();
+        let exact = mixture_options(MaskingMode::Exact, f32::INFINITY);
+        let approximate = mixture_options(MaskingMode::Approximate, f32::INFINITY);
         let bin_map = BinMap::build(&map, small_bins()).unwrap();
         let pn = PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap();
         let (mix, mix_approx, bins, smoothed, pnp) = (
-            mixture.patch(&footprint),
+            mixture.patch_with(&footprint, &exact, None),
             mixture.patch_with(&footprint, &approximate, None),
             bin_map.patch(&footprint),
             bin_map.patch_with(&footprint, &brdf::glint::binmap::PatchOptions { smoothing_alpha: smoothing }, None),

@@ -15,14 +15,15 @@ use brdf::bxdf::{
     BlinnPhongNormalization, Masking, OriginalPhongNormalization, PhongNormalization, Sampling,
 };
 use brdf::fresnel::{ConductorFresnel, DielectricFresnel, NoFresnel, SchlickFresnel};
-use brdf::glint::mixture::MaskingMode;
+use brdf::glint::mixture::{MaskingMode, PatchOptions};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{BeckmannMixture, BinMap, GlintNdf, PositionNormalBrdf, PositionNormalMap};
 use brdf::ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
 use brdf::{BlinnPhongLobe, Bxdf, Lambert, MicrofacetBrdf, OriginalPhong, Phong, Vec2, Vec3};
 use proptest::prelude::*;
 use support::robustness::{
-    any_alpha, any_dir, any_footprint, any_map, any_u, quick_mixture_params, small_bins,
+    any_alpha, any_dir, any_footprint, any_map, any_u, mixture_options, quick_mixture_params,
+    small_bins,
 };
 use support::totality::{check_bxdf, check_ndf};
 
@@ -146,13 +147,23 @@ proptest! {
         wo in any_dir(), wi in any_dir(), uc in any_u(), u0 in any_u(), u1 in any_u(),
     ) {
         let u = Vec2::new(u0, u1);
-        for (masking, lod) in [
-            (MaskingMode::Exact, f32::INFINITY),
-            (MaskingMode::Approximate, f32::INFINITY),
-            (MaskingMode::Exact, 0.0),
+        let mixture = BeckmannMixture::build(&map, quick_mixture_params()).unwrap();
+        // Per-query options are not validated: hostile ones (NaN, negative, infinite) must be total too.
+        let hostile = PatchOptions {
+            masking: MaskingMode::Exact,
+            lod_lobes: f32::NAN,
+            lod_tolerance: f32::NAN,
+            lod_resolution: -1.0,
+        };
+        for options in [
+            mixture_options(MaskingMode::Exact, f32::INFINITY),
+            mixture_options(MaskingMode::Approximate, f32::INFINITY),
+            mixture_options(MaskingMode::Exact, 0.0),
+            mixture_options(MaskingMode::Approximate, -1.0),
+            hostile,
+            PatchOptions { lod_tolerance: f32::INFINITY, lod_resolution: f32::NAN, ..hostile },
         ] {
-            let mixture = BeckmannMixture::build(&map, quick_mixture_params(masking, lod)).unwrap();
-            let patch = mixture.patch(&footprint);
+            let patch = mixture.patch_with(&footprint, &options, None);
             check_ndf(&patch, wo, wi, uc, u);
             check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), wo, wi, uc, u);
         }

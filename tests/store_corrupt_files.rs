@@ -11,7 +11,8 @@ use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{BeckmannMixture, BinMap, NormalMap, PositionNormalMap};
 use support::format::reseal;
 use support::store::{
-    as_version_2, at, load_mixture, map, saved, small_compact_file, small_mixture_file,
+    as_version_2, at, load_mixture, map, mixture_as_version_3, position_normal_as_version_3, saved,
+    small_compact_file, small_mixture_file,
 };
 
 #[test]
@@ -25,6 +26,20 @@ fn every_truncation_is_an_error() {
             );
         }
     }
+}
+
+/// A version-4 file of `kind` (of [`small_files`]) as format `version` (2 or 3) wrote it: the
+/// patch options that the mixtures and the position-normal map stored then (at their defaults), and
+/// for a full mixture of version 2 no merge errors.
+fn as_version(kind: &str, file: &[u8], version: u32) -> Vec<u8> {
+    let mut f = match (kind, version) {
+        ("mixture", 2) => return as_version_2(file),
+        ("mixture" | "compact mixture", _) => mixture_as_version_3(file, 0, 16384.0),
+        ("position-normal", _) => position_normal_as_version_3(file, 128.0),
+        _ => file.to_vec(),
+    };
+    f[8..12].copy_from_slice(&version.to_le_bytes());
+    reseal(f)
 }
 
 /// A small file of every kind, with its loader.
@@ -68,19 +83,8 @@ fn every_flipped_byte_is_an_error() {
                 let e = load(&f).unwrap_err();
                 let expected = match k {
                     0..8 => matches!(e, Error::BadMagic { .. }),
-                    // A flip to version 2 (from 3, bit 0 of byte 8) is a version still read for
-                    // every kind but the bin map: the checksum, which covers the header, refuses it.
-                    // (A full mixture read as version 2 stops short of its merge errors first.)
-                    8..12 => {
-                        matches!(e, Error::UnsupportedVersion { .. })
-                            || (k == 8
-                                && f[8] == 2
-                                && kind != "bin map"
-                                && matches!(
-                                    e,
-                                    Error::ChecksumMismatch { .. } | Error::InvalidFile { .. }
-                                ))
-                    }
+                    // No flip of these masks turns version 4 into a version still read (2 or 3).
+                    8..12 => matches!(e, Error::UnsupportedVersion { .. }),
                     12..16 => matches!(e, Error::WrongModelKind { .. }),
                     // The payload length: too long leaves bytes over or runs out; too short cuts a
                     // field.
@@ -108,42 +112,40 @@ fn header_errors_name_what_is_wrong() {
     let e = load_mixture(&f).unwrap_err();
     assert!(e.to_string().contains("BRDFGLNT"), "{e}");
     let mut f = file.clone();
-    f[8..12].copy_from_slice(&4u32.to_le_bytes());
+    f[8..12].copy_from_slice(&5u32.to_le_bytes());
     let e = load_mixture(&reseal(f)).unwrap_err();
     assert!(
         matches!(
             e,
             Error::UnsupportedVersion {
-                found: 4,
-                supported: 3
+                found: 5,
+                supported: 4
             }
         ),
         "{e}"
     );
-    // Format version 2 is still read for every kind but the bin map (which gained 𝓑 in version 3;
-    // the full mixture gained its merge errors, recomputed when absent); older versions are not.
+    // Format versions 2 and 3 are still read for every kind but the bin map (which gained 𝓑 in
+    // version 3, and is read from version 3 on; the full mixture gained its merge errors in version
+    // 3, recomputed when absent; versions 2 and 3 of the mixtures and the position-normal map store
+    // patch options, read and ignored); older versions are not.
     for (kind, file, load) in small_files() {
-        let v2 = if kind == "mixture" {
-            as_version_2(&file)
-        } else {
-            let mut f = file.clone();
-            f[8..12].copy_from_slice(&2u32.to_le_bytes());
-            reseal(f)
-        };
-        let r = load(&v2);
-        if kind == "bin map" {
-            assert!(
-                matches!(
-                    r,
-                    Err(Error::UnsupportedVersion {
-                        found: 2,
-                        supported: 3
-                    })
-                ),
-                "{kind}: {r:?}"
-            );
-        } else {
-            assert!(r.is_ok(), "{kind}: {r:?}");
+        for version in [2u32, 3] {
+            let old = as_version(kind, &file, version);
+            let r = load(&old);
+            if kind == "bin map" && version == 2 {
+                assert!(
+                    matches!(
+                        r,
+                        Err(Error::UnsupportedVersion {
+                            found: 2,
+                            supported: 4
+                        })
+                    ),
+                    "{kind}: {r:?}"
+                );
+            } else {
+                assert!(r.is_ok(), "{kind} version {version}: {r:?}");
+            }
         }
         let mut f = file.clone();
         f[8..12].copy_from_slice(&1u32.to_le_bytes());

@@ -1,6 +1,7 @@
 //! Forged files, with valid checksums but contents no build writes (docs/format.md): inconsistent bin
 //! maps, compact and full mixtures are each an `InvalidFile` naming what is wrong, and every re-sealed
-//! byte change of a compact file loads to a total model or is refused.
+//! byte change of a compact file loads to a total model or is refused. The patch options that format
+//! version 3 stored, whatever their values, are read and ignored.
 //!
 //! The checksum used to forge the files is written from the format's documentation
 //! (`support::format`), independently of the crate's code.
@@ -12,7 +13,10 @@ use brdf::glint::{BinMap, Footprint, GlintNdf};
 use brdf::ndf::Ndf;
 use brdf::{Error, Vec2};
 use support::format::reseal;
-use support::store::{at, dirs, load_mixture, map, saved, small_compact_file, small_mixture_file};
+use support::store::{
+    at, dirs, load_mixture, map, mixture_as_version_3, position_normal_as_version_3, saved,
+    small_compact_file, small_mixture_file,
+};
 
 /// Offsets in a bin-map file: width 24, height 32, bins 40, leaf 48, sub-texels 56, lookup 64, σ 68,
 /// 𝓑⁻¹ count 72, 𝓑⁻¹ 80.. (one u32 per sub-texel), then offsets (count, data), roots, forest,
@@ -33,7 +37,7 @@ fn inconsistent_bin_maps_are_errors() {
         "the default sub-texel resolution the layout assumes"
     );
     let texels = (n * sub) * (n * sub);
-    // Format version 3: offsets, roots, forest, then 𝓑⁻¹ and 𝓑 (as u16: 25 bins).
+    // Format versions 3 and 4: offsets, roots, forest, then 𝓑⁻¹ and 𝓑 (as u16: 25 bins).
     let layout = |file: &[u8]| {
         let offsets_at = 80;
         let roots_at = offsets_at + 4 * 26 + 8;
@@ -166,15 +170,16 @@ fn inconsistent_bin_maps_are_errors() {
 }
 
 /// Offsets in the compact mixture file of a 6² map (docs/format.md, kind 5; lobe grid 6², levels of
-/// detail 6² and 3²): the parameters as kind 2 up to 76, level count 76; level 0: frame count 84,
-/// 4 frames 92..156, block count 156, 4 blocks 164..804, error count 804 (0); level 1: frame count
-/// 812, 1 frame 820..836, block count 836, 1 block 844..1004, error count 1004, 9 codes 1012..1021.
+/// detail 6² and 3²; format version 4): the parameters as kind 2 up to 68, level count 68; level 0:
+/// frame count 76, 4 frames 84..148, block count 148, 4 blocks 156..796, error count 796 (0); level
+/// 1: frame count 804, 1 frame 812..828, block count 828, 1 block 836..996, error count 996, 9 codes
+/// 1004..1013.
 mod compact_at {
-    pub const LEVELS: usize = 76;
-    pub const FRAME0: usize = 92;
-    pub const BLOCK0: usize = 164;
-    pub const ERROR_COUNT1: usize = 1004;
-    pub const END: usize = 1021;
+    pub const LEVELS: usize = 68;
+    pub const FRAME0: usize = 84;
+    pub const BLOCK0: usize = 156;
+    pub const ERROR_COUNT1: usize = 996;
+    pub const END: usize = 1013;
 }
 
 /// Compact files whose checksums are valid but whose contents no build writes: each an
@@ -323,15 +328,6 @@ fn inconsistent_contents_with_valid_checksums_are_errors() {
             "spacing",
         ),
         (
-            "unknown masking mode",
-            {
-                let mut f = file.clone();
-                set(&mut f, at::MASKING, &7u32.to_le_bytes());
-                f
-            },
-            "masking",
-        ),
-        (
             "NaN moment",
             {
                 let mut f = file.clone();
@@ -414,4 +410,44 @@ fn inconsistent_contents_with_valid_checksums_are_errors() {
         matches!(e, Error::InvalidFile { .. }) && e.to_string().contains("payload"),
         "{e}"
     );
+}
+
+/// Format version 3 stored patch options (the mixture's masking mode and cost cap, the
+/// position-normal map's footprint cap). Options are per query, so a version-3 file loads whatever
+/// those fields hold (values no build wrote included) and answers exactly as the version-4 file:
+/// its default patch is the default patch, bit for bit.
+#[test]
+fn version_3_option_fields_are_read_and_ignored() {
+    let fp = Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 9.0, 6, 6);
+    let answers = |p: &dyn Ndf| -> Vec<u32> {
+        dirs()
+            .iter()
+            .flat_map(|&w| [p.d(w), p.lambda(w), p.projected_area(w)])
+            .map(f32::to_bits)
+            .collect()
+    };
+    for file in [small_mixture_file(), small_compact_file()] {
+        let now = load_mixture(&file).unwrap();
+        for (masking, lod_lobes) in [(1u32, 0.0f32), (7, f32::NAN), (0, -1.0)] {
+            let forged = mixture_as_version_3(&file, masking, lod_lobes);
+            let old =
+                load_mixture(&forged).unwrap_or_else(|e| panic!("{masking} {lod_lobes}: {e}"));
+            assert_eq!(
+                answers(&old.patch(&fp)),
+                answers(&now.patch(&fp)),
+                "masking {masking}, lod_lobes {lod_lobes}"
+            );
+        }
+    }
+    let pn = brdf::glint::PositionNormalMap::build(&map(6), Default::default()).unwrap();
+    let file = saved(|w| pn.save(w));
+    for cap in [1.0f32, 0.0, f32::NAN] {
+        let forged = position_normal_as_version_3(&file, cap);
+        let old = brdf::glint::PositionNormalMap::load(&mut forged.as_slice()).unwrap();
+        assert_eq!(
+            answers(&old.patch(&fp)),
+            answers(&pn.patch(&fp)),
+            "max_query_texels {cap}"
+        );
+    }
 }

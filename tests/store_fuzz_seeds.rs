@@ -7,7 +7,7 @@ use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{LobeStorage, MixtureParams};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{BeckmannMixture, BinMap, PositionNormalMap};
-use support::store::{map, saved};
+use support::store::{map, mixture_as_version_3, position_normal_as_version_3, saved};
 
 /// Writes the seed files of the store fuzz targets (small valid files of each kind):
 /// `cargo test --test store_fuzz_seeds -- --ignored`.
@@ -31,11 +31,11 @@ fn write_fuzz_seeds() {
             ..MixtureParams::default()
         };
         let mx = BeckmannMixture::build(&m, params).unwrap();
-        write(
-            "store_mixture",
-            &format!("mixture{n}"),
-            saved(|w| mx.save(w)),
-        );
+        let file = saved(|w| mx.save(w));
+        // The same file as format version 3 wrote it (with patch options, read and ignored).
+        let v3 = mixture_as_version_3(&file, 1, 256.0);
+        write("store_mixture", &format!("mixture{n}"), file);
+        write("store_mixture", &format!("mixture{n}_v3"), v3);
         // Compact storage (model kind 5): 1², 3² (no level-2 node: the single block's own frame)
         // and 8² (frames from the quadtree's level 2).
         for k in [n, n + 5] {
@@ -54,11 +54,10 @@ fn write_fuzz_seeds() {
             );
         }
         let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
-        write(
-            "store_position_normal",
-            &format!("pn{n}"),
-            saved(|w| pn.save(w)),
-        );
+        let file = saved(|w| pn.save(w));
+        let v3 = position_normal_as_version_3(&file, 128.0);
+        write("store_position_normal", &format!("pn{n}"), file);
+        write("store_position_normal", &format!("pn{n}_v3"), v3);
         for (bins, leaf) in [(3, 1), (7, 2)] {
             let params = BinMapParams {
                 bins_per_axis: bins,

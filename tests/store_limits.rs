@@ -57,14 +57,15 @@ fn lying_sizes_allocate_no_more_than_the_file_holds() {
         .unwrap()
         .save(&mut file)
         .unwrap();
-    // Declare a 40000² map (1.6·10⁹ lobes, 32 GB) and a payload that claims it all; keep 1 MiB of
+    // Format version 4 (docs/format.md: lobe count at 68, lobes at 76). Declare a 40000² map (1.6·10⁹
+    // lobes, 32 GB) and a payload that claims it all; keep 1 MiB of
     // real lobe data (zeros are valid moments) so that the loader reads some before running out.
     file[24..32].copy_from_slice(&40000u64.to_le_bytes());
     file[32..40].copy_from_slice(&40000u64.to_le_bytes());
-    file[76..84].copy_from_slice(&1_600_000_000u64.to_le_bytes());
-    file[16..24].copy_from_slice(&(60 + 32_000_000_000u64).to_le_bytes());
-    file.truncate(84);
-    file.resize(84 + (1 << 20) + 8, 0);
+    file[68..76].copy_from_slice(&1_600_000_000u64.to_le_bytes());
+    file[16..24].copy_from_slice(&(52 + 32_000_000_000u64).to_le_bytes());
+    file.truncate(76);
+    file.resize(76 + (1 << 20) + 8, 0);
     let file = reseal(file);
     let (r, peak) = peak_during(|| BeckmannMixture::load(&mut file.as_slice()));
     assert!(
@@ -92,11 +93,11 @@ fn lying_sizes_allocate_no_more_than_the_file_holds() {
     file[24..32].copy_from_slice(&32768u64.to_le_bytes());
     file[32..40].copy_from_slice(&32768u64.to_le_bytes());
     // Levels 32768², 16384², …, 1²: 16.
-    file[76..84].copy_from_slice(&16u64.to_le_bytes());
-    file[84..92].copy_from_slice(&(8192u64 * 8192).to_le_bytes());
-    file[16..24].copy_from_slice(&(68 + 12_000_000_000u64).to_le_bytes());
-    file.truncate(92);
-    file.resize(92 + (1 << 20) + 8, 0);
+    file[68..76].copy_from_slice(&16u64.to_le_bytes());
+    file[76..84].copy_from_slice(&(8192u64 * 8192).to_le_bytes());
+    file[16..24].copy_from_slice(&(60 + 12_000_000_000u64).to_le_bytes());
+    file.truncate(84);
+    file.resize(84 + (1 << 20) + 8, 0);
     let file = reseal(file);
     let (r, peak) = peak_during(|| BeckmannMixture::load(&mut file.as_slice()));
     assert!(

@@ -1,16 +1,20 @@
 //! Saving and loading built glint maps and normal maps (docs/format.md): exact round trips, every
 //! query of a loaded model bit-identical to the built one, for the normal map, the full and compact
-//! mixtures (and a full mixture in format version 2), the position-normal map and the bin map.
+//! mixtures (and a full mixture in format versions 2 and 3), the position-normal map (and in version
+//! 3) and the bin map. Files hold no per-query options: the options that versions 2 and 3 stored are
+//! read and ignored.
 
 mod support;
 
 use brdf::glint::binmap::{BinLookup, BinMapParams};
 use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams, PatchOptions};
-use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::position_normal::{self, PositionNormalParams};
 use brdf::glint::{BeckmannMixture, BinMap, Footprint, GlintNdf, NormalMap, PositionNormalMap};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
-use support::store::{as_version_2, dirs, map, saved};
+use support::store::{
+    as_version_2, dirs, map, mixture_as_version_3, position_normal_as_version_3, saved,
+};
 
 /// Asserts that two patches answer every query with the same bits.
 fn assert_same_patch(a: &impl Ndf, b: &impl Ndf, what: &str) {
@@ -88,33 +92,50 @@ fn normal_map_round_trip_is_exact() {
 fn mixture_round_trip_is_exact() {
     let n = 32;
     let m = map(n);
+    let params = MixtureParams {
+        samples: 32,
+        ..MixtureParams::default()
+    };
+    let built = BeckmannMixture::build(&m, params).unwrap();
+    let file = saved(|w| built.save(w));
+    assert_eq!(&file[8..12], &4u32.to_le_bytes());
+    let loaded = BeckmannMixture::load(&mut file.as_slice()).unwrap();
+    assert_eq!(loaded.params(), built.params());
+    assert_eq!(loaded.memory(), built.memory());
     for (masking, lod) in [
         (MaskingMode::Exact, f32::INFINITY),
         (MaskingMode::Approximate, 64.0),
     ] {
-        let params = MixtureParams {
-            samples: 32,
-            patch: PatchOptions {
-                masking,
-                lod_lobes: lod,
-                ..PatchOptions::default()
-            },
-            ..MixtureParams::default()
+        let options = PatchOptions {
+            masking,
+            lod_lobes: lod,
+            ..PatchOptions::default()
         };
-        let built = BeckmannMixture::build(&m, params).unwrap();
-        let file = saved(|w| built.save(w));
-        let loaded = BeckmannMixture::load(&mut file.as_slice()).unwrap();
-        assert_eq!(loaded.params(), built.params());
-        assert_eq!(loaded.memory(), built.memory());
         for (k, f) in footprints(n).iter().enumerate() {
             assert_same_patch(
-                &built.patch(f),
-                &loaded.patch(f),
+                &built.patch_with(f, &options, None),
+                &loaded.patch_with(f, &options, None),
                 &format!("{masking:?} fp {k}"),
             );
         }
-        // Saving the loaded model gives the same bytes.
-        assert_eq!(saved(|w| loaded.save(w)), file);
+    }
+    // Saving the loaded model gives the same bytes.
+    assert_eq!(saved(|w| loaded.save(w)), file);
+    // The same mixture as format version 3 wrote it, with non-default options stored (approximate
+    // masking, a cost cap of one lobe): it loads, the stored options are ignored (its default patch
+    // is the built mixture's default patch), and it re-saves as the version-4 file.
+    let v3 = mixture_as_version_3(&file, 1, 1.0);
+    let old = BeckmannMixture::load(&mut v3.as_slice()).unwrap();
+    assert_eq!(old.params(), built.params());
+    for (k, f) in footprints(n).iter().enumerate() {
+        assert_same_patch(
+            &built.patch(f),
+            &old.patch(f),
+            &format!("fp {k}, version 3"),
+        );
+    }
+    assert_eq!(saved(|w| old.save(w)), file);
+    {
         // The same mixture in format version 2 (no merge errors: recomputed on load) answers the
         // same, so the stored errors are the ones the build computes.
         let old = BeckmannMixture::load(&mut as_version_2(&file).as_slice()).unwrap();
@@ -122,7 +143,7 @@ fn mixture_round_trip_is_exact() {
             assert_same_patch(
                 &built.patch(f),
                 &old.patch(f),
-                &format!("{masking:?} fp {k}, version 2"),
+                &format!("fp {k}, version 2"),
             );
         }
     }
@@ -141,12 +162,12 @@ fn compact_mixture_round_trip_is_exact() {
         let m = map(n);
         let params = MixtureParams {
             storage: LobeStorage::Compact,
-            patch: PatchOptions {
-                masking,
-                lod_tolerance: 0.5,
-                ..PatchOptions::default()
-            },
             ..MixtureParams::default()
+        };
+        let options = PatchOptions {
+            masking,
+            lod_tolerance: 0.5,
+            ..PatchOptions::default()
         };
         let built = BeckmannMixture::build(&m, params).unwrap();
         let file = saved(|w| built.save(w));
@@ -157,10 +178,10 @@ fn compact_mixture_round_trip_is_exact() {
         assert_eq!(loaded.level_count(), built.level_count());
         let mut levels = std::collections::BTreeSet::new();
         for (k, f) in footprints(n).iter().enumerate() {
-            // The tolerance is not stored in files: both with the build's options.
+            // Options are not stored in files: both with the same per-query options.
             let (a, b) = (
-                built.patch_with(f, &params.patch, None),
-                loaded.patch_with(f, &params.patch, None),
+                built.patch_with(f, &options, None),
+                loaded.patch_with(f, &options, None),
             );
             levels.insert(a.level());
             assert_eq!(a.level(), b.level());
@@ -173,6 +194,15 @@ fn compact_mixture_round_trip_is_exact() {
             );
         }
         assert_eq!(saved(|w| loaded.save(w)), file);
+        // As format version 3 wrote it, with non-default options stored (approximate masking, a
+        // cost cap of 0): the stored options are ignored.
+        let v3 = mixture_as_version_3(&file, 1, 0.0);
+        let old = BeckmannMixture::load(&mut v3.as_slice()).unwrap();
+        for (k, f) in footprints(n).iter().enumerate() {
+            let what = format!("compact {n}² fp {k}, version 3");
+            assert_same_patch(&built.patch(f), &old.patch(f), &what);
+        }
+        assert_eq!(saved(|w| old.save(w)), file);
     }
 }
 
@@ -190,14 +220,31 @@ fn position_normal_round_trip_is_exact() {
         let loaded = PositionNormalMap::load(&mut file.as_slice()).unwrap();
         assert_eq!(loaded.params(), built.params());
         assert_eq!(loaded.memory(), built.memory());
+        let capped = position_normal::PatchOptions {
+            max_query_texels: 8.0,
+        };
         for (k, f) in footprints(n).iter().enumerate() {
             assert_same_patch(
                 &built.patch(f),
                 &loaded.patch(f),
                 &format!("rate {rate} fp {k}"),
             );
+            assert_same_patch(
+                &built.patch_with(f, &capped, None),
+                &loaded.patch_with(f, &capped, None),
+                &format!("rate {rate} fp {k}, cap 8"),
+            );
         }
         assert_eq!(saved(|w| loaded.save(w)), file);
+        // As format version 3 wrote it, with a cap of 1 texel stored: the stored cap is ignored.
+        let old = PositionNormalMap::load(&mut position_normal_as_version_3(&file, 1.0).as_slice())
+            .unwrap();
+        assert_eq!(old.params(), built.params());
+        for (k, f) in footprints(n).iter().enumerate() {
+            let what = format!("rate {rate} fp {k}, version 3");
+            assert_same_patch(&built.patch(f), &old.patch(f), &what);
+        }
+        assert_eq!(saved(|w| old.save(w)), file);
     }
 }
 

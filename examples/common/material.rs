@@ -90,10 +90,12 @@ pub struct Configured {
 }
 
 impl Configured {
-    /// `model` with its own options ([`GlintNdf::options`]).
+    /// `model` with the default per-query options.
     pub fn new(model: Arc<GlintModel>) -> Configured {
-        let options = model.options();
-        Configured { model, options }
+        Configured {
+            model,
+            options: GlintOptions::default(),
+        }
     }
 
     /// A bin map whose patches carry slope σ `sigma` (0: the one-bin resolution).
@@ -115,19 +117,16 @@ impl GlintNdf for Configured {
     where
         Self: 'b;
 
-    type Options = GlintOptions;
-
-    fn options(&self) -> GlintOptions {
-        self.options.clone()
-    }
+    /// The configured options: a query takes none of its own.
+    type Options = ();
 
     fn patch_with<'b>(
         &'b self,
         footprint: &Footprint,
-        options: &GlintOptions,
+        _options: &(),
         scratch: Option<&'b GlintScratch>,
     ) -> GlintPatch<'b> {
-        self.model.patch_with(footprint, options, scratch)
+        self.model.patch_with(footprint, &self.options, scratch)
     }
 }
 

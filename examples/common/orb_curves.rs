@@ -90,7 +90,7 @@ const EVALS: [u32; 3] = [1, 4, 16];
 
 /// The glint models of one map with their build times, each given the scene's σ_ε the way its
 /// paper allows (examples/common/material.rs): the mixture as a path tracer would use it (lobe floor
-/// σ_ε, 64 quadrature nodes per lobe and `lod_lobes` 256, examples/render.rs), the bin map at its
+/// σ_ε, 64 quadrature nodes per lobe, queried with `lod_lobes` 256, examples/render.rs), the bin map at its
 /// default bins smoothed by a Beckmann lobe of α = √2 σ_ε, the position-normal map with σ_r = σ_ε;
 /// and, as "paper default" rows, the bin map's one-bin resolution (σ = 0) and Yan's σ_r = 0.005.
 pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
@@ -98,13 +98,13 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
     let params = MixtureParams {
         sigma_min: SIGMA_EPS,
         samples: 64,
-        patch: PatchOptions {
-            lod_lobes: 256.0,
-            ..PatchOptions::default()
-        },
         ..MixtureParams::default()
     };
-    let mixture = Configured::new(Arc::new(BeckmannMixture::build(map, params)?.into()));
+    let mut mixture = Configured::new(Arc::new(BeckmannMixture::build(map, params)?.into()));
+    mixture.options.mixture = PatchOptions {
+        lod_lobes: 256.0,
+        ..PatchOptions::default()
+    };
     let mixture_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
     // The masking lobe's floor at σ_ε too.

@@ -1,5 +1,5 @@
 //! Beckmann mixture (Chermain 2019): build on an arbitrary small map with arbitrary parameters, patch
-//! through an arbitrary footprint, query and sample the patch and its P-BRDF.
+//! through an arbitrary footprint with arbitrary per-query options, query and sample the patch and its P-BRDF.
 #![no_main]
 
 use arbitrary::Arbitrary;
@@ -28,15 +28,6 @@ fuzz_target!(|input: Input| {
         spacing: input.spacing,
         sigma_min: input.sigma_min,
         samples: input.samples as usize % 64,
-        patch: PatchOptions {
-            masking: if input.approximate {
-                MaskingMode::Approximate
-            } else {
-                MaskingMode::Exact
-            },
-            lod_lobes: input.lod_lobes,
-            ..PatchOptions::default()
-        },
         storage: if input.compact {
             LobeStorage::Compact
         } else {
@@ -48,7 +39,17 @@ fuzz_target!(|input: Input| {
     let Ok(mixture) = BeckmannMixture::build(&map, params) else {
         return;
     };
-    let patch = mixture.patch(&input.footprint.build());
+    // Per-query options are not validated: every value must give a total patch.
+    let options = PatchOptions {
+        masking: if input.approximate {
+            MaskingMode::Approximate
+        } else {
+            MaskingMode::Exact
+        },
+        lod_lobes: input.lod_lobes,
+        ..PatchOptions::default()
+    };
+    let patch = mixture.patch_with(&input.footprint.build(), &options, None);
     check_ndf(&patch, &input.probe);
     check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), &input.probe);
 });

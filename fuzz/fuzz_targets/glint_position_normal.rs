@@ -1,9 +1,9 @@
 //! Position-normal Gaussians (Yan 2016): build on an arbitrary small map with arbitrary parameters,
-//! patch through an arbitrary footprint, query and sample the patch, the published BRDF and ours.
+//! patch through an arbitrary footprint with an arbitrary footprint cap, query and sample the patch, the published BRDF and ours.
 #![no_main]
 
 use arbitrary::Arbitrary;
-use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::position_normal::{PatchOptions, PositionNormalParams};
 use brdf::glint::{GlintNdf, PositionNormalBrdf, PositionNormalMap};
 use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
 use brdf_fuzz::{FootprintInput, MapInput, Probe, check_bxdf, check_ndf};
@@ -28,12 +28,15 @@ fuzz_target!(|input: Input| {
         sigma_r: input.sigma_r,
         weight_sigmas: input.weight_sigmas,
         slope_sigmas: input.slope_sigmas,
-        max_query_texels: input.max_query_texels,
     };
     let Ok(model) = PositionNormalMap::build(&map, params) else {
         return;
     };
-    let patch = model.patch(&input.footprint.build());
+    // Per-query options are not validated: every cap must give a total patch.
+    let options = PatchOptions {
+        max_query_texels: input.max_query_texels,
+    };
+    let patch = model.patch_with(&input.footprint.build(), &options, None);
     check_ndf(&patch, &input.probe);
     check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), &input.probe);
     check_bxdf(&PositionNormalBrdf::new(&patch, NoFresnel), &input.probe);

@@ -124,11 +124,19 @@ use crate::ndf::Ndf;
 /// [`Ndf`] in the local frame of the geometric surface (z = ω_g), normalised like every NDF of the
 /// crate: ∫ D_P(m) (m·ω_g) dm = 1.
 ///
-/// Every query goes through one path, [`GlintNdf::patch_with`]: the footprint, the model's per-query
+/// Every query goes through one path, [`GlintNdf::patch_with`]: the footprint, the per-query
 /// [`Options`](GlintNdf::Options) (level of detail, masking, smoothing; each model's own type, with
 /// its `DEFAULT_*` constants in the model's module), and optionally a per-thread [`GlintScratch`]
 /// that lends the patch its buffers. [`GlintNdf::patch`] and [`GlintNdf::patch_in`] are the same with
-/// the model's [`options`](GlintNdf::options).
+/// `Self::Options::default()`.
+///
+/// **Options are per query, never part of a model.** A model holds only what its build made, and
+/// its file (`save` / `load`) stores no options, so a patch depends on the model, the footprint and
+/// the options passed, and on nothing else: a loaded model with the same options gives bit-identical
+/// patches, and [`GlintNdf::patch`] always means the documented defaults. A renderer that wants
+/// other options keeps them with its material and passes them to every query. There is no
+/// accessor for "the model's options": a model has none to report, and a `patch` whose meaning
+/// depended on how the model was built or loaded is the hidden state this design rules out.
 ///
 /// # Example
 ///
@@ -179,18 +187,14 @@ pub trait GlintNdf {
     /// model's documented `DEFAULT_*` values.
     type Options: Clone + Default + std::fmt::Debug;
 
-    /// The options [`GlintNdf::patch`] and [`GlintNdf::patch_in`] use. The default implementation
-    /// returns `Self::Options::default()`; a model built with options of its own returns those.
-    fn options(&self) -> Self::Options {
-        Self::Options::default()
-    }
-
     /// The P-NDF of the surface seen through one ray footprint:
     /// D_P(ω_h) = ∫ δ(ω_n(u) − ω_h) k_P(u) du (\[Chermain2019\] eq. 8), as approximated by the model
     /// with `options`. With a `scratch` (one per render thread), the patch takes its working
     /// buffers from it and gives them back when it drops; several patches of one scratch can be
-    /// alive at once. Once the scratch has grown to the largest footprint (and the most live
-    /// patches), building and querying a patch performs no heap allocation (tests/alloc.rs).
+    /// alive at once. Once the scratch has grown to the largest need it serves (the largest
+    /// footprint's, or under a coarse level of detail possibly a smaller footprint's, which gathers
+    /// more lobes; and the most live patches), building and querying a patch performs no heap
+    /// allocation (tests/alloc.rs).
     /// Without one, the patch allocates its own. Results are bit-identical either way.
     fn patch_with<'a>(
         &'a self,
@@ -199,14 +203,14 @@ pub trait GlintNdf {
         scratch: Option<&'a GlintScratch>,
     ) -> Self::Patch<'a>;
 
-    /// [`GlintNdf::patch_with`] with the model's [`options`](GlintNdf::options), allocating.
+    /// [`GlintNdf::patch_with`] with the default options (`Self::Options::default()`), allocating.
     fn patch(&self, footprint: &Footprint) -> Self::Patch<'_> {
-        self.patch_with(footprint, &self.options(), None)
+        self.patch_with(footprint, &Self::Options::default(), None)
     }
 
-    /// [`GlintNdf::patch_with`] with the model's [`options`](GlintNdf::options) and the buffers of
-    /// a caller's [`GlintScratch`].
+    /// [`GlintNdf::patch_with`] with the default options (`Self::Options::default()`) and the
+    /// buffers of a caller's [`GlintScratch`].
     fn patch_in<'a>(&'a self, footprint: &Footprint, scratch: &'a GlintScratch) -> Self::Patch<'a> {
-        self.patch_with(footprint, &self.options(), Some(scratch))
+        self.patch_with(footprint, &Self::Options::default(), Some(scratch))
     }
 }

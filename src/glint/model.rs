@@ -65,8 +65,8 @@ macro_rules! glint_models {
 
         /// Per-query options of a [`GlintModel`]'s patches: one field per model, each that model's
         /// own options type; a patch uses the field of its model. `Default` gives every model's
-        /// documented defaults; [`GlintNdf::options`] of a [`GlintModel`] gives its model's own
-        /// options in its field.
+        /// documented defaults (what [`GlintNdf::patch`] uses). Kept by the renderer with its
+        /// material and passed to every query: no model or file holds options.
         #[derive(Clone, Debug, Default)]
         #[non_exhaustive]
         pub struct GlintOptions {
@@ -131,14 +131,6 @@ macro_rules! glint_models {
         impl GlintNdf for GlintModel {
             type Patch<'a> = GlintPatch<'a>;
             type Options = GlintOptions;
-
-            fn options(&self) -> GlintOptions {
-                let mut options = GlintOptions::default();
-                match self {
-                    $( GlintModel::$variant(m) => options.$field = m.options(), )+
-                }
-                options
-            }
 
             fn patch_with<'a>(
                 &'a self,

@@ -3,7 +3,7 @@
 
 use super::AnyFresnel;
 use crate::error::{Error, Result};
-use crate::glint::{Footprint, GlintModel, GlintNdf, GlintOptions};
+use crate::glint::{Footprint, GlintModel, GlintOptions};
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
 
@@ -14,8 +14,8 @@ use std::sync::Arc;
 ///
 /// The model is shared (`Arc`): cloning the material, or making several materials of one map
 /// (other Fresnel terms, other options), copies no map data. The options are the per-query
-/// options of the model's patches; [`GlintMaterial::new`] takes the model's own
-/// ([`GlintNdf::options`]).
+/// options of the model's patches, held by the material, never by the model or its file;
+/// [`GlintMaterial::new`] starts from the defaults ([`GlintOptions::default`]).
 ///
 /// **Placement.** The footprint given to [`Material::bsdf`](super::Material::bsdf) is in the
 /// surface's (u, v); the map covers the unit square of uv scaled by [`GlintMaterial::uv_scale`]
@@ -31,12 +31,12 @@ pub struct GlintMaterial {
 }
 
 impl GlintMaterial {
-    /// `model` with its own options ([`GlintNdf::options`]) and `fresnel`, the map once over the
-    /// unit uv square, no base.
+    /// `model` with the default per-query options and `fresnel`, the map once over the unit uv
+    /// square, no base.
     pub fn new(model: impl Into<Arc<GlintModel>>, fresnel: impl Into<AnyFresnel>) -> GlintMaterial {
         let model = model.into();
         GlintMaterial {
-            options: model.options(),
+            options: GlintOptions::default(),
             model,
             fresnel: fresnel.into(),
             uv_scale: Vec2::ONE,

@@ -1,4 +1,4 @@
-//! Helpers of the Beckmann-mixture tests (tests/mixture*.rs): the 64² test maps, parameters with the
+//! Helpers of the Beckmann-mixture tests (tests/mixture*.rs): the 64² test maps, patch options with the
 //! level of detail off, footprints, and the slope-grid quadrature of a patch's P22.
 //!
 //! Integrals of the spiky P-NDF are taken in slope space, where D cos θ dω = P22 ds: the trapezoid
@@ -8,7 +8,7 @@
 //! the step, and the difference is reported as the error estimate next to each tolerance.
 
 use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
-use brdf::glint::{BeckmannMixture, Footprint, MixturePatch, NormalMap};
+use brdf::glint::{BeckmannMixture, Footprint, GlintNdf, MixturePatch, NormalMap};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 use rand::RngExt;
@@ -38,17 +38,19 @@ pub fn procedural_maps() -> Vec<(&'static str, NormalMap)> {
     maps().into_iter().take(4).collect()
 }
 
-/// Mixture params with the level of detail off, so that every footprint exercises the mixture.
-pub fn exact_params() -> MixtureParams {
-    MixtureParams {
-        patch: PatchOptions {
-            masking: MaskingMode::Exact,
-            lod_lobes: f32::INFINITY,
-            lod_tolerance: 0.0,
-            ..PatchOptions::default()
-        },
-        ..MixtureParams::default()
+/// Patch options with the level of detail off, so that every footprint exercises the mixture.
+pub fn exact_options() -> PatchOptions {
+    PatchOptions {
+        masking: MaskingMode::Exact,
+        lod_lobes: f32::INFINITY,
+        lod_tolerance: 0.0,
+        ..PatchOptions::default()
     }
+}
+
+/// The patch of `mix` through `fp` with [`exact_options`] (allocating).
+pub fn exact_patch<'a>(mix: &'a BeckmannMixture, fp: &Footprint) -> MixturePatch<'a> {
+    mix.patch_with(fp, &exact_options(), None)
 }
 
 pub fn footprint(area: f32, center: Vec2) -> Footprint {
@@ -151,14 +153,20 @@ pub fn probe_normal(patch: &MixturePatch, rng: &mut impl RngExt, k: usize) -> Ve
     }
 }
 
-/// The four procedural maps and the noise map at 64², built once for the property tests.
+/// The four procedural maps and the noise map at 64², built once for the property tests (query
+/// them with [`exact_options`]).
 pub fn block_mixtures() -> &'static [(&'static str, BeckmannMixture)] {
     static MIX: std::sync::OnceLock<Vec<(&'static str, BeckmannMixture)>> =
         std::sync::OnceLock::new();
     MIX.get_or_init(|| {
         maps()
             .into_iter()
-            .map(|(name, map)| (name, BeckmannMixture::build(&map, exact_params()).unwrap()))
+            .map(|(name, map)| {
+                (
+                    name,
+                    BeckmannMixture::build(&map, MixtureParams::default()).unwrap(),
+                )
+            })
             .collect()
     })
 }

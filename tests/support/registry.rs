@@ -7,7 +7,7 @@
 
 use brdf::glint::binmap::{self, BinMapParams};
 use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams, PatchOptions};
-use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::position_normal::{self, PositionNormalParams};
 use brdf::glint::{
     BeckmannMixture, BinMap, GlintModel, GlintOptions, NormalMap, PositionNormalMap,
 };
@@ -20,60 +20,72 @@ pub struct Example {
 }
 
 /// Every registered model on `map` (small builds: a few seconds in all for a 64² map), with the
-/// variants that take different code paths (mixture storage and masking, bin-map smoothing).
+/// variants that take different code paths (mixture storage and masking, bin-map smoothing). Every
+/// model has at least one example with options other than its defaults (a coarser level of detail
+/// or footprint cap, bin-map smoothing).
 ///
 /// # Panics
 /// If a name of `GlintModel::NAMES` has no example: add one here for a new model.
 pub fn examples(map: &NormalMap) -> Vec<Example> {
-    let mixture = |masking, storage| {
+    let mixture = |storage| {
         let params = MixtureParams {
             samples: 16,
             storage,
-            patch: PatchOptions {
-                masking,
-                ..PatchOptions::default()
-            },
             ..MixtureParams::default()
         };
         GlintModel::from(BeckmannMixture::build(map, params).unwrap())
     };
-    let with_own_options = |label, model: GlintModel| {
-        let options = brdf::glint::GlintNdf::options(&model);
-        Example {
-            label,
-            model,
-            options,
-        }
+    let masked = |masking| {
+        let mut options = GlintOptions::default();
+        options.mixture.masking = masking;
+        options
     };
+    let example = |label, model, options| Example {
+        label,
+        model,
+        options,
+    };
+    let full = mixture(LobeStorage::Full);
     let bin_map = GlintModel::from(BinMap::build(map, BinMapParams::default()).unwrap());
-    let mut smoothed = brdf::glint::GlintNdf::options(&bin_map);
+    let mut smoothed = GlintOptions::default();
     smoothed.bin_map = binmap::PatchOptions {
         smoothing_alpha: 0.05,
     };
+    let mut coarse = GlintOptions::default();
+    coarse.mixture = PatchOptions {
+        masking: MaskingMode::Approximate,
+        lod_lobes: 64.0,
+        lod_tolerance: 0.05,
+        lod_resolution: 0.04,
+    };
+    let mut capped = GlintOptions::default();
+    capped.position_normal = position_normal::PatchOptions {
+        max_query_texels: 8.0,
+    };
     let examples = vec![
-        with_own_options(
+        example(
             "mixture, exact masking",
-            mixture(MaskingMode::Exact, LobeStorage::Full),
+            full.clone(),
+            masked(MaskingMode::Exact),
         ),
-        with_own_options(
-            "mixture, approximate masking",
-            mixture(MaskingMode::Approximate, LobeStorage::Full),
+        example(
+            "mixture, approximate masking, coarse level of detail",
+            full,
+            coarse,
         ),
-        with_own_options(
+        example(
             "mixture, compact storage",
-            mixture(MaskingMode::Exact, LobeStorage::Compact),
+            mixture(LobeStorage::Compact),
+            masked(MaskingMode::Exact),
         ),
-        with_own_options("bin map", bin_map.clone()),
-        Example {
-            label: "bin map, smoothed",
-            model: bin_map,
-            options: smoothed,
-        },
-        with_own_options(
-            "position-normal",
+        example("bin map", bin_map.clone(), GlintOptions::default()),
+        example("bin map, smoothed", bin_map, smoothed),
+        example(
+            "position-normal, footprint cap 8 texels",
             PositionNormalMap::build(map, PositionNormalParams::default())
                 .unwrap()
                 .into(),
+            capped,
         ),
     ];
     for name in GlintModel::NAMES {

@@ -123,15 +123,19 @@ pub fn any_footprint() -> impl Strategy<Value = Footprint> {
 }
 
 /// Few QMC nodes: the build's accuracy does not matter here, its totality does.
-pub fn quick_mixture_params(masking: MaskingMode, lod_lobes: f32) -> MixtureParams {
+pub fn quick_mixture_params() -> MixtureParams {
     MixtureParams {
         samples: 16,
-        patch: PatchOptions {
-            masking,
-            lod_lobes,
-            ..PatchOptions::default()
-        },
         ..MixtureParams::default()
+    }
+}
+
+/// Patch options with `masking` and the cost cap `lod_lobes` (the rest at their defaults).
+pub fn mixture_options(masking: MaskingMode, lod_lobes: f32) -> PatchOptions {
+    PatchOptions {
+        masking,
+        lod_lobes,
+        ..PatchOptions::default()
     }
 }
 

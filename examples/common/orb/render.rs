@@ -14,8 +14,8 @@ use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, Footprint, GlintModel, GlintNdf, Kernel, MixturePatch, NormalMap,
-    PositionNormalMap, footprint_brdf, for_each_footprint_slope,
+    BeckmannMixture, BinMap, Footprint, GlintModel, GlintNdf, Kernel, NormalMap, PositionNormalMap,
+    footprint_brdf, for_each_footprint_slope,
 };
 use brdf::ndf::Beckmann;
 use glam::{Vec2, Vec3};
@@ -291,34 +291,34 @@ pub fn mean_image(a: &Image, b: &Image) -> Image {
     }
 }
 
-/// A [`BeckmannMixture`] seen with fixed patch options (exact / approximate masking, level of
-/// detail), so that each variant is a [`GlintNdf`] of its own.
-pub struct MixtureVariant<'a> {
-    /// The mixture.
-    pub mixture: &'a BeckmannMixture,
-    /// The patch options of this variant.
-    pub options: PatchOptions,
+/// A glint model seen with fixed per-query options (for the mixture: exact / approximate masking,
+/// level of detail), so that each variant is a [`GlintNdf`] of its own: its queries take no options
+/// (`()`) and pass the variant's to the model, as a renderer's material would.
+pub struct WithOptions<'a, G: GlintNdf> {
+    /// The model.
+    pub model: &'a G,
+    /// The per-query options of this variant.
+    pub options: G::Options,
 }
 
-impl GlintNdf for MixtureVariant<'_> {
+/// A [`BeckmannMixture`] with fixed [`PatchOptions`].
+pub type MixtureVariant<'a> = WithOptions<'a, BeckmannMixture>;
+
+impl<G: GlintNdf> GlintNdf for WithOptions<'_, G> {
     type Patch<'b>
-        = MixturePatch<'b>
+        = G::Patch<'b>
     where
         Self: 'b;
 
-    type Options = PatchOptions;
-
-    fn options(&self) -> PatchOptions {
-        self.options
-    }
+    type Options = ();
 
     fn patch_with<'b>(
         &'b self,
         footprint: &Footprint,
-        options: &PatchOptions,
+        _options: &(),
         scratch: Option<&'b brdf::glint::GlintScratch>,
-    ) -> MixturePatch<'b> {
-        self.mixture.patch_with(footprint, options, scratch)
+    ) -> G::Patch<'b> {
+        self.model.patch_with(footprint, &self.options, scratch)
     }
 }
 

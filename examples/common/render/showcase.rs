@@ -5,18 +5,18 @@
 use super::{Camera, Checker, Image, PointLight, Scene, Sky, render};
 use crate::common::{Artifact, Res, save_rgb};
 use brdf::fresnel::{ConductorFresnel, DielectricFresnel};
-use brdf::glint::mixture::{MixtureParams, PatchOptions};
+use brdf::glint::mixture::MixtureParams;
 use brdf::glint::{
-    BeckmannMixture, FlakesParams, GlintModel, NormalMap, NormalRepair, ScratchedParams,
-    TangentConvention, flakes, scratched,
+    BeckmannMixture, FlakesParams, GlintModel, GlintOptions, NormalMap, NormalRepair,
+    ScratchedParams, TangentConvention, flakes, scratched,
 };
+use brdf::material::AnyFresnel;
 use brdf::{Ggx, GlintMaterial, Lambert, Material, Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 use std::f32::consts::PI;
 use std::path::Path;
-use std::sync::Arc;
 use std::time::Instant;
 
 /// Render settings.
@@ -57,20 +57,20 @@ impl Options {
     }
 }
 
-/// A glint model of `map`: the Beckmann mixture of \[Chermain2019\] with 64 quadrature nodes per
-/// lobe (the orb example's setting, 4× faster to build than the default) and its level of detail at
-/// 256 lobes, so that the wide footprints of secondary hits cost one filtered lobe (the default
-/// threshold, 16384, lets a bounce off the ground query thousands of lobes: minutes per image).
-pub fn glint_model(map: &NormalMap) -> Res<Arc<GlintModel>> {
+/// A glint material of `map`: the Beckmann mixture of \[Chermain2019\] with 64 quadrature nodes
+/// per lobe (the orb example's setting, 4× faster to build than the default), queried with its
+/// level of detail at 256 lobes, so that the wide footprints of secondary hits cost one filtered
+/// lobe (the default threshold, 16384, lets a bounce off the ground query thousands of lobes:
+/// minutes per image).
+pub fn glint_material(map: &NormalMap, fresnel: impl Into<AnyFresnel>) -> Res<GlintMaterial> {
     let params = MixtureParams {
         samples: 64,
-        patch: PatchOptions {
-            lod_lobes: 256.0,
-            ..PatchOptions::default()
-        },
         ..MixtureParams::default()
     };
-    Ok(Arc::new(BeckmannMixture::build(map, params)?.into()))
+    let mut options = GlintOptions::default();
+    options.mixture.lod_lobes = 256.0;
+    let model = GlintModel::from(BeckmannMixture::build(map, params)?);
+    Ok(GlintMaterial::new(model, fresnel).with_options(options))
 }
 
 /// A hammered-metal height field (overlapping parabolic dents, the deepest wins), `n` × `n`, tiled,
@@ -156,13 +156,12 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
         &png,
         "the hammered normal map (OpenGL convention) that the render example writes, then loads",
     ));
-    let hammered = glint_model(&NormalMap::from_image_file(
-        &png,
-        TangentConvention::OpenGl,
-        NormalRepair::Reject,
-    )?)?;
-    let scratched = glint_model(&scratched(n, n, ScratchedParams::default(), 7)?)?;
-    let flakes = glint_model(&flakes(
+    let hammered =
+        NormalMap::from_image_file(&png, TangentConvention::OpenGl, NormalRepair::Reject)?;
+    let hammered = glint_material(&hammered, ConductorFresnel::COPPER)?;
+    let scratched = scratched(n, n, ScratchedParams::default(), 7)?;
+    let scratched = glint_material(&scratched, ConductorFresnel::SILVER)?;
+    let flakes = flakes(
         n,
         n,
         FlakesParams {
@@ -170,7 +169,8 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
             tilt_sigma: 0.15,
         },
         3,
-    )?)?;
+    )?;
+    let flakes = glint_material(&flakes, DielectricFresnel::new(1.5)?)?;
     type Make = Box<dyn FnOnce(Vec2) -> Res<Material>>;
     let shots: [(&str, &str, Make); 5] = [
         (
@@ -191,28 +191,19 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
         (
             "render_scratched.png",
             "glints: silver with a procedural scratched map (Beckmann mixture)",
-            Box::new(move |tiles| {
-                let glints = GlintMaterial::new(scratched, ConductorFresnel::SILVER);
-                Ok(glints.with_uv_scale(tiles)?.into())
-            }),
+            Box::new(move |tiles| Ok(scratched.with_uv_scale(tiles)?.into())),
         ),
         (
             "render_hammered.png",
             "glints: copper with the hammered PNG normal map (Beckmann mixture)",
-            Box::new(move |tiles| {
-                let glints = GlintMaterial::new(hammered, ConductorFresnel::COPPER);
-                Ok(glints.with_uv_scale(tiles)?.into())
-            }),
+            Box::new(move |tiles| Ok(hammered.with_uv_scale(tiles)?.into())),
         ),
         (
             "render_flake_paint.png",
             "layered: a glint clear coat (flakes map, η = 1.5) over red Lambert paint",
             Box::new(move |tiles| {
-                let coat = GlintMaterial::new(flakes, DielectricFresnel::new(1.5)?);
-                Ok(coat
-                    .with_uv_scale(tiles)?
-                    .over_base(Vec3::new(0.5, 0.03, 0.02))?
-                    .into())
+                let coat = flakes.with_uv_scale(tiles)?;
+                Ok(coat.over_base(Vec3::new(0.5, 0.03, 0.02))?.into())
             }),
         ),
     ];

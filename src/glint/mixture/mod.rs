@@ -22,7 +22,7 @@
 //!
 //! **Files, bottom to top.** Each file imports only files listed before it (no cycles; unit-test
 //! modules may also build mixtures through the public API):
-//! 1. `params.rs`: parameters, options, `DEFAULT_*` constants, [`MixtureMemory`];
+//! 1. `params.rs`: build parameters, per-query options, `DEFAULT_*` constants, [`MixtureMemory`];
 //! 2. `build.rs` (QMC moments), `build_filter.rs` (the separable filter's moments);
 //! 3. `lanes.rs` (lane arithmetic: `exp2`, the ramp term), `blocks.rs` (the 4 × 4 lobe blocks, their
 //!    lane kernels and the walk to them), `simd.rs` (the baseline and AVX2 copies of the block loops);
@@ -71,11 +71,6 @@ use crate::glint::{Footprint, GlintNdf, GlintScratch};
 impl GlintNdf for BeckmannMixture {
     type Patch<'a> = MixturePatch<'a>;
     type Options = PatchOptions;
-
-    /// The options the mixture was built with, [`MixtureParams::patch`].
-    fn options(&self) -> PatchOptions {
-        self.params().patch
-    }
 
     /// The P-NDF of a footprint ([`MixturePatch`]) with explicit options (masking mode, level of
     /// detail), its per-slot buffers lent by `scratch` if any.

@@ -100,7 +100,7 @@ impl BeckmannMixture {
     /// # Errors
     /// [`Error::InvalidParameter`] naming the field of `params` that is invalid (`spacing`,
     /// `sigma_min`, `samples` (under [`MomentMethod::Qmc`]), `supersampling`, `kernel_sigmas`,
-    /// `weight_sigmas`, `slope_tail`, `lod_lobes`, `lod_tolerance`, `lod_resolution`);
+    /// `weight_sigmas`, `slope_tail`);
     /// [`Error::InvalidSize`] if the lobe grid would exceed 2³¹ lobes.
     pub fn build(map: &NormalMap, params: MixtureParams) -> Result<Self> {
         Self::build_with_progress(map, params, None)

@@ -1,5 +1,6 @@
 //! The mixture's parameters: the build parameters ([`MixtureParams`], validated by the build and the
-//! loader), the per-patch options ([`PatchOptions`]), the choices they hold ([`MomentMethod`],
+//! loader), the per-query patch options ([`PatchOptions`], passed with every query and never held by
+//! a mixture or its file), the choices they hold ([`MomentMethod`],
 //! [`LobeStorage`], [`MaskingMode`]), their documented `DEFAULT_*` values and limits, and the memory
 //! report [`MixtureMemory`].
 
@@ -177,7 +178,14 @@ pub enum MaskingMode {
     Approximate,
 }
 
-/// Per-patch options: the masking mode and the level of detail (error tolerance and cost cap).
+/// Per-query options of a mixture's patches: the masking mode and the level of detail (error
+/// tolerance and cost cap). Passed with every query
+/// ([`GlintNdf::patch_with`](crate::glint::GlintNdf::patch_with)); a mixture holds none and its file
+/// stores none, so the same options give the same patch from a built or a loaded mixture.
+///
+/// Every value is accepted (evaluation is total): a NaN or negative `lod_tolerance` acts as 0, a NaN
+/// `lod_lobes` as no cap, a negative one as a cap of 0 (the filtered lobe), and a NaN or negative
+/// `lod_resolution` as 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PatchOptions {
     /// Exact or approximate masking terms ([`DEFAULT_MASKING`]).
@@ -189,12 +197,12 @@ pub struct PatchOptions {
     /// Error tolerance of the level of detail ([`DEFAULT_LOD_TOLERANCE`]): a patch uses the
     /// coarsest level of merged lobes whose weighted merge-error bound Σ W_n e(n) is at most this
     /// (and whose nodes are no wider than half the footprint's smaller standard deviation); 0 keeps the
-    /// full mixture (level 0), unless the cost cap moves it. Not stored in saved files.
+    /// full mixture (level 0), unless the cost cap moves it.
     pub lod_tolerance: f32,
     /// Slope resolution r of the tolerance's error ([`DEFAULT_LOD_RESOLUTION`], slope units): the
     /// bound Σ W_n e_r(n) is on the TV between the two P-NDFs after both are blurred by an isotropic
     /// Gaussian of standard deviation r in slope space, read at the largest r of
-    /// [`LOD_RESOLUTIONS`] not above this. 0: the continuous TV. Not stored in saved files.
+    /// [`LOD_RESOLUTIONS`] not above this. 0: the continuous TV.
     pub lod_resolution: f32,
 }
 
@@ -209,7 +217,9 @@ impl Default for PatchOptions {
     }
 }
 
-/// Build parameters of a [`BeckmannMixture`](super::BeckmannMixture). `Default` gives the documented `DEFAULT_*` values.
+/// Build parameters of a [`BeckmannMixture`](super::BeckmannMixture): what the build needs, and
+/// nothing a query chooses (those are the [`PatchOptions`] passed with each query). `Default` gives
+/// the documented `DEFAULT_*` values.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MixtureParams {
     /// Seed spacing h in texels (≥ [`MIN_SPACING`]). The lobe grid has max(1, round(width / h)) × max(1,
@@ -227,8 +237,6 @@ pub struct MixtureParams {
     pub weight_sigmas: f32,
     /// Mass left outside each lobe's slope box (0 < tail < 1).
     pub slope_tail: f32,
-    /// Options of the patches made by [`GlintNdf::patch`](crate::glint::GlintNdf::patch).
-    pub patch: PatchOptions,
     /// How the moments are integrated ([`MomentMethod::default`]: the filter). Not stored in saved
     /// files (a loaded mixture reads its moments and reports the default here).
     pub moments: MomentMethod,
@@ -246,7 +254,6 @@ impl Default for MixtureParams {
             kernel_sigmas: DEFAULT_KERNEL_SIGMAS,
             weight_sigmas: DEFAULT_WEIGHT_SIGMAS,
             slope_tail: DEFAULT_SLOPE_TAIL,
-            patch: PatchOptions::default(),
             moments: MomentMethod::default(),
             storage: LobeStorage::default(),
         }
@@ -313,29 +320,6 @@ impl MixtureParams {
                 name: "slope_tail",
                 value: self.slope_tail as f64,
                 reason: "must be in (0, 1)",
-            });
-        }
-        if self.patch.lod_lobes.is_nan() || self.patch.lod_lobes < 0.0 {
-            return Err(Error::InvalidParameter {
-                name: "lod_lobes",
-                value: self.patch.lod_lobes as f64,
-                reason: "must be >= 0 (infinity disables the level of detail)",
-            });
-        }
-        let t = self.patch.lod_tolerance;
-        if !(t >= 0.0 && t.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: "lod_tolerance",
-                value: t as f64,
-                reason: "must be finite and >= 0 (0 keeps the full mixture)",
-            });
-        }
-        let r = self.patch.lod_resolution;
-        if !(r >= 0.0 && r.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: "lod_resolution",
-                value: r as f64,
-                reason: "must be finite and >= 0 (0: the continuous bound)",
             });
         }
         Ok(())

@@ -1,8 +1,9 @@
 //! Saving and loading a built [`BeckmannMixture`] (format: docs/format.md, kinds 2 and 5).
 //!
-//! Full storage (kind 2) stores the map size, the build parameters, the lobes' moments (20 bytes per
-//! lobe) and the merge-error bounds of the levels of detail (N_RES `f32` per node of every level
-//! l ≥ 1: 4 bytes per lobe; files of format version 2 do not hold them, and get them recomputed). The
+//! Full storage (kind 2) stores the map size, the build parameters (no per-query options: those are
+//! passed with each query), the lobes' moments (20 bytes per lobe) and the merge-error bounds of the
+//! levels of detail (N_RES `f32` per node of every level l ≥ 1: 4 bytes per lobe; files of format
+//! version 2 do not hold them, and get them recomputed). The
 //! lobe blocks, the slope boxes' hierarchy, the moment mip chain and the levels' merged lobes are
 //! rebuilt on load by the same code as the build (`FullStorage::new`, O(lobes), parallel): this keeps
 //! files at 24 bytes per lobe and every query of a loaded mixture bit-identical to the built one.
@@ -15,7 +16,7 @@ use super::blocks::SIDE;
 use super::compact::{self, CompactBlock, CompactStorage};
 use super::levels::{N_RES, level_grids};
 use super::model::{BeckmannMixture, Storage, box_sigmas, lobe_grid};
-use super::params::{LobeStorage, MaskingMode, MixtureParams, PatchOptions};
+use super::params::{LobeStorage, MixtureParams};
 use crate::Result;
 use crate::glint::MAX_SLOPE;
 use crate::glint::io::format::{self, Decoder, Kind, Stored};
@@ -51,11 +52,6 @@ impl BeckmannMixture {
             e.put(p.kernel_sigmas)?;
             e.put(p.weight_sigmas)?;
             e.put(p.slope_tail)?;
-            e.put(match p.patch.masking {
-                MaskingMode::Exact => 0u32,
-                MaskingMode::Approximate => 1u32,
-            })?;
-            e.put(p.patch.lod_lobes)?;
             match self.lobe_storage() {
                 Storage::Full(s) => {
                     e.array(s.moments().iter().copied())?;
@@ -84,8 +80,11 @@ impl BeckmannMixture {
 
     /// Reads a mixture written by [`BeckmannMixture::save`], in either storage (the file's model
     /// kind). Its patches answer `d`, `lambda`, `projected_area`, `sample_visible` and `pdf_visible`
-    /// bit-identically to the saved mixture's (with the same patch options: the level-of-detail
-    /// tolerance is not stored).
+    /// bit-identically to the saved mixture's with the same per-query [`PatchOptions`]
+    /// (which no file holds: the masking mode and cost cap that files of format versions 2 and 3
+    /// stored are read and ignored).
+    ///
+    /// [`PatchOptions`]: super::PatchOptions
     ///
     /// Compact files (kind 5): one read, the level count, frame, block and error counts checked
     /// against the grid before allocating, then every lane checked (binary16 range, a valid lobe
@@ -119,16 +118,12 @@ impl BeckmannMixture {
         let kernel_sigmas = d.get("kernel_sigmas")?;
         let weight_sigmas = d.get("weight_sigmas")?;
         let slope_tail = d.get("slope_tail")?;
-        let masking = match d.get::<u32>("masking")? {
-            0 => MaskingMode::Exact,
-            1 => MaskingMode::Approximate,
-            m => {
-                return Err(format::invalid(format!(
-                    "masking mode {m} (0 or 1 expected)"
-                )));
-            }
-        };
-        let lod_lobes = d.get("lod_lobes")?;
+        if d.version() < 4 {
+            // Versions 2 and 3 stored two patch options (masking mode, cost cap); options are per
+            // query, so they are read past and dropped.
+            let _masking: u32 = d.get("masking")?;
+            let _lod_lobes: f32 = d.get("lod_lobes")?;
+        }
         let params = MixtureParams {
             spacing,
             sigma_min,
@@ -136,12 +131,6 @@ impl BeckmannMixture {
             kernel_sigmas,
             weight_sigmas,
             slope_tail,
-            // The level-of-detail tolerance is a per-query option, not in the file: the default.
-            patch: PatchOptions {
-                masking,
-                lod_lobes,
-                ..PatchOptions::default()
-            },
             storage: match kind {
                 Kind::BeckmannMixtureCompact => LobeStorage::Compact,
                 _ => LobeStorage::Full,

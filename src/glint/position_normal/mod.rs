@@ -35,8 +35,9 @@ pub const MAX_WEIGHT_SIGMAS: f32 = 10.0;
 /// σ_h / h = 1/√(8 ln 2) (see [`PositionNormalMap::SIGMA_H_PER_SPACING`]).
 pub(crate) const SIGMA_H_PER_SPACING: f64 = 0.424_660_900_144_009_5;
 
-/// Build parameters of a [`PositionNormalMap`]. `Default` gives the documented associated
-/// `DEFAULT_*` values.
+/// Build parameters of a [`PositionNormalMap`]: what the build needs, and nothing a query chooses
+/// (the footprint cap is a per-query [`PatchOptions`] field). `Default` gives the documented
+/// associated `DEFAULT_*` values.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PositionNormalParams {
     /// Elements per texel side (≥ 1): the element spacing is h = 1 / rate texels.
@@ -47,8 +48,6 @@ pub struct PositionNormalParams {
     pub weight_sigmas: f32,
     /// Truncation of the element slope densities, in σ per axis (> 0).
     pub slope_sigmas: f32,
-    /// Footprint cap in texels: `weight_sigmas` · σ_footprint ≤ this (> 0; `f32::INFINITY` disables).
-    pub max_query_texels: f32,
 }
 
 impl PositionNormalParams {
@@ -71,9 +70,10 @@ impl PositionNormalParams {
     /// integrates to at least 1 − 4 Q(4) ≈ 1 − 1.3·10⁻⁴ (Q the normal tail).
     pub const DEFAULT_SLOPE_SIGMAS: f32 = 4.0;
 
-    /// Default cap on the footprint: its standard deviation along each principal axis is clamped so that
-    /// `weight_sigmas` · σ ≤ 128 texels (the released code's maximum query range, which bounds the
-    /// per-patch work of a method that has no level of detail).
+    /// Default cap on the footprint ([`PatchOptions::max_query_texels`]): its standard deviation
+    /// along each principal axis is clamped so that `weight_sigmas` · σ ≤ 128 texels (the released
+    /// code's maximum query range, which bounds the per-patch work of a method that has no level of
+    /// detail).
     pub const DEFAULT_MAX_QUERY_TEXELS: f32 = 128.0;
 }
 
@@ -84,7 +84,6 @@ impl Default for PositionNormalParams {
             sigma_r: Self::DEFAULT_SIGMA_R,
             weight_sigmas: Self::DEFAULT_WEIGHT_SIGMAS,
             slope_sigmas: Self::DEFAULT_SLOPE_SIGMAS,
-            max_query_texels: Self::DEFAULT_MAX_QUERY_TEXELS,
         }
     }
 }
@@ -116,27 +115,20 @@ impl PositionNormalParams {
             });
         }
         positive("slope_sigmas", self.slope_sigmas)?;
-        if self.max_query_texels.is_nan() || self.max_query_texels <= 0.0 {
-            return Err(Error::InvalidParameter {
-                name: "max_query_texels",
-                value: self.max_query_texels as f64,
-                reason: "must be > 0 (infinity disables the cap)",
-            });
-        }
         Ok(())
     }
 }
 
 /// Per-query options of a position-normal patch (the [`GlintNdf::Options`] of
-/// [`PositionNormalMap`]).
+/// [`PositionNormalMap`]). Passed with every query ([`GlintNdf::patch_with`]); a map holds none and
+/// its file stores none.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PatchOptions {
     /// The level of detail: the footprint is shrunk about its centre until `weight_sigmas` ·
     /// σ_footprint ≤ this many texels (`f32::INFINITY` keeps the exact footprint whatever its size;
     /// values not > 0, NaN included, shrink the footprint to its centre). `Default` gives
-    /// [`PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS`]; [`GlintNdf::patch`] uses the map's
-    /// [`PositionNormalParams::max_query_texels`]. docs/position_normal.md gives the cost against
-    /// accuracy.
+    /// [`PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS`]. docs/position_normal.md gives the cost
+    /// against accuracy.
     pub max_query_texels: f32,
 }
 
@@ -212,7 +204,7 @@ impl PositionNormalMap {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming the invalid field of `params` (`sampling_rate`, `sigma_r`,
-    /// `weight_sigmas`, `slope_sigmas`, `max_query_texels`); [`Error::InvalidSize`] if the element grid
+    /// `weight_sigmas`, `slope_sigmas`); [`Error::InvalidSize`] if the element grid
     /// would exceed 2³¹ elements.
     pub fn build(map: &NormalMap, params: PositionNormalParams) -> Result<Self> {
         params.validate()?;
@@ -328,13 +320,6 @@ impl PositionNormalMap {
 impl GlintNdf for PositionNormalMap {
     type Patch<'a> = PositionNormalPatch<'a>;
     type Options = PatchOptions;
-
-    /// The map's own query cap, [`PositionNormalParams::max_query_texels`].
-    fn options(&self) -> PatchOptions {
-        PatchOptions {
-            max_query_texels: self.params.max_query_texels,
-        }
-    }
 
     /// The position-normal P-NDF of a footprint ([`PositionNormalPatch`]) under the query cap of
     /// `options`.

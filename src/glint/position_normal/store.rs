@@ -1,6 +1,6 @@
 //! Saving and loading a built [`PositionNormalMap`] (format: docs/format.md, kind 3).
 //!
-//! Stored: the map size, the build parameters and the elements (slope and Jacobian, 24 bytes each).
+//! Stored: the map size, the build parameters (no per-query options) and the elements (slope and Jacobian, 24 bytes each).
 //! The slope boxes and their hierarchy are rebuilt on load by the same code as the build (O(elements)),
 //! so every query of a loaded map is bit-identical to the built one.
 
@@ -25,14 +25,14 @@ impl PositionNormalMap {
             e.put(p.sigma_r)?;
             e.put(p.weight_sigmas)?;
             e.put(p.slope_sigmas)?;
-            e.put(p.max_query_texels)?;
             e.array(self.elements.iter().copied())
         })
     }
 
     /// Reads a representation written by [`PositionNormalMap::save`]. Its patches answer `d`,
     /// `lambda`, `projected_area`, `sample_visible` and `pdf_visible` bit-identically to the saved
-    /// one's.
+    /// one's with the same per-query [`PatchOptions`](super::PatchOptions) (which no file holds: the
+    /// footprint cap that files of format versions 2 and 3 stored is read and ignored).
     ///
     /// # Errors
     /// [`crate::Error::BadMagic`], [`crate::Error::UnsupportedVersion`],
@@ -50,8 +50,12 @@ impl PositionNormalMap {
             sigma_r: d.get("sigma_r")?,
             weight_sigmas: d.get("weight_sigmas")?,
             slope_sigmas: d.get("slope_sigmas")?,
-            max_query_texels: d.get("max_query_texels")?,
         };
+        if d.version() < 4 {
+            // Versions 2 and 3 stored the per-query footprint cap; options are per query, so it is
+            // read past and dropped.
+            let _max_query_texels: f32 = d.get("max_query_texels")?;
+        }
         let refused = |e: crate::Error| format::invalid(format!("stored map refused: {e}"));
         params.validate().map_err(refused)?;
         crate::glint::surface::texel_count(width, height, width.saturating_mul(height))
