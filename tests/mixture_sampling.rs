@@ -80,3 +80,78 @@ fn reciprocity_and_sample_eval_pdf_agreement() {
         }
     }
 }
+
+#[test]
+fn shading_point_queries_equal_those_of_a_fresh_patch() {
+    // A patch keeps the exact V_P of the last view (shared by eval, pdf and sample at one wo) and
+    // `eval_pdf` hands D(h) to the pdf: every value must be the one a fresh copy of the patch (which
+    // keeps nothing) returns through the separate `eval` and `pdf`, bit for bit, also when threads
+    // share the patch and overwrite each other's view.
+    use brdf::bxdf::Sampling;
+    use brdf::glint::GlintNdf;
+    use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams};
+    let map = glint::scratched(N, N, glint::ScratchedParams::default(), 5).unwrap();
+    for storage in [LobeStorage::Full, LobeStorage::Compact] {
+        let mix = BeckmannMixture::build(
+            &map,
+            MixtureParams {
+                storage,
+                ..MixtureParams::default()
+            },
+        )
+        .unwrap();
+        for masking in [MaskingMode::Exact, MaskingMode::Approximate] {
+            let mut opts = exact_options();
+            opts.masking = masking;
+            for area in [2.0, 64.0] {
+                let patch = mix.patch_with(&footprint(area, Vec2::new(0.4, 0.6)), &opts, None);
+                std::thread::scope(|s| {
+                    for t in 0..3u64 {
+                        let patch = &patch;
+                        s.spawn(move || shade_and_compare(patch, t));
+                    }
+                });
+            }
+        }
+        // Both samplers' densities take the given D.
+        let patch = exact_patch(&mix, &footprint(16.0, Vec2::new(0.5, 0.5)));
+        let brdf = MicrofacetBrdf::new(&patch, NoFresnel).with_sampling(Sampling::Normals);
+        let fresh = MicrofacetBrdf::new(patch.clone(), NoFresnel).with_sampling(Sampling::Normals);
+        let mut rng = support::rng(5);
+        for _ in 0..200 {
+            let wo = support::dir(rng.random_range(0.0..85.0), rng.random_range(0.0..360.0));
+            let wi = support::dir(rng.random_range(0.0..85.0), rng.random_range(0.0..360.0));
+            assert_eq!(
+                brdf.eval_pdf(wo, wi),
+                (fresh.eval(wo, wi), fresh.pdf(wo, wi))
+            );
+        }
+    }
+}
+
+/// Shading points at random views on `patch` (eval_pdf at two wi, a sample, its eval_pdf), each
+/// value compared with a fresh copy's `eval` and `pdf`.
+fn shade_and_compare(patch: &brdf::glint::MixturePatch, seed: u64) {
+    let mut rng = support::rng(100 + seed);
+    let brdf = MicrofacetBrdf::new(patch, NoFresnel);
+    for _ in 0..150 {
+        let wo = support::dir(rng.random_range(0.0..89.0), rng.random_range(0.0..360.0));
+        let fresh = MicrofacetBrdf::new(patch.clone(), NoFresnel);
+        for _ in 0..2 {
+            let wi = support::dir(rng.random_range(0.0..89.0), rng.random_range(0.0..360.0));
+            let pair = (fresh.eval(wo, wi), fresh.pdf(wo, wi));
+            assert_eq!(brdf.eval_pdf(wo, wi), pair, "{wo} {wi}");
+        }
+        let u = Vec2::new(rng.random(), rng.random());
+        let s = brdf.sample(wo, 0.5, u);
+        let f = fresh.sample(wo, 0.5, u);
+        assert_eq!(s.map(|s| (s.wi, s.f, s.pdf)), f.map(|f| (f.wi, f.f, f.pdf)));
+        if let Some(s) = s {
+            assert_eq!(brdf.pdf(wo, s.wi), fresh.pdf(wo, s.wi));
+            assert_eq!(
+                patch.pdf_visible(wo, s.wi),
+                fresh.ndf().pdf_visible(wo, s.wi)
+            );
+        }
+    }
+}

@@ -196,7 +196,9 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
     /// the renderer's-measure factor too, and a glint patch's A is not free).
     #[inline]
     fn masking_factor_with(&self, wo: Vec3, wi: Vec3, ai: f32) -> f32 {
-        let vo = self.ndf.visible_area(wo);
+        // V at the view through `view_visible_area`: a glint patch may keep it for the queries
+        // that follow at the same wo (its pdf, its sampler, the next eval).
+        let vo = self.ndf.view_visible_area(wo);
         let vi = self.ndf.visible_area(wi);
         let denom = match self.masking {
             Masking::Separable => vo * vi,
@@ -241,10 +243,10 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
         }
     }
 
-    /// f(wo, wi) in the renderer's measure: F · D/4 · M(wo, wi) · A(wi)/cos θi (module docs).
+    /// f(wo, wi) in the renderer's measure: F · D/4 · M(wo, wi) · A(wi)/cos θi (module docs), with
+    /// `d` = D(h) already evaluated.
     #[inline]
-    fn eval_at(&self, wo: Vec3, wi: Vec3, hv: &Half) -> Vec3 {
-        let d = self.ndf.d(hv.h);
+    fn eval_at(&self, wo: Vec3, wi: Vec3, hv: &Half, d: f32) -> Vec3 {
         if d.is_nan() || d <= 0.0 {
             return Vec3::ZERO;
         }
@@ -261,11 +263,19 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
     /// A micronormal density below `f32::MIN_POSITIVE` is subnormal (fewer than 23 significant
     /// bits, none at all near 10⁻⁴⁵) and is taken as 0, so that every returned pdf is accurate
     /// to f32 rounding and no sample is drawn where it is not.
+    ///
+    /// With `d` = Some(D(h)) already evaluated (by `eval_pdf`), the NDF is given it
+    /// ([`Ndf::pdf_visible_given_d`]): the same density, without a second evaluation of D where
+    /// the NDF's density needs one.
     #[inline]
-    fn pdf_at(&self, wo: Vec3, hv: &Half) -> f32 {
-        let (pm, cos) = match self.sampling {
-            Sampling::Normals => (self.ndf.pdf_normal(hv.h), hv.c),
-            Sampling::VisibleNormals => (self.ndf.pdf_visible(wo, hv.h), hv.k),
+    fn pdf_at(&self, wo: Vec3, hv: &Half, d: Option<f32>) -> f32 {
+        let (pm, cos) = match (self.sampling, d) {
+            (Sampling::Normals, None) => (self.ndf.pdf_normal(hv.h), hv.c),
+            (Sampling::Normals, Some(d)) => (self.ndf.pdf_normal_given_d(hv.h, d), hv.c),
+            (Sampling::VisibleNormals, None) => (self.ndf.pdf_visible(wo, hv.h), hv.k),
+            (Sampling::VisibleNormals, Some(d)) => {
+                (self.ndf.pdf_visible_given_d(wo, hv.h, d), hv.k)
+            }
         };
         if pm.is_nan() || pm < f32::MIN_POSITIVE {
             return 0.0;
@@ -287,21 +297,25 @@ struct Half {
 impl<D: Ndf, F: Fresnel> Bxdf for MicrofacetBrdf<D, F> {
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match Self::half(wo, wi) {
-            Some(hv) => self.eval_at(wo, wi, &hv),
+            Some(hv) => self.eval_at(wo, wi, &hv, self.ndf.d(hv.h)),
             None => Vec3::ZERO,
         }
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match Self::half(wo, wi) {
-            Some(hv) => self.pdf_at(wo, &hv),
+            Some(hv) => self.pdf_at(wo, &hv, None),
             None => 0.0,
         }
     }
 
     fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         match Self::half(wo, wi) {
-            Some(hv) => (self.eval_at(wo, wi, &hv), self.pdf_at(wo, &hv)),
+            Some(hv) => {
+                // D(h) once for both: the NDF's density may need it again (its contract check).
+                let d = self.ndf.d(hv.h);
+                (self.eval_at(wo, wi, &hv, d), self.pdf_at(wo, &hv, Some(d)))
+            }
             None => (Vec3::ZERO, 0.0),
         }
     }

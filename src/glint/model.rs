@@ -213,4 +213,16 @@ impl Ndf for GlintPatch<'_> {
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
         forward!(self, p => p.pdf_visible(wo, m))
     }
+    #[inline]
+    fn view_visible_area(&self, wo: Vec3) -> f32 {
+        forward!(self, p => p.view_visible_area(wo))
+    }
+    #[inline]
+    fn pdf_normal_given_d(&self, m: Vec3, d_m: f32) -> f32 {
+        forward!(self, p => p.pdf_normal_given_d(m, d_m))
+    }
+    #[inline]
+    fn pdf_visible_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        forward!(self, p => p.pdf_visible_given_d(wo, m, d_m))
+    }
 }

@@ -130,6 +130,33 @@ pub trait Ndf {
             0.0
         }
     }
+
+    /// V(wo) for the view direction of a shading query: the same number as
+    /// [`Ndf::visible_area`]`(wo)`. `MicrofacetBrdf` asks for V at its `wo` through this method
+    /// and for V at its `wi` through `visible_area`, so that an NDF whose V costs a pass over many
+    /// lobes may keep what it computes for `wo` for the queries that follow at the same view
+    /// (`pdf_visible`, `sample_visible`, the next `eval` at another `wi`). Never override it with
+    /// another value than `visible_area(wo)`.
+    fn view_visible_area(&self, wo: Vec3) -> f32 {
+        self.visible_area(wo)
+    }
+
+    /// [`Ndf::pdf_normal`]`(m)` for a caller that has already evaluated `d_m` = `self.d(m)`
+    /// (`MicrofacetBrdf::eval_pdf` evaluates D at the half vector for f): the same number, without
+    /// evaluating D again where the density needs it (the density contract's `d(m) = 0` check of
+    /// a truncated mixture). The default ignores `d_m`. `d_m` must be `self.d(m)`.
+    fn pdf_normal_given_d(&self, m: Vec3, d_m: f32) -> f32 {
+        let _ = d_m;
+        self.pdf_normal(m)
+    }
+
+    /// [`Ndf::pdf_visible`]`(wo, m)` for a caller that has already evaluated `d_m` = `self.d(m)`:
+    /// the same number (see [`Ndf::pdf_normal_given_d`]). The default ignores `d_m`. `d_m` must be
+    /// `self.d(m)`.
+    fn pdf_visible_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        let _ = d_m;
+        self.pdf_visible(wo, m)
+    }
 }
 
 /// Λ(w) = V(w)/A(w) − 1 from an NDF's own visible and projected areas: Smith's identity read
@@ -191,5 +218,14 @@ impl<T: Ndf + ?Sized> Ndf for &T {
     }
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
         (**self).pdf_visible(wo, m)
+    }
+    fn view_visible_area(&self, wo: Vec3) -> f32 {
+        (**self).view_visible_area(wo)
+    }
+    fn pdf_normal_given_d(&self, m: Vec3, d_m: f32) -> f32 {
+        (**self).pdf_normal_given_d(m, d_m)
+    }
+    fn pdf_visible_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        (**self).pdf_visible_given_d(wo, m, d_m)
     }
 }

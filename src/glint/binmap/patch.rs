@@ -927,6 +927,19 @@ impl Ndf for BinMapPatch<'_> {
     /// views nothing faces). 0 for an invalid wo (at or below the horizon, zero, non-finite), as
     /// for every NDF, though the sampler still returns a normal there.
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        self.pdf_visible_with(wo, m, || self.d(m))
+    }
+
+    /// [`Ndf::pdf_visible`] with D_P(m) = `d_m` given (the smoothed support check uses it).
+    fn pdf_visible_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        self.pdf_visible_with(wo, m, || d_m)
+    }
+}
+
+impl BinMapPatch<'_> {
+    /// [`Ndf::pdf_visible`], with `d` giving D_P(m) where the smoothed density checks its support.
+    #[inline]
+    fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
         if !(wo.is_finite() && wo.z > 0.0) {
             return 0.0;
         }
@@ -937,7 +950,7 @@ impl Ndf for BinMapPatch<'_> {
             // The smoothed D leaves out each lobe beyond its truncation radius (SMOOTH_TAIL), the
             // lobes' own samplers do not: where D is 0 the density is 0 too (a draw there, at most
             // 10⁻⁶ of a lobe's mass, gets pdf 0 and `MicrofacetBrdf::sample` returns `None`).
-            Some((e, total)) if self.d(m) > 0.0 => pdf_visible_lobes(e, wo, total, m),
+            Some((e, total)) if d() > 0.0 => pdf_visible_lobes(e, wo, total, m),
             Some(_) => 0.0,
             None => self.pdf_normal(m),
         }

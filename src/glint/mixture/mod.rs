@@ -55,6 +55,7 @@ mod patch;
 mod simd;
 mod storage;
 mod store;
+mod view_memo;
 
 pub use model::BeckmannMixture;
 pub use params::{

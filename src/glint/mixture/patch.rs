@@ -15,6 +15,7 @@ use super::params::{MaskingMode, PatchOptions};
 use super::passes::{SumP22, UntruncatedSum, VisiblePick, VisibleSum};
 use super::simd::{self, Simd};
 use super::storage::LevelView;
+use super::view_memo::ViewMemo;
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
@@ -79,6 +80,21 @@ impl PatchLevel<'_> {
 ///   P-NDFs blurred by N(0, r² I)) is at most `lod_tolerance`, then moved coarser if the footprint
 ///   still covers more than `lod_lobes` nodes (the filtered lobe alone if no level is coarse
 ///   enough). D_P, both masking modes, both samplers and their pdfs all use that one level.
+/// - Cost per shading point: the patch keeps the exact V_P of the last view it was asked about
+///   (through [`Ndf::view_visible_area`], `pdf_visible` or `sample_visible`; lock-free, so a patch
+///   shared by threads stays `Send + Sync`), and takes the D_P(h) that `MicrofacetBrdf::eval_pdf`
+///   already evaluated ([`Ndf::pdf_visible_given_d`]). A renderer's `eval_pdf` at k directions and
+///   one `sample` at one wo then cost k + 1 D_P walks, k + 1 untruncated passes (the pdfs), one
+///   V_P(wo) pass, the sampler's pick pass and, with exact masking, k + 1 V_P(wi) passes; every
+///   value is the one the separate queries return.
+/// - What approximate masking cannot make O(1): the densities. `pdf_visible` and `pdf_normal` are
+///   sums over the lobes at m (one pass; the density of a mixture is the sum of its lobes'), and
+///   `sample_visible` picks a lobe ∝ W_i V_i(wo), which needs the exact V_P(wo) (one pass per
+///   view, shared with the pdfs) and a pick pass. Picking ∝ W_i instead (O(log lobes) by the
+///   weights' CDF) would make the density Σ W_i ⟨wo,m⟩⁺ D_i / V_i(wo), whose pass costs a V_i per
+///   lobe at every pdf, and bound the sample weight by F · max_i V_i(wo)/V_P(wo) instead of F
+///   (src/bxdf/microfacet.rs, "Sample weights"); [`crate::bxdf::Sampling::Normals`] already is
+///   the O(log lobes) sampler, with a weight not bounded by F. docs/mixture.md.
 ///
 /// # Reference
 /// \[Chermain2019\] eq. 7-17, §4.2.2, §5.
@@ -95,6 +111,9 @@ pub struct MixturePatch<'a> {
     gathered: Option<Gathered<'a>>,
     /// The compiled copy of the block loops the patch runs ([`Simd::detected`]).
     simd: Simd,
+    /// The exact V_P of the last view direction (`pdf_visible`, `sample_visible`,
+    /// `view_visible_area`): one pass over the lobes per wo, not one per query.
+    view: ViewMemo,
 }
 
 impl<'a> MixturePatch<'a> {
@@ -130,6 +149,7 @@ impl<'a> MixturePatch<'a> {
             filtered,
             gathered,
             simd: Simd::detected(),
+            view: ViewMemo::default(),
         }
     }
 
@@ -257,6 +277,15 @@ impl<'a> MixturePatch<'a> {
         ))
     }
 
+    /// [`MixturePatch::exact_visible_area`] at a view direction: the value kept for `wo` if it is
+    /// the last view the patch was asked about ([`ViewMemo`]), else one pass, kept.
+    fn view_exact_visible_area(&self, g: &Gathered, wo: Vec3) -> f64 {
+        if !(wo.z > 0.0 && wo.is_finite()) {
+            return 0.0;
+        }
+        self.view.get_or(wo, || self.exact_visible_area(g, wo))
+    }
+
     /// The exact visible area V_P(w) = Σ W_i V_i(w) = ∫ ⟨w, m⟩⁺ D_P(m) dm, whatever the masking mode
     /// (the filtered lobe's under the level of detail).
     ///
@@ -319,7 +348,7 @@ impl<'a> MixturePatch<'a> {
     /// is `pdf_visible` (which divides by the same block V_P) up to the lanes' 1e-6 relative error on
     /// each V_i.
     fn sample_visible_gathered(&self, g: &Gathered, wo: Vec3, u: Vec2) -> Vec3 {
-        let total = self.exact_visible_area(g, wo);
+        let total = self.view_exact_visible_area(g, wo);
         if !(total > 0.0 && total.is_finite()) {
             return self.sample_normal(u);
         }
@@ -421,11 +450,46 @@ impl Ndf for MixturePatch<'_> {
     /// slope box, where the sampler lands with probability at most `slope_tail`; `MicrofacetBrdf`
     /// then returns no sample). Differs from `d(m) cos θ_m` by at most the truncated tail. O(lobes).
     fn pdf_normal(&self, m: Vec3) -> f32 {
+        self.pdf_normal_with(m, || self.d(m))
+    }
+
+    /// [`Ndf::pdf_normal`] with D_P(m) = `d_m` given (the contract's check uses it).
+    fn pdf_normal_given_d(&self, m: Vec3, d_m: f32) -> f32 {
+        self.pdf_normal_with(m, || d_m)
+    }
+
+    /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe, with the exact V_P in every masking
+    /// mode: exactly the density of [`Ndf::sample_visible`] where D_P > 0, and 0 where D_P = 0.
+    /// O(lobes).
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        self.pdf_visible_with(wo, m, || self.d(m))
+    }
+
+    /// [`Ndf::pdf_visible`] with D_P(m) = `d_m` given (the contract's check uses it).
+    fn pdf_visible_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        self.pdf_visible_with(wo, m, || d_m)
+    }
+
+    /// [`Ndf::visible_area`] at the view: the exact V_P kept for the queries that follow at the
+    /// same `wo` ([`MaskingMode::Exact`]); Scarf's bound, O(1), is not kept
+    /// ([`MaskingMode::Approximate`]).
+    fn view_visible_area(&self, wo: Vec3) -> f32 {
+        match (&self.gathered, self.masking) {
+            (Some(g), MaskingMode::Exact) => finite_or_zero(self.view_exact_visible_area(g, wo)),
+            _ => self.visible_area(wo),
+        }
+    }
+}
+
+impl MixturePatch<'_> {
+    /// [`Ndf::pdf_normal`], with `d` giving D_P(m) for the density contract's check.
+    #[inline]
+    fn pdf_normal_with(&self, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
         let Some(g) = &self.gathered else {
             return self.filtered.pdf_normal(m);
         };
         // 0 where D_P is (outside every lobe's slope box): one density contract for every NDF.
-        if !(m.z > 0.0 && m.is_finite()) || self.d(m) <= 0.0 {
+        if !(m.z > 0.0 && m.is_finite()) || d() <= 0.0 {
             return 0.0;
         }
         let p = self.untruncated_d(g, m) * m.z as f64;
@@ -433,10 +497,10 @@ impl Ndf for MixturePatch<'_> {
         if p.is_finite() { p } else { 0.0 }
     }
 
-    /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe, with the exact V_P in every masking
-    /// mode: exactly the density of [`Ndf::sample_visible`] where D_P > 0, and 0 where D_P = 0.
-    /// O(lobes).
-    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+    /// [`Ndf::pdf_visible`], with `d` giving D_P(m) for the density contract's check and V_P(wo)
+    /// through the patch's [`ViewMemo`].
+    #[inline]
+    fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
         let Some(g) = &self.gathered else {
             return self.filtered.pdf_visible(wo, m);
         };
@@ -445,10 +509,10 @@ impl Ndf for MixturePatch<'_> {
             return 0.0;
         }
         // 0 where D_P is (outside every lobe's slope box): one density contract for every NDF.
-        if self.d(m) <= 0.0 {
+        if d() <= 0.0 {
             return 0.0;
         }
-        let v = self.exact_visible_area(g, wo);
+        let v = self.view_exact_visible_area(g, wo);
         if v.is_nan() || v <= 0.0 {
             return 0.0;
         }

@@ -557,11 +557,24 @@ impl Ndf for PositionNormalPatch<'_> {
     /// density of [`Ndf::sample_visible`] on the support of D_P (draws outside it as in
     /// [`Ndf::pdf_normal`]). 0 for invalid wo. O(elements).
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        self.pdf_visible_with(wo, m, || self.d(m))
+    }
+
+    /// [`Ndf::pdf_visible`] with D_P(m) = `d_m` given (the support check uses it).
+    fn pdf_visible_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        self.pdf_visible_with(wo, m, || d_m)
+    }
+}
+
+impl PositionNormalPatch<'_> {
+    /// [`Ndf::pdf_visible`], with `d` giving D_P(m) for the support check.
+    #[inline]
+    fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
         let c = wo.dot(m);
         if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
             return 0.0;
         }
-        if self.d(m) <= 0.0 {
+        if d() <= 0.0 {
             return 0.0;
         }
         let v = self.exact_visible_area(wo);
