@@ -22,7 +22,9 @@
 mod clip;
 mod forest;
 mod lookup;
+mod masking;
 mod patch;
+mod sampling;
 mod store;
 
 pub use forest::QueryStats;
