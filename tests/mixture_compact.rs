@@ -37,6 +37,7 @@ const FULL_MIXTURE: PatchOptions = PatchOptions {
     lod_lobes: f32::INFINITY,
     lod_tolerance: 0.0,
     lod_resolution: brdf::glint::mixture::DEFAULT_LOD_RESOLUTION,
+    sub_texel_area: 0.0,
 };
 
 /// Memory per lobe from `memory()`: ≤ 16 bytes in all under compact storage (the target),

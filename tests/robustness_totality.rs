@@ -154,6 +154,7 @@ proptest! {
             lod_lobes: f32::NAN,
             lod_tolerance: f32::NAN,
             lod_resolution: -1.0,
+            sub_texel_area: f32::NAN,
         };
         for options in [
             mixture_options(MaskingMode::Exact, f32::INFINITY),

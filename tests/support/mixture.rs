@@ -38,12 +38,14 @@ pub fn procedural_maps() -> Vec<(&'static str, NormalMap)> {
     maps().into_iter().take(4).collect()
 }
 
-/// Patch options with the level of detail off, so that every footprint exercises the mixture.
+/// Patch options with the level of detail and the sub-texel lobe off, so that every footprint
+/// exercises the mixture.
 pub fn exact_options() -> PatchOptions {
     PatchOptions {
         masking: MaskingMode::Exact,
         lod_lobes: f32::INFINITY,
         lod_tolerance: 0.0,
+        sub_texel_area: 0.0,
         ..PatchOptions::default()
     }
 }

@@ -57,6 +57,7 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
         lod_lobes: 64.0,
         lod_tolerance: 0.05,
         lod_resolution: 0.04,
+        sub_texel_area: 0.0,
     };
     let mut capped = GlintOptions::default();
     capped.position_normal = position_normal::PatchOptions {

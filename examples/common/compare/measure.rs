@@ -55,7 +55,7 @@ impl Settings {
             size: if quick { 1024 } else { 2048 },
             reference_samples: if quick { 1_000_000 } else { 4_000_000 },
             areas: if quick {
-                vec![0.25, 1.0, 16.0, 256.0]
+                vec![0.25, 1.0, 4.0, 16.0, 256.0]
             } else {
                 vec![0.25, 1.0, 16.0, 256.0, 4096.0, 16384.0, 65536.0]
             },

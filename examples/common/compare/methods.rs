@@ -11,7 +11,7 @@ use brdf::MicrofacetBrdf;
 use brdf::bxdf::{Bxdf, Masking};
 use brdf::fresnel::NoFresnel;
 use brdf::glint::binmap::BinMapParams;
-use brdf::glint::mixture::{DEFAULT_LOD_LOBES, MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
     BeckmannMixture, BinMap, Footprint, GlintNdf, NormalMap, PositionNormalBrdf, PositionNormalMap,
@@ -89,11 +89,13 @@ fn mixture_methods(map: &NormalMap, settings: &Settings) -> Res<Vec<Box<dyn Meth
         ..MixtureParams::default()
     };
     let mix = Arc::new(BeckmannMixture::build(map, params)?);
-    // Tolerance 0: these rows are the full mixture (or the filtered lobe), not a level of detail.
+    // Tolerance 0 and no sub-texel lobe: these rows are the full mixture (or the filtered lobe),
+    // not a level of detail.
     let opts = |masking, lod_lobes| PatchOptions {
         masking,
         lod_lobes,
         lod_tolerance: 0.0,
+        sub_texel_area: 0.0,
         ..PatchOptions::default()
     };
     let inf = f32::INFINITY;
@@ -113,9 +115,15 @@ fn mixture_methods(map: &NormalMap, settings: &Settings) -> Res<Vec<Box<dyn Meth
             false,
         ),
     ];
-    if settings.areas.iter().any(|&a| a > DEFAULT_LOD_LOBES) {
-        methods.push(m(PatchOptions::default(), "mixture (default LOD)", false));
-    }
+    methods.push(m(PatchOptions::default(), "mixture (defaults)", false));
+    methods.push(m(
+        PatchOptions {
+            sub_texel_area: f32::INFINITY,
+            ..PatchOptions::default()
+        },
+        "sub-texel lobe",
+        true,
+    ));
     methods.push(m(
         opts(MaskingMode::Approximate, 0.0),
         "filtered lobe",

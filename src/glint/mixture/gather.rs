@@ -15,6 +15,7 @@ use super::lanes::LANES;
 use super::levels::resolution_index;
 use super::params::PatchOptions;
 use super::storage::{LevelView, LobeStore};
+use super::sub_texel;
 use crate::glint::Footprint;
 use crate::glint::scratch::{Home, Lent};
 use crate::ndf::SlopeGaussian;
@@ -182,8 +183,8 @@ struct Effective {
 
 /// The footprint's Gaussian k_P in level-0 lobe units: centre and covariance [xx, xy, yy].
 pub(super) struct FootprintLobes {
-    c: [f64; 2],
-    cov: [f64; 3],
+    pub c: [f64; 2],
+    pub cov: [f64; 3],
 }
 
 impl FootprintLobes {
@@ -202,7 +203,7 @@ impl FootprintLobes {
     }
 
     /// The footprint's area in lobe cells (12 √det Σ_P: a uniform square of side a has σ² = a²/12).
-    fn area(&self) -> f64 {
+    pub fn area(&self) -> f64 {
         let [sxx, sxy, syy] = self.cov;
         12.0 * (sxx * syy - sxy * sxy).max(0.0).sqrt()
     }
@@ -461,21 +462,30 @@ pub(super) struct Footprinted<'a, L> {
     pub level: L,
     pub filtered: SlopeGaussian,
     pub gathered: Option<Gathered<'a>>,
+    /// Whether `filtered` is the sub-texel limit lobe (sub_texel.rs) rather than the filtered lobe.
+    pub sub_texel: bool,
 }
 
 /// The per-footprint work of a patch of `store` (module docs): the filtered lobe, the level of
 /// detail (the coarsest whose weighted merge-error bound meets `options.lod_tolerance`, moved
 /// coarser by the cost cap, see [`level_range`]) and the gather there, its buffers lent by `slots`.
-/// `weight_sigmas` and `sigma_min` are the mixture's parameters.
+/// `weight_sigmas`, `kernel_sigmas` and `sigma_min` are the mixture's parameters.
 pub(super) fn footprint_patch<'a, S: LobeStore>(
     store: &'a S,
     fp: &FootprintLobes,
     options: &PatchOptions,
-    weight_sigmas: f32,
-    sigma_min: f32,
+    [weight_sigmas, kernel_sigmas, sigma_min]: [f32; 3],
     slots: Option<Home<'a, SlotBuffers>>,
 ) -> Footprinted<'a, S::Level<'a>> {
     let area = fp.area();
+    if area < options.sub_texel_area as f64 {
+        return Footprinted {
+            level: store.level(0),
+            filtered: sub_texel::limit_lobe(store, fp.c, fp.cov, sigma_min, kernel_sigmas),
+            gathered: None,
+            sub_texel: true,
+        };
+    }
     let lod = 0.5 * area.max(1e-300).log2();
     let filtered = SlopeGaussian::from_moments(store.filtered_moments(fp.c, lod), sigma_min);
     let res = resolution_index(options.lod_resolution);
@@ -484,6 +494,7 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
             level: store.level(0),
             filtered,
             gathered: None,
+            sub_texel: false,
         };
     };
     let mut bufs = Lent::new(slots);
@@ -508,6 +519,7 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
         level,
         filtered,
         gathered: Some(gather(weight_sigmas, level, &eff, res, bufs)),
+        sub_texel: false,
     }
 }
 

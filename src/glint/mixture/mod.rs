@@ -55,15 +55,16 @@ mod patch;
 mod simd;
 mod storage;
 mod store;
+mod sub_texel;
 mod view_memo;
 
 pub use model::BeckmannMixture;
 pub use params::{
     DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES, DEFAULT_LOD_RESOLUTION, DEFAULT_LOD_TOLERANCE,
     DEFAULT_MASKING, DEFAULT_SAMPLES, DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL, DEFAULT_SPACING,
-    DEFAULT_SUPERSAMPLING, DEFAULT_WEIGHT_SIGMAS, LOD_RESOLUTIONS, LobeStorage, MAX_SUPERSAMPLING,
-    MAX_TRUNCATION_SIGMAS, MIN_COMPACT_SIGMA, MIN_SPACING, MaskingMode, MixtureMemory,
-    MixtureParams, MomentMethod, PatchOptions,
+    DEFAULT_SUB_TEXEL_AREA, DEFAULT_SUPERSAMPLING, DEFAULT_WEIGHT_SIGMAS, LOD_RESOLUTIONS,
+    LobeStorage, MAX_SUPERSAMPLING, MAX_TRUNCATION_SIGMAS, MIN_COMPACT_SIGMA, MIN_SPACING,
+    MaskingMode, MixtureMemory, MixtureParams, MomentMethod, PatchOptions,
 };
 pub use patch::MixturePatch;
 

@@ -79,6 +79,15 @@ pub const DEFAULT_LOD_LOBES: f32 = 16384.0;
 /// 0.01 (docs/mixture.md, "Why merged levels lose"), and levels ≥ 1 come from the cost cap.
 pub const DEFAULT_LOD_TOLERANCE: f32 = 0.01;
 
+/// Default footprint area, in lobe cells (texels at the default spacing), below which a patch is
+/// the sub-texel limit lobe (src/glint/mixture/sub_texel.rs): one slope Gaussian at the interpolated
+/// slope of the footprint's centre, as wide as the slope variation the footprint covers plus σ_ε.
+///
+/// Below about a texel each mixture lobe carries the slope variation of its whole seed kernel
+/// (σ_k = 0.42 texel), where the P-NDF tends to one slope; measured against the σ_ε-convolved truth
+/// in docs/results.md ("Sub-texel footprints"), which is where this threshold comes from.
+pub const DEFAULT_SUB_TEXEL_AREA: f32 = 2.0;
+
 /// The slope resolutions r at which the levels store their merge-error bounds (slope units, an
 /// isotropic Gaussian's standard deviation): a patch reads the bound at the largest of these ≤
 /// [`PatchOptions::lod_resolution`], which also bounds the error at that resolution (the TV of
@@ -194,6 +203,9 @@ pub struct PatchOptions {
     /// level move to coarser levels (the filtered lobe alone when none is coarse enough);
     /// `f32::INFINITY` disables the cap.
     pub lod_lobes: f32,
+    /// Footprint area, in lobe cells (texels at the default spacing), below which the patch is the
+    /// sub-texel limit lobe ([`DEFAULT_SUB_TEXEL_AREA`]; 0 never).
+    pub sub_texel_area: f32,
     /// Error tolerance of the level of detail ([`DEFAULT_LOD_TOLERANCE`]): a patch uses the
     /// coarsest level of merged lobes whose weighted merge-error bound Σ W_n e(n) is at most this
     /// (and whose nodes are no wider than half the footprint's smaller standard deviation); 0 keeps the
@@ -211,6 +223,7 @@ impl Default for PatchOptions {
         PatchOptions {
             masking: DEFAULT_MASKING,
             lod_lobes: DEFAULT_LOD_LOBES,
+            sub_texel_area: DEFAULT_SUB_TEXEL_AREA,
             lod_tolerance: DEFAULT_LOD_TOLERANCE,
             lod_resolution: DEFAULT_LOD_RESOLUTION,
         }

@@ -109,6 +109,8 @@ pub struct MixturePatch<'a> {
     filtered: SlopeGaussian,
     /// `None` when the level of detail serves the filtered lobe alone.
     gathered: Option<Gathered<'a>>,
+    /// Whether `filtered` is the sub-texel limit lobe (src/glint/mixture/sub_texel.rs).
+    sub_texel: bool,
     /// The compiled copy of the block loops the patch runs ([`Simd::detected`]).
     simd: Simd,
     /// The exact V_P of the last view direction (`pdf_visible`, `sample_visible`,
@@ -130,16 +132,26 @@ impl<'a> MixturePatch<'a> {
         let (width, height) = mixture.map_size();
         let fp = FootprintLobes::new(footprint, width, height, mixture.spacing_f64());
         let p = mixture.params();
-        let (ws, sigma_min) = (p.weight_sigmas, p.sigma_min);
+        let params = [p.weight_sigmas, p.kernel_sigmas, p.sigma_min];
         // The storage is chosen here, once per patch.
-        let (level, filtered, gathered) = match mixture.lobe_storage() {
+        let (level, filtered, gathered, sub_texel) = match mixture.lobe_storage() {
             Storage::Full(s) => {
-                let f = footprint_patch(s, &fp, &options, ws, sigma_min, slots);
-                (PatchLevel::Full(f.level), f.filtered, f.gathered)
+                let f = footprint_patch(s, &fp, &options, params, slots);
+                (
+                    PatchLevel::Full(f.level),
+                    f.filtered,
+                    f.gathered,
+                    f.sub_texel,
+                )
             }
             Storage::Compact(s) => {
-                let f = footprint_patch(s, &fp, &options, ws, sigma_min, slots);
-                (PatchLevel::Compact(f.level), f.filtered, f.gathered)
+                let f = footprint_patch(s, &fp, &options, params, slots);
+                (
+                    PatchLevel::Compact(f.level),
+                    f.filtered,
+                    f.gathered,
+                    f.sub_texel,
+                )
             }
         };
         MixturePatch {
@@ -148,6 +160,7 @@ impl<'a> MixturePatch<'a> {
             masking: options.masking,
             filtered,
             gathered,
+            sub_texel,
             simd: Simd::detected(),
             view: ViewMemo::default(),
         }
@@ -158,9 +171,17 @@ impl<'a> MixturePatch<'a> {
         self.masking
     }
 
-    /// Whether the level of detail replaced the mixture by the filtered lobe.
+    /// Whether the level of detail replaced the mixture by the filtered lobe (the footprint's
+    /// moment-matched lobe, or below [`PatchOptions::sub_texel_area`] the sub-texel limit lobe).
     pub fn is_filtered_lobe(&self) -> bool {
         self.gathered.is_none()
+    }
+
+    /// Whether the patch is the sub-texel limit lobe: one slope Gaussian at the interpolated slope
+    /// of the footprint's centre, for footprints below [`PatchOptions::sub_texel_area`]
+    /// (src/glint/mixture/sub_texel.rs).
+    pub fn is_sub_texel(&self) -> bool {
+        self.sub_texel
     }
 
     /// The level of detail l the patch reads: its lobes are the merged lobes of 2^l × 2^l blocks of
