@@ -83,7 +83,7 @@ pub type Builder = fn(&NormalMap, &Settings) -> Res<Vec<Box<dyn Method>>>;
 /// default): exact terms, approximate terms, the default level of detail (only when a footprint
 /// exceeds it: otherwise it is the exact variant), and the single filtered Beckmann lobe (the
 /// cheapest model).
-fn mixture_methods(map: &NormalMap, settings: &Settings) -> Res<Vec<Box<dyn Method>>> {
+fn mixture_methods(map: &NormalMap, _settings: &Settings) -> Res<Vec<Box<dyn Method>>> {
     let params = MixtureParams {
         sigma_min: SIGMA_EPS,
         ..MixtureParams::default()
