@@ -155,6 +155,8 @@ proptest! {
             lod_tolerance: f32::NAN,
             lod_resolution: -1.0,
             sub_texel_area: f32::NAN,
+            filtered_area: f32::NAN,
+            filtered_tolerance: f32::NAN,
         };
         for options in [
             mixture_options(MaskingMode::Exact, f32::INFINITY),

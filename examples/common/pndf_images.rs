@@ -60,7 +60,7 @@ fn settings(quick: bool) -> Settings {
 }
 
 /// The four procedural maps with their default parameters (bumpy: RMS slope 0.25, ℓ = 4 texels).
-pub(super) fn maps(size: usize) -> Res<Vec<(&'static str, NormalMap)>> {
+pub fn maps(size: usize) -> Res<Vec<(&'static str, NormalMap)>> {
     Ok(vec![
         ("bumpy", bumpy(size, size, 0.25, 4.0, 1)?),
         ("brushed", brushed(size, size, BrushedParams::default(), 2)?),

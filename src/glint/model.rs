@@ -56,6 +56,8 @@ macro_rules! glint_models {
         /// The patch of a [`GlintModel`]: the P-NDF of one footprint, whichever model made it.
         #[derive(Clone, Debug)]
         #[non_exhaustive]
+        // The patches are held by value: boxing the largest would allocate per shading point.
+        #[allow(clippy::large_enum_variant)]
         pub enum GlintPatch<'a> {
             $(
                 #[doc = concat!("The patch of a [`GlintModel::", stringify!($variant), "`].")]

@@ -46,6 +46,7 @@ pub fn exact_options() -> PatchOptions {
         lod_lobes: f32::INFINITY,
         lod_tolerance: 0.0,
         sub_texel_area: 0.0,
+        filtered_area: f32::INFINITY,
         ..PatchOptions::default()
     }
 }

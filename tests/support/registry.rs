@@ -58,6 +58,14 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
         lod_tolerance: 0.05,
         lod_resolution: 0.04,
         sub_texel_area: 0.0,
+        filtered_area: f32::INFINITY,
+        filtered_tolerance: 0.0,
+    };
+    let mut filtered = GlintOptions::default();
+    filtered.mixture = PatchOptions {
+        filtered_area: 0.0,
+        filtered_tolerance: f32::INFINITY,
+        ..PatchOptions::default()
     };
     let mut capped = GlintOptions::default();
     capped.position_normal = position_normal::PatchOptions {
@@ -71,8 +79,13 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
         ),
         example(
             "mixture, approximate masking, coarse level of detail",
-            full,
+            full.clone(),
             coarse,
+        ),
+        example(
+            "mixture, sub-texel lobe and filtered mixture at every footprint",
+            full,
+            filtered,
         ),
         example(
             "mixture, compact storage",

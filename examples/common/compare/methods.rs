@@ -96,6 +96,7 @@ fn mixture_methods(map: &NormalMap, _settings: &Settings) -> Res<Vec<Box<dyn Met
         lod_lobes,
         lod_tolerance: 0.0,
         sub_texel_area: 0.0,
+        filtered_area: f32::INFINITY,
         ..PatchOptions::default()
     };
     let inf = f32::INFINITY;

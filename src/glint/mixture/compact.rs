@@ -37,6 +37,7 @@
 //! compact_encode.rs.
 
 use super::blocks::{J_SCALE, LANES, LobeBlock, SIDE};
+use super::lobe_set::LobeSet;
 use super::params::MixtureMemory;
 use super::storage::{LevelView, LobeStore};
 use crate::glint::kernels::slope_tree::{SlopeTree, level_sizes};
@@ -453,6 +454,12 @@ impl LobeStore for CompactStorage {
     /// Trilinear in the decoded levels' raw moments ([`filtered`]).
     fn filtered_moments(&self, p: [f64; 2], lod: f64) -> [f32; 5] {
         filtered(&self.levels, p, lod)
+    }
+
+    /// False: compact storage holds no filtered-mixture chain (its footprints above the cost cap
+    /// get the filtered lobe).
+    fn filtered_mixture(&self, _p: [f64; 2], _lod: f64, _set: &mut LobeSet) -> bool {
+        false
     }
 
     /// Level 0's compact blocks in `block_bytes`, its quadtree (levels ≥ 2) and frame in

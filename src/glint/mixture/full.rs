@@ -9,8 +9,10 @@
 //! and built mixtures answer bit-identically.
 
 use super::blocks::{LobeBlocks, SIDE};
+use super::gmm::GmmPyramid;
 use super::hierarchy::{LobePyramid, lobe_box};
 use super::levels::{LobeLevel, N_RES, build_levels};
+use super::lobe_set::LobeSet;
 use super::params::MixtureMemory;
 use super::storage::{LevelView, LobeStore};
 use crate::glint::kernels::slope_tree::{SlopeTree, level_sizes, parent_row};
@@ -24,12 +26,19 @@ pub(super) struct FullStorage {
     levels: Vec<LobeLevel>,
     /// The moment mip chain over the lobes (for the filtered lobe).
     pyramid: LobePyramid,
+    /// The filtered-mixture mip chain (gmm.rs).
+    gmm: GmmPyramid,
     sigma_min: f32,
     /// σ² of the variance floor as [`SlopeGaussian::from_moments`] honours `sigma_min`.
     s2: f64,
 }
 
 impl FullStorage {
+    /// Levels of the filtered-mixture mip chain (level 0 included).
+    pub fn filtered_mixture_levels(&self) -> usize {
+        self.gmm.levels()
+    }
+
     /// The storage of the lobes `moments` (row major over `nx × ny`): level 0's blocks and quadtree,
     /// the mip chain and the levels of detail, with the levels' merge errors computed or, when
     /// given, taken from `errors` (one entry per level l ≥ 1; the loader checks their sizes and
@@ -45,6 +54,7 @@ impl FullStorage {
         // Blocks and tree in one streaming pass (no whole-grid temporaries), then the mip chain.
         let (blocks, tree) = derive_blocks_and_tree(nx, ny, &moments, sigma_min, box_k);
         let pyramid = LobePyramid::build(nx, ny, &moments);
+        let gmm = GmmPyramid::build(nx, ny, &moments, sigma_min);
         let pad = SlopeGaussian::from_moments([0.0; 5], sigma_min);
         let merged = build_levels(nx, ny, &moments, sigma_min, box_k, &pad, errors);
         let mut levels = Vec::with_capacity(1 + merged.len());
@@ -59,6 +69,7 @@ impl FullStorage {
         FullStorage {
             levels,
             pyramid,
+            gmm,
             sigma_min,
             s2: sigma_floor_squared(sigma_min),
         }
@@ -98,13 +109,18 @@ impl LobeStore for FullStorage {
         self.pyramid.filtered(self.moments(), p, lod)
     }
 
+    fn filtered_mixture(&self, p: [f64; 2], lod: f64, set: &mut LobeSet) -> bool {
+        self.gmm.lookup(self.moments(), p, lod, set);
+        true
+    }
+
     fn memory(&self) -> MixtureMemory {
         let l0 = &self.levels[0];
         MixtureMemory {
             lobes: l0.moments.len(),
             lobe_bytes: l0.moments.len() * 20,
             hierarchy_bytes: l0.tree.bytes(),
-            mip_bytes: self.pyramid.bytes(),
+            mip_bytes: self.pyramid.bytes() + self.gmm.bytes(),
             block_bytes: l0.blocks.bytes(),
             level_bytes: self.merged().iter().map(LobeLevel::bytes).sum(),
         }

@@ -13,6 +13,7 @@ use super::blocks::SIDE;
 use super::build::kernel_sigma;
 use super::lanes::LANES;
 use super::levels::resolution_index;
+use super::lobe_set::{Few, LobeSet};
 use super::params::PatchOptions;
 use super::storage::{LevelView, LobeStore};
 use super::sub_texel;
@@ -462,39 +463,92 @@ pub(super) struct Footprinted<'a, L> {
     pub level: L,
     pub filtered: SlopeGaussian,
     pub gathered: Option<Gathered<'a>>,
-    /// Whether `filtered` is the sub-texel limit lobe (sub_texel.rs) rather than the filtered lobe.
-    pub sub_texel: bool,
+    /// What serves the patch when `gathered` is `None`: the filtered lobe, the sub-texel limit
+    /// lobe (sub_texel.rs) or the filtered mixture (gmm.rs), with its error estimate (the filtered
+    /// mixture's fit error; 1 for the single lobes, which have none).
+    pub set: Option<(Few<'a>, SetKind, f32)>,
+}
+
+/// Which few-lobe patch a [`LobeSet`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum SetKind {
+    /// The footprint's moment-matched lobe (\[Chermain2019\] §4.2.2).
+    FilteredLobe,
+    /// The sub-texel limit lobe (sub_texel.rs).
+    SubTexel,
+    /// The filtered mixture (gmm.rs).
+    FilteredMixture,
+}
+
+/// The filtered mixture's measured error at level of detail `lod`: the larger of the two levels
+/// a trilinear lookup reads (1 where not measured, NaN `lod` → level 0).
+fn filtered_error_at(errors: &[f32], lod: f64) -> f32 {
+    if errors.is_empty() {
+        return 1.0;
+    }
+    let top = errors.len() - 1;
+    let lod = if lod.is_nan() {
+        0.0
+    } else {
+        lod.clamp(0.0, top as f64)
+    };
+    let (lo, hi) = (lod.floor() as usize, (lod.ceil() as usize).min(top));
+    errors[lo].max(errors[hi])
 }
 
 /// The per-footprint work of a patch of `store` (module docs): the filtered lobe, the level of
 /// detail (the coarsest whose weighted merge-error bound meets `options.lod_tolerance`, moved
 /// coarser by the cost cap, see [`level_range`]) and the gather there, its buffers lent by `slots`.
-/// `weight_sigmas`, `kernel_sigmas` and `sigma_min` are the mixture's parameters.
+/// `weight_sigmas`, `kernel_sigmas` and `sigma_min` are the mixture's parameters,
+/// `filtered_error` the filtered mixture's measured error per level (calibrate.rs).
 pub(super) fn footprint_patch<'a, S: LobeStore>(
     store: &'a S,
     fp: &FootprintLobes,
     options: &PatchOptions,
     [weight_sigmas, kernel_sigmas, sigma_min]: [f32; 3],
+    filtered_error: &[f32],
     slots: Option<Home<'a, SlotBuffers>>,
+    sets: Option<Home<'a, LobeSet>>,
 ) -> Footprinted<'a, S::Level<'a>> {
     let area = fp.area();
     if area < options.sub_texel_area as f64 {
+        let lobe = sub_texel::limit_lobe(store, fp.c, fp.cov, sigma_min, kernel_sigmas);
         return Footprinted {
             level: store.level(0),
-            filtered: sub_texel::limit_lobe(store, fp.c, fp.cov, sigma_min, kernel_sigmas),
+            filtered: lobe,
             gathered: None,
-            sub_texel: true,
+            set: Some((Few::One(lobe), SetKind::SubTexel, 1.0)),
         };
     }
     let lod = 0.5 * area.max(1e-300).log2();
     let filtered = SlopeGaussian::from_moments(store.filtered_moments(fp.c, lod), sigma_min);
+    // The filtered mixture where the storage has one (with its measured error at this level),
+    // else the filtered lobe.
+    let error = filtered_error_at(filtered_error, lod);
+    let few = || {
+        let mut set = Lent::new(sets);
+        if store.filtered_mixture(fp.c, lod, &mut set) && set.len() > 0 {
+            (Few::Set(set), SetKind::FilteredMixture, error)
+        } else {
+            (Few::One(filtered), SetKind::FilteredLobe, 1.0)
+        }
+    };
+    let tolerance = options.filtered_tolerance;
+    if area >= options.filtered_area as f64 && (error <= tolerance || tolerance == f32::INFINITY) {
+        return Footprinted {
+            level: store.level(0),
+            filtered,
+            gathered: None,
+            set: Some(few()),
+        };
+    }
     let res = resolution_index(options.lod_resolution);
     let Some((finest, coarsest)) = level_range(store, fp, area, options) else {
         return Footprinted {
             level: store.level(0),
             filtered,
             gathered: None,
-            sub_texel: false,
+            set: Some(few()),
         };
     };
     let mut bufs = Lent::new(slots);
@@ -519,7 +573,7 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
         level,
         filtered,
         gathered: Some(gather(weight_sigmas, level, &eff, res, bufs)),
-        sub_texel: false,
+        set: None,
     }
 }
 

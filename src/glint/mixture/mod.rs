@@ -39,15 +39,18 @@
 mod blocks;
 mod build;
 mod build_filter;
+mod calibrate;
 mod compact;
 mod compact_encode;
 #[cfg(test)]
 mod dispatch_tests;
 mod full;
 mod gather;
+mod gmm;
 mod hierarchy;
 mod lanes;
 mod levels;
+mod lobe_set;
 mod model;
 mod params;
 mod passes;
@@ -58,13 +61,15 @@ mod store;
 mod sub_texel;
 mod view_memo;
 
+pub use gmm::GMM_LOBES;
 pub use model::BeckmannMixture;
 pub use params::{
-    DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES, DEFAULT_LOD_RESOLUTION, DEFAULT_LOD_TOLERANCE,
-    DEFAULT_MASKING, DEFAULT_SAMPLES, DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL, DEFAULT_SPACING,
-    DEFAULT_SUB_TEXEL_AREA, DEFAULT_SUPERSAMPLING, DEFAULT_WEIGHT_SIGMAS, LOD_RESOLUTIONS,
-    LobeStorage, MAX_SUPERSAMPLING, MAX_TRUNCATION_SIGMAS, MIN_COMPACT_SIGMA, MIN_SPACING,
-    MaskingMode, MixtureMemory, MixtureParams, MomentMethod, PatchOptions,
+    DEFAULT_FILTERED_AREA, DEFAULT_FILTERED_TOLERANCE, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES,
+    DEFAULT_LOD_RESOLUTION, DEFAULT_LOD_TOLERANCE, DEFAULT_MASKING, DEFAULT_SAMPLES,
+    DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL, DEFAULT_SPACING, DEFAULT_SUB_TEXEL_AREA,
+    DEFAULT_SUPERSAMPLING, DEFAULT_WEIGHT_SIGMAS, LOD_RESOLUTIONS, LobeStorage, MAX_SUPERSAMPLING,
+    MAX_TRUNCATION_SIGMAS, MIN_COMPACT_SIGMA, MIN_SPACING, MaskingMode, MixtureMemory,
+    MixtureParams, MomentMethod, PatchOptions,
 };
 pub use patch::MixturePatch;
 

@@ -5,6 +5,7 @@
 
 use super::build;
 use super::build_filter;
+use super::calibrate;
 use super::compact::CompactStorage;
 use super::compact_encode;
 use super::full::FullStorage;
@@ -65,6 +66,9 @@ pub struct BeckmannMixture {
     params: MixtureParams,
     /// Half-width of the slope boxes in lobe standard deviations, k = √(−2 ln tail).
     box_k: f32,
+    /// The filtered mixture's measured TV to the full mixture per level of its mip chain
+    /// (calibrate.rs); empty without a filtered mixture (compact storage).
+    filtered_error: Vec<f32>,
 }
 
 /// The lobe grid (nx, ny) = max(1, round(size / spacing)) and the spacing actually used per axis.
@@ -197,7 +201,11 @@ impl BeckmannMixture {
         params: MixtureParams,
         storage: Storage,
     ) -> Self {
-        BeckmannMixture {
+        let levels = match &storage {
+            Storage::Full(s) => s.filtered_mixture_levels(),
+            Storage::Compact(_) => 0,
+        };
+        let mut mix = BeckmannMixture {
             width,
             height,
             grid,
@@ -205,7 +213,17 @@ impl BeckmannMixture {
             storage,
             params,
             box_k: box_sigmas(params.slope_tail),
-        }
+            filtered_error: Vec::new(),
+        };
+        mix.filtered_error = calibrate::filtered_mixture_errors(&mix, levels);
+        mix
+    }
+
+    /// The filtered mixture's measured TV to the full mixture per level of its mip chain (index l:
+    /// footprints of 4^l lobe cells; 1 where not measured below the first measured level), empty
+    /// under compact storage. See src/glint/mixture/calibrate.rs.
+    pub fn filtered_mixture_errors(&self) -> &[f32] {
+        &self.filtered_error
     }
 
     /// The lobes and their levels of detail.

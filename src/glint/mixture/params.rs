@@ -88,6 +88,21 @@ pub const DEFAULT_LOD_TOLERANCE: f32 = 0.01;
 /// in docs/results.md ("Sub-texel footprints"), which is where this threshold comes from.
 pub const DEFAULT_SUB_TEXEL_AREA: f32 = 2.0;
 
+/// Default footprint area, in lobe cells (texels at the default spacing), at and above which a
+/// patch is the filtered mixture (src/glint/mixture/gmm.rs): [`GMM_LOBES`](super::GMM_LOBES) lobes
+/// per node of a mip chain, read trilinearly, O(1) per query whatever the footprint (full storage;
+/// compact storage serves the filtered lobe there).
+///
+/// Chosen from the cost and error of a shading point against footprint (docs/results.md, "Cost and
+/// error of a shading point against footprint"): where the gathered mixture's cost has grown past
+/// the filtered mixture's while its TV to the σ_ε-convolved truth has come within a few hundredths.
+pub const DEFAULT_FILTERED_AREA: f32 = 4096.0;
+
+/// Default tolerance of the filtered mixture: the largest TV to the full mixture, measured per
+/// mixture and level at build time (src/glint/mixture/calibrate.rs), at which it serves a large
+/// footprint. See docs/results.md, "Cost and error of a shading point against footprint".
+pub const DEFAULT_FILTERED_TOLERANCE: f32 = 0.15;
+
 /// The slope resolutions r at which the levels store their merge-error bounds (slope units, an
 /// isotropic Gaussian's standard deviation): a patch reads the bound at the largest of these ≤
 /// [`PatchOptions::lod_resolution`], which also bounds the error at that resolution (the TV of
@@ -206,6 +221,15 @@ pub struct PatchOptions {
     /// Footprint area, in lobe cells (texels at the default spacing), below which the patch is the
     /// sub-texel limit lobe ([`DEFAULT_SUB_TEXEL_AREA`]; 0 never).
     pub sub_texel_area: f32,
+    /// Footprint area, in lobe cells, at and above which the patch may be the filtered mixture
+    /// ([`DEFAULT_FILTERED_AREA`]; `f32::INFINITY` never).
+    pub filtered_area: f32,
+    /// Largest measured TV between the filtered mixture and the full mixture at the footprint's
+    /// level ([`DEFAULT_FILTERED_TOLERANCE`], measured per mixture at build time,
+    /// src/glint/mixture/calibrate.rs) at which the filtered mixture serves a footprint of at
+    /// least `filtered_area`; above it the footprint is gathered (the level of detail and the
+    /// cost cap `lod_lobes` decide). `f32::INFINITY` always serves it.
+    pub filtered_tolerance: f32,
     /// Error tolerance of the level of detail ([`DEFAULT_LOD_TOLERANCE`]): a patch uses the
     /// coarsest level of merged lobes whose weighted merge-error bound Σ W_n e(n) is at most this
     /// (and whose nodes are no wider than half the footprint's smaller standard deviation); 0 keeps the
@@ -224,6 +248,8 @@ impl Default for PatchOptions {
             masking: DEFAULT_MASKING,
             lod_lobes: DEFAULT_LOD_LOBES,
             sub_texel_area: DEFAULT_SUB_TEXEL_AREA,
+            filtered_area: DEFAULT_FILTERED_AREA,
+            filtered_tolerance: DEFAULT_FILTERED_TOLERANCE,
             lod_tolerance: DEFAULT_LOD_TOLERANCE,
             lod_resolution: DEFAULT_LOD_RESOLUTION,
         }

@@ -9,7 +9,8 @@
 use super::blocks;
 use super::compact::CompactView;
 use super::full::FullLevel;
-use super::gather::{FootprintLobes, Gathered, SlotBuffers, footprint_patch};
+use super::gather::{FootprintLobes, Gathered, SetKind, SlotBuffers, footprint_patch};
+use super::lobe_set::{Few, LobeSet};
 use super::model::{BeckmannMixture, Storage};
 use super::params::{MaskingMode, PatchOptions};
 use super::passes::{SumP22, UntruncatedSum, VisiblePick, VisibleSum};
@@ -109,8 +110,11 @@ pub struct MixturePatch<'a> {
     filtered: SlopeGaussian,
     /// `None` when the level of detail serves the filtered lobe alone.
     gathered: Option<Gathered<'a>>,
-    /// Whether `filtered` is the sub-texel limit lobe (src/glint/mixture/sub_texel.rs).
-    sub_texel: bool,
+    /// What serves the patch when `gathered` is `None` (the filtered lobe, the sub-texel limit
+    /// lobe or the filtered mixture) and which it is; empty and `None` otherwise.
+    few: Few<'a>,
+    few_kind: Option<SetKind>,
+    few_error: f32,
     /// The compiled copy of the block loops the patch runs ([`Simd::detected`]).
     simd: Simd,
     /// The exact V_P of the last view direction (`pdf_visible`, `sample_visible`,
@@ -129,29 +133,21 @@ impl<'a> MixturePatch<'a> {
         scratch: Option<&'a GlintScratch>,
     ) -> MixturePatch<'a> {
         let slots = scratch.map(|s| s.home::<SlotBuffers>());
+        let sets = scratch.map(|s| s.home::<LobeSet>());
         let (width, height) = mixture.map_size();
         let fp = FootprintLobes::new(footprint, width, height, mixture.spacing_f64());
         let p = mixture.params();
         let params = [p.weight_sigmas, p.kernel_sigmas, p.sigma_min];
+        let errors = mixture.filtered_mixture_errors();
         // The storage is chosen here, once per patch.
-        let (level, filtered, gathered, sub_texel) = match mixture.lobe_storage() {
+        let (level, filtered, gathered, set) = match mixture.lobe_storage() {
             Storage::Full(s) => {
-                let f = footprint_patch(s, &fp, &options, params, slots);
-                (
-                    PatchLevel::Full(f.level),
-                    f.filtered,
-                    f.gathered,
-                    f.sub_texel,
-                )
+                let f = footprint_patch(s, &fp, &options, params, errors, slots, sets);
+                (PatchLevel::Full(f.level), f.filtered, f.gathered, f.set)
             }
             Storage::Compact(s) => {
-                let f = footprint_patch(s, &fp, &options, params, slots);
-                (
-                    PatchLevel::Compact(f.level),
-                    f.filtered,
-                    f.gathered,
-                    f.sub_texel,
-                )
+                let f = footprint_patch(s, &fp, &options, params, errors, slots, sets);
+                (PatchLevel::Compact(f.level), f.filtered, f.gathered, f.set)
             }
         };
         MixturePatch {
@@ -160,7 +156,9 @@ impl<'a> MixturePatch<'a> {
             masking: options.masking,
             filtered,
             gathered,
-            sub_texel,
+            few_kind: set.as_ref().map(|(_, k, _)| *k),
+            few_error: set.as_ref().map_or(0.0, |(_, _, e)| *e),
+            few: set.map_or(Few::None, |(s, _, _)| s),
             simd: Simd::detected(),
             view: ViewMemo::default(),
         }
@@ -171,17 +169,31 @@ impl<'a> MixturePatch<'a> {
         self.masking
     }
 
-    /// Whether the level of detail replaced the mixture by the filtered lobe (the footprint's
-    /// moment-matched lobe, or below [`PatchOptions::sub_texel_area`] the sub-texel limit lobe).
+    /// Whether the level of detail replaced the mixture by the single filtered lobe (the
+    /// footprint's moment-matched lobe: compact storage above the cost cap or
+    /// [`PatchOptions::filtered_area`], or an empty filtered mixture).
     pub fn is_filtered_lobe(&self) -> bool {
-        self.gathered.is_none()
+        self.few_kind == Some(SetKind::FilteredLobe)
+    }
+
+    /// Whether the patch is the filtered mixture: [`super::GMM_LOBES`] lobes per node of a mip
+    /// chain read trilinearly (src/glint/mixture/gmm.rs), for footprints of at least
+    /// [`PatchOptions::filtered_area`] (or beyond the cost cap), full storage.
+    pub fn is_filtered_mixture(&self) -> bool {
+        self.few_kind == Some(SetKind::FilteredMixture)
     }
 
     /// Whether the patch is the sub-texel limit lobe: one slope Gaussian at the interpolated slope
     /// of the footprint's centre, for footprints below [`PatchOptions::sub_texel_area`]
     /// (src/glint/mixture/sub_texel.rs).
     pub fn is_sub_texel(&self) -> bool {
-        self.sub_texel
+        self.few_kind == Some(SetKind::SubTexel)
+    }
+
+    /// The lobes of the patch when it is one of the few-lobe forms (filtered lobe, sub-texel lobe,
+    /// filtered mixture): (weight, lobe) pairs, weights summing to 1; empty otherwise.
+    pub fn few_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
+        self.few.lobes().into_iter()
     }
 
     /// The level of detail l the patch reads: its lobes are the merged lobes of 2^l × 2^l blocks of
@@ -198,7 +210,9 @@ impl<'a> MixturePatch<'a> {
     /// even spread and the full mixture's own weights is not bounded (measured 0.0005-0.013 in TV,
     /// docs/mixture.md). See src/glint/mixture/levels.rs.
     pub fn lod_error(&self) -> f32 {
-        self.gathered.as_ref().map_or(1.0, |g| g.lod_error as f32)
+        self.gathered
+            .as_ref()
+            .map_or(self.few_error, |g| g.lod_error as f32)
     }
 
     /// The Beckmann lobe of the footprint's filtered moments (\[Chermain2019\] §4.2.2): their
@@ -217,7 +231,7 @@ impl<'a> MixturePatch<'a> {
     pub fn mean_slope(&self) -> Vec2 {
         self.gathered
             .as_ref()
-            .map_or(self.filtered.mean(), |g| g.mean_slope)
+            .map_or_else(|| self.few.mean_slope(), |g| g.mean_slope)
     }
 
     /// The normalised weights W_i and their lobes, for tests and tools: (W, lobe) per slot.
@@ -243,7 +257,7 @@ impl<'a> MixturePatch<'a> {
     /// \[Chermain2019\] eq. 9, §5.
     pub fn d_with_stats(&self, m: Vec3) -> (f32, usize) {
         let Some(g) = &self.gathered else {
-            return (self.filtered.d(m), 0);
+            return (self.few.d(m), 0);
         };
         let Some(s) = normal_to_slope(m) else {
             return (0.0, 0);
@@ -315,7 +329,7 @@ impl<'a> MixturePatch<'a> {
     pub fn visible_area_exact(&self, w: Vec3) -> f32 {
         match &self.gathered {
             Some(g) => finite_or_zero(self.exact_visible_area(g, w)),
-            None => self.filtered.visible_area(w),
+            None => self.few.visible_area(w),
         }
     }
 
@@ -358,7 +372,7 @@ impl<'a> MixturePatch<'a> {
             Some(g) => (0..g.bufs.weights.len())
                 .map(|s| g.bufs.weights[s] as f64 * self.slot_lobe(g, s).projected_area(w) as f64)
                 .sum::<f64>() as f32,
-            None => self.filtered.projected_area(w),
+            None => self.few.projected_area(w),
         }
     }
 
@@ -432,7 +446,7 @@ impl Ndf for MixturePatch<'_> {
     fn projected_area(&self, w: Vec3) -> f32 {
         match &self.gathered {
             Some(_) => self.signed_projected_area(w).max(0.0),
-            None => self.filtered.projected_area(w),
+            None => self.few.projected_area(w),
         }
     }
 
@@ -443,14 +457,14 @@ impl Ndf for MixturePatch<'_> {
         match (&self.gathered, self.masking) {
             (Some(g), MaskingMode::Exact) => finite_or_zero(self.exact_visible_area(g, w)),
             (Some(g), MaskingMode::Approximate) => self.visible_area_bound(g, w),
-            (None, _) => self.filtered.visible_area(w),
+            (None, _) => self.few.visible_area(w),
         }
     }
 
     /// m ~ D_P(m) cos θ_m: lobe ∝ W_i with u.x (rescaled), then the lobe's slope Gaussian.
     fn sample_normal(&self, u: Vec2) -> Vec3 {
         let Some(g) = &self.gathered else {
-            return self.filtered.sample_normal(u);
+            return self.few.sample_normal(u);
         };
         let (s, ux) = invert_cdf(&g.bufs.cdf, u.x);
         self.slot_lobe(g, s).sample_normal(Vec2::new(ux, u.y))
@@ -462,7 +476,7 @@ impl Ndf for MixturePatch<'_> {
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
         match &self.gathered {
             Some(g) => self.sample_visible_gathered(g, wo, u),
-            None => self.filtered.sample_visible(wo, u),
+            None => self.few.sample_visible(wo, u),
         }
     }
 
@@ -507,7 +521,7 @@ impl MixturePatch<'_> {
     #[inline]
     fn pdf_normal_with(&self, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
         let Some(g) = &self.gathered else {
-            return self.filtered.pdf_normal(m);
+            return self.few.pdf_normal(m);
         };
         // 0 where D_P is (outside every lobe's slope box): one density contract for every NDF.
         if !(m.z > 0.0 && m.is_finite()) || d() <= 0.0 {
@@ -523,7 +537,7 @@ impl MixturePatch<'_> {
     #[inline]
     fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
         let Some(g) = &self.gathered else {
-            return self.filtered.pdf_visible(wo, m);
+            return self.few.pdf_visible(wo, m);
         };
         let c = wo.dot(m);
         if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {

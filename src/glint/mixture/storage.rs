@@ -10,6 +10,7 @@
 //! Both traits are crate-private and implemented only by the two storages (sealed).
 
 use super::blocks::LobeBlock;
+use super::lobe_set::LobeSet;
 use super::params::MixtureMemory;
 use crate::glint::kernels::slope_tree::SlopeTree;
 use crate::ndf::SlopeGaussian;
@@ -71,6 +72,11 @@ pub(super) trait LobeStore {
     /// (level-0 lobe units) at level of detail `lod` (\[Chermain2019\] §4.2.2): a trilinear lookup,
     /// a convex combination of stored moments.
     fn filtered_moments(&self, p: [f64; 2], lod: f64) -> [f32; 5];
+
+    /// The filtered mixture of a footprint centred at `p` at level of detail `lod` (gmm.rs) into
+    /// `set`, or `false` (set untouched) when the storage holds no filtered-mixture chain (then
+    /// the filtered lobe serves).
+    fn filtered_mixture(&self, p: [f64; 2], lod: f64, set: &mut LobeSet) -> bool;
 
     /// Bytes held.
     fn memory(&self) -> MixtureMemory;

@@ -1,0 +1,122 @@
+//! The filtered mixture's error, measured at build time: for each level l of its mip chain, the
+//! mean total variation between the filtered mixture (gmm.rs) and the full mixture over
+//! footprints of 4^l lobe cells (the footprints whose lookup reads level l), so that a patch
+//! serves the filtered mixture only where it stays within the caller's tolerance of the full one
+//! ([`PatchOptions::filtered_tolerance`](super::PatchOptions::filtered_tolerance)).
+//!
+//! **Estimator.** TV(p, q) = ½ ∫ |p − q| = E_r[|p − q| / (p + q)] with r = ½ (p + q), p and q the
+//! two patches' normal densities D(m) cos θ_m; [`SAMPLES`] normals, half drawn from each patch
+//! by its `sample_normal` on a fixed R2 sequence (deterministic), at [`CENTRES`] fixed footprint
+//! centres, averaged. The standard error of the mean is ≤ ½ / √(SAMPLES · CENTRES) ≈ 0.016.
+//!
+//! **Which levels.** Measured for footprints of 4^l lobe cells with 4^l in [[`FIRST_AREA`],
+//! [`LAST_AREA`]]; the full mixture's `d` costs ~0.1 ms at the last one, which bounds the build's
+//! extra time (~0.1-0.3 s per map). Coarser levels take the value measured at [`LAST_AREA`] (the
+//! filtered mixture's distance falls as footprints grow and their P-NDFs smooth out: measured in
+//! docs/results.md), finer ones are not served by the filtered mixture (error 1).
+
+use super::model::BeckmannMixture;
+use super::params::PatchOptions;
+use crate::glint::{Footprint, GlintNdf};
+use crate::ndf::Ndf;
+use glam::{Vec2, Vec3};
+
+/// Normals per footprint centre.
+const SAMPLES: usize = 256;
+/// Footprint centres per level.
+const CENTRES: usize = 4;
+/// Smallest footprint (lobe cells) at which the error is measured.
+pub(super) const FIRST_AREA: f64 = 64.0;
+/// Largest footprint (lobe cells) at which the error is measured.
+const LAST_AREA: f64 = 4096.0;
+
+/// The R2 sequence point k (\[Roberts2018\]): a low-discrepancy point in [0, 1)².
+fn r2(k: usize) -> Vec2 {
+    const G: f64 = 1.324_717_957_244_746;
+    let a = [1.0 / G, 1.0 / (G * G)];
+    let x = (0.5 + k as f64 * a[0]).fract();
+    let y = (0.5 + k as f64 * a[1]).fract();
+    Vec2::new(x as f32, y as f32)
+}
+
+/// TV between the normal densities D cos θ of two patches, by the estimator of the module docs.
+fn tv(p: &impl Ndf, q: &impl Ndf) -> f64 {
+    let density = |n: &dyn Fn(Vec3) -> f32, m: Vec3| -> f64 {
+        if m.z > 0.0 && m.is_finite() {
+            (n(m) * m.z) as f64
+        } else {
+            0.0
+        }
+    };
+    let mut sum = 0.0;
+    for k in 0..SAMPLES {
+        let u = r2(k);
+        let m = if k % 2 == 0 {
+            p.sample_normal(u)
+        } else {
+            q.sample_normal(u)
+        };
+        let (a, b) = (density(&|m| p.d(m), m), density(&|m| q.d(m), m));
+        if a + b > 0.0 && (a + b).is_finite() {
+            sum += (a - b).abs() / (a + b);
+        }
+    }
+    sum / SAMPLES as f64
+}
+
+/// Per level l of the mip chain (index l, level 0 included), the measured mean TV between the
+/// filtered mixture and the full mixture at footprints of 4^l lobe cells (module docs); empty when
+/// the mixture's storage has no filtered mixture.
+pub(super) fn filtered_mixture_errors(mix: &BeckmannMixture, levels: usize) -> Vec<f32> {
+    use rayon::prelude::*;
+    let (w, h) = mix.map_size();
+    let [hx, hy] = mix.spacing_f64();
+    let full = PatchOptions {
+        lod_lobes: f32::INFINITY,
+        lod_tolerance: 0.0,
+        sub_texel_area: 0.0,
+        filtered_area: f32::INFINITY,
+        ..PatchOptions::default()
+    };
+    let filtered = PatchOptions {
+        filtered_area: 0.0,
+        filtered_tolerance: f32::INFINITY,
+        ..full
+    };
+    let (nx, ny) = mix.grid();
+    let grid_area = (nx * ny) as f64;
+    let measured: Vec<(usize, f32)> = (0..levels)
+        .into_par_iter()
+        .filter_map(|l| {
+            let area = (1u64 << (2 * l)) as f64;
+            if !(FIRST_AREA..=LAST_AREA).contains(&area) || area > grid_area {
+                return None;
+            }
+            let mut sum = 0.0;
+            for c in 0..CENTRES {
+                let uv = r2(1000 + c);
+                let fp = Footprint::isotropic_texels(uv, (area * hx * hy) as f32, w, h);
+                let exact = mix.patch_with(&fp, &full, None);
+                let few = mix.patch_with(&fp, &filtered, None);
+                if !few.is_filtered_mixture() {
+                    return None;
+                }
+                sum += tv(&exact, &few);
+            }
+            Some((l, (sum / CENTRES as f64) as f32))
+        })
+        .collect();
+    if measured.is_empty() {
+        return Vec::new();
+    }
+    let last = measured.iter().max_by_key(|m| m.0).map_or(1.0, |m| m.1);
+    let last_level = measured.iter().map(|m| m.0).max().unwrap_or(0);
+    (0..levels)
+        .map(|l| {
+            measured
+                .iter()
+                .find(|m| m.0 == l)
+                .map_or(if l > last_level { last } else { 1.0 }, |m| m.1)
+        })
+        .collect()
+}

@@ -1,0 +1,321 @@
+//! The filtered mixture: a mip chain whose every node holds a [`GMM_LOBES`]-lobe slope Gaussian
+//! mixture of the lobes below it, so that a large footprint is served in O(1) by a few lobes that
+//! keep the P-NDF's shape (the single filtered lobe of \[Chermain2019\] §4.2.2 keeps only its mean
+//! and covariance).
+//!
+//! **Build.** Level 0 is the lobes themselves (one component each, as D evaluates them: floored
+//! covariance, clamped correlation; not stored). A node of level l + 1 takes the components of its
+//! (up to) 2 × 2 children, each child's weights divided by the number of children, and reduces them
+//! to [`GMM_LOBES`] by greedy pairwise merging: the pair whose moment-matched merge has the smallest
+//! upper bound of the KL divergence it adds,
+//! B(i, j) = ½ [(w_i + w_j) ln det Σ_ij − w_i ln det Σ_i − w_j ln det Σ_j] (\[Runnalls2007\] eq. 21),
+//! is merged until [`GMM_LOBES`] components remain. Moment matching keeps the node's mean and
+//! covariance exact (those of the single filtered lobe), so the filtered mixture is never further
+//! from the lobes it replaces, in its first two moments, than the filtered lobe; its extra lobes
+//! keep what one Gaussian cannot hold (a flat surface's peak and its scratches' streaks apart).
+//!
+//! **Lookup.** As the moment mip chain: trilinear at level log₂ √(footprint area in lobes) and the
+//! footprint's centre, a convex combination of up to 8 nodes, each weight multiplying its node's
+//! component weights (src/glint/mixture/lobe_set.rs holds the result and evaluates it).
+//!
+//! Cost: ~20 ns of build per lobe (one reduction of ≤ 4 [`GMM_LOBES`] components per node), 96
+//! bytes per node of the levels ≥ 1 (≤ 32 bytes per lobe), and O(1) per query.
+
+use super::lobe_set::LobeSet;
+use crate::glint::kernels::slope_tree::level_sizes;
+use crate::ndf::SlopeGaussian;
+
+/// Components per node of the filtered mixture.
+pub const GMM_LOBES: usize = 4;
+
+/// One stored component: weight (summing to 1 over a node) and raw moments
+/// `[E x̃, E ỹ, E x̃², E ỹ², E x̃ỹ]` of its Gaussian.
+type Stored = [f32; 6];
+
+/// A component during the build: weight, mean and covariance [xx, xy, yy], in `f64`.
+#[derive(Clone, Copy, Debug)]
+struct Comp {
+    w: f64,
+    mean: [f64; 2],
+    cov: [f64; 3],
+}
+
+impl Comp {
+    fn of_lobe(g: &SlopeGaussian) -> Comp {
+        let (m, c) = (g.mean(), g.covariance());
+        Comp {
+            w: 1.0,
+            mean: [m.x as f64, m.y as f64],
+            cov: [c.x_axis.x as f64, c.x_axis.y as f64, c.y_axis.y as f64],
+        }
+    }
+
+    fn ln_det(&self) -> f64 {
+        (self.cov[0] * self.cov[2] - self.cov[1] * self.cov[1])
+            .max(1e-300)
+            .ln()
+    }
+
+    /// The moment-matched merge of two components.
+    fn merge(&self, o: &Comp) -> Comp {
+        let w = self.w + o.w;
+        if w <= 0.0 {
+            return *self;
+        }
+        let (a, b) = (self.w / w, o.w / w);
+        let mean = [
+            a * self.mean[0] + b * o.mean[0],
+            a * self.mean[1] + b * o.mean[1],
+        ];
+        let (d0, d1) = (self.mean[0] - o.mean[0], self.mean[1] - o.mean[1]);
+        let ab = a * b;
+        Comp {
+            w,
+            mean,
+            cov: [
+                a * self.cov[0] + b * o.cov[0] + ab * d0 * d0,
+                a * self.cov[1] + b * o.cov[1] + ab * d0 * d1,
+                a * self.cov[2] + b * o.cov[2] + ab * d1 * d1,
+            ],
+        }
+    }
+
+    fn stored(&self) -> Stored {
+        let [mx, my] = self.mean;
+        [
+            self.w as f32,
+            mx as f32,
+            my as f32,
+            (self.cov[0] + mx * mx) as f32,
+            (self.cov[2] + my * my) as f32,
+            (self.cov[1] + mx * my) as f32,
+        ]
+    }
+
+    fn from_stored(s: &Stored) -> Comp {
+        let (mx, my) = (s[1] as f64, s[2] as f64);
+        Comp {
+            w: s[0] as f64,
+            mean: [mx, my],
+            cov: [
+                s[3] as f64 - mx * mx,
+                s[5] as f64 - mx * my,
+                s[4] as f64 - my * my,
+            ],
+        }
+    }
+}
+
+/// Reduces `comps` (weights summing to 1) to at most `k` components by Runnalls' greedy merging
+/// (module docs).
+fn reduce(comps: &mut Vec<Comp>, k: usize) {
+    comps.retain(|c| c.w > 0.0);
+    while comps.len() > k {
+        let mut best = (f64::INFINITY, 0, 1);
+        for i in 0..comps.len() {
+            for j in (i + 1)..comps.len() {
+                let (a, b) = (&comps[i], &comps[j]);
+                let m = a.merge(b);
+                let cost = 0.5 * (m.w * m.ln_det() - a.w * a.ln_det() - b.w * b.ln_det());
+                if cost < best.0 {
+                    best = (cost, i, j);
+                }
+            }
+        }
+        let (_, i, j) = best;
+        let m = comps[i].merge(&comps[j]);
+        comps[i] = m;
+        comps.swap_remove(j);
+    }
+}
+
+/// The filtered-mixture mip chain (module docs): levels l ≥ 1, [`GMM_LOBES`] components per node.
+#[derive(Clone, Debug)]
+pub(super) struct GmmPyramid {
+    sizes: Vec<[usize; 2]>,
+    /// `levels[l - 1]`: level l's nodes, row major, each [`GMM_LOBES`] components (weight 0 pads).
+    levels: Vec<Vec<[Stored; GMM_LOBES]>>,
+    /// Level 0: the lobes' raw moments (as the store holds them) and the floor σ_min.
+    sigma_min: f32,
+}
+
+impl GmmPyramid {
+    /// Builds the chain over an `nx × ny` lobe grid of raw moments `lobes` (row major), each lobe
+    /// floored at `sigma_min` as D evaluates it.
+    pub fn build(nx: usize, ny: usize, lobes: &[[f32; 5]], sigma_min: f32) -> GmmPyramid {
+        use rayon::prelude::*;
+        let sizes = level_sizes(nx, ny);
+        let mut levels: Vec<Vec<[Stored; GMM_LOBES]>> = Vec::new();
+        for l in 1..sizes.len() {
+            let [pw, ph] = sizes[l - 1];
+            let [w, h] = sizes[l];
+            let prev = levels.last();
+            let children_of = |x: usize, y: usize| -> Vec<Comp> {
+                let mut comps = Vec::with_capacity(4 * GMM_LOBES);
+                let mut n = 0.0;
+                for cy in (2 * y)..(2 * y + 2).min(ph) {
+                    for cx in (2 * x)..(2 * x + 2).min(pw) {
+                        n += 1.0;
+                        let k = cy * pw + cx;
+                        match prev {
+                            Some(p) => comps.extend(p[k].iter().map(Comp::from_stored)),
+                            None => comps.push(Comp::of_lobe(&SlopeGaussian::from_moments(
+                                lobes[k], sigma_min,
+                            ))),
+                        }
+                    }
+                }
+                for c in &mut comps {
+                    c.w /= n;
+                }
+                comps
+            };
+            let level: Vec<[Stored; GMM_LOBES]> = (0..w * h)
+                .into_par_iter()
+                .map(|k| {
+                    let mut comps = children_of(k % w, k / w);
+                    reduce(&mut comps, GMM_LOBES);
+                    let mut out = [[0.0f32; 6]; GMM_LOBES];
+                    for (o, c) in out.iter_mut().zip(&comps) {
+                        *o = c.stored();
+                    }
+                    out
+                })
+                .collect();
+            levels.push(level);
+        }
+        GmmPyramid {
+            sizes,
+            levels,
+            sigma_min,
+        }
+    }
+
+    /// Levels of the chain, level 0 (the lobes) included.
+    pub fn levels(&self) -> usize {
+        self.sizes.len()
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.levels
+            .iter()
+            .map(|l| l.len() * std::mem::size_of::<[Stored; GMM_LOBES]>())
+            .sum()
+    }
+
+    /// The filtered mixture of a footprint centred at `p` (level-0 lobe units) at level of detail
+    /// `lod` (clamped to [0, top], NaN → 0), into `set`: trilinear over the nodes, as the moment
+    /// mip chain (src/glint/mixture/hierarchy.rs), `lobes` the level-0 raw moments; at most 8
+    /// nodes × [`GMM_LOBES`] lobes.
+    pub fn lookup(&self, lobes: &[[f32; 5]], p: [f64; 2], lod: f64, set: &mut LobeSet) {
+        let top = (self.sizes.len() - 1) as f64;
+        let lod = if lod.is_nan() {
+            0.0
+        } else {
+            lod.clamp(0.0, top)
+        };
+        let p = if p[0].is_finite() && p[1].is_finite() {
+            p
+        } else {
+            [0.0, 0.0]
+        };
+        let l0 = lod.floor();
+        let t = lod - l0;
+        let l0 = l0 as usize;
+        set.clear();
+        let mut add_level = |l: usize, wl: f64| {
+            if wl <= 0.0 {
+                return;
+            }
+            let [w, h] = self.sizes[l];
+            let scale = (1u64 << l) as f64;
+            let (px, py) = (p[0] / scale - 0.5, p[1] / scale - 0.5);
+            let (bx, by) = (px.floor(), py.floor());
+            let (fx, fy) = (px - bx, py - by);
+            for (dx, dy, wb) in [
+                (0.0, 0.0, (1.0 - fx) * (1.0 - fy)),
+                (1.0, 0.0, fx * (1.0 - fy)),
+                (0.0, 1.0, (1.0 - fx) * fy),
+                (1.0, 1.0, fx * fy),
+            ] {
+                let wn = wl * wb;
+                if wn <= 0.0 {
+                    continue;
+                }
+                let i = ((bx + dx) as i64).rem_euclid(w as i64) as usize;
+                let j = ((by + dy) as i64).rem_euclid(h as i64) as usize;
+                let k = j * w + i;
+                if l == 0 {
+                    set.push(
+                        wn as f32,
+                        SlopeGaussian::from_moments(lobes[k], self.sigma_min),
+                    );
+                } else {
+                    for c in &self.levels[l - 1][k] {
+                        if c[0] > 0.0 {
+                            let g = SlopeGaussian::from_moments(
+                                [c[1], c[2], c[3], c[4], c[5]],
+                                self.sigma_min,
+                            );
+                            set.push((wn * c[0] as f64) as f32, g);
+                        }
+                    }
+                }
+            }
+        };
+        add_level(l0, 1.0 - t);
+        if l0 + 1 < self.sizes.len() {
+            add_level(l0 + 1, t);
+        }
+        set.normalise();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn comp(w: f64, mx: f64, my: f64, s: f64) -> Comp {
+        Comp {
+            w,
+            mean: [mx, my],
+            cov: [s * s, 0.0, s * s],
+        }
+    }
+
+    /// Reduction keeps the total weight, mean and covariance of the mixture (moment matching is
+    /// exact at every merge), and merges the two close components before the far one.
+    #[test]
+    fn reduction_keeps_the_first_two_moments() {
+        let mut c = vec![
+            comp(0.25, 0.0, 0.0, 0.01),
+            comp(0.25, 0.001, 0.0, 0.01),
+            comp(0.25, 0.3, 0.1, 0.02),
+            comp(0.25, -0.2, 0.05, 0.01),
+        ];
+        let moments = |c: &[Comp]| {
+            let w: f64 = c.iter().map(|c| c.w).sum();
+            let mx: f64 = c.iter().map(|c| c.w * c.mean[0]).sum::<f64>() / w;
+            let vxx: f64 = c
+                .iter()
+                .map(|c| c.w * (c.cov[0] + (c.mean[0] - mx).powi(2)))
+                .sum::<f64>()
+                / w;
+            (w, mx, vxx)
+        };
+        let before = moments(&c);
+        reduce(&mut c, 3);
+        let after = moments(&c);
+        assert_eq!(c.len(), 3);
+        assert!((before.0 - after.0).abs() < 1e-12);
+        assert!((before.1 - after.1).abs() < 1e-12);
+        assert!((before.2 - after.2).abs() < 1e-12);
+        // The far components survive unmerged.
+        assert!(c.iter().any(|c| (c.mean[0] - 0.3).abs() < 1e-12));
+        assert!(c.iter().any(|c| (c.mean[0] + 0.2).abs() < 1e-12));
+        reduce(&mut c, 1);
+        let one = moments(&c);
+        assert!((before.2 - one.2).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,271 @@
+//! A small weighted set of slope Gaussians evaluated by brute force: what a mixture patch serves
+//! when its level of detail is one lobe (the filtered lobe, the sub-texel limit lobe) or the
+//! filtered mixture of a large footprint (src/glint/mixture/gmm.rs), with the terms of
+//! \[Chermain2019\] eq. 9-17 over its lobes:
+//!
+//! - D(m) = Σ w_i D_i(m);
+//! - A(w) = max(cos θ − w_xy·μ, 0), μ = Σ w_i μ_i (the signed areas summed, as the mixture's);
+//! - V(w) = Σ w_i V_i(w) (exact, O(lobes));
+//! - `sample_normal`: a lobe ∝ w_i, then its slope Gaussian; density Σ w_i D_i(m) cos θ_m;
+//! - `sample_visible`: a lobe ∝ w_i V_i(wo), then its visible normal; density
+//!   Σ w_i ⟨wo, m⟩⁺ D_i(m) / V(wo).
+//!
+//! A set of one lobe answers every query as that lobe does. A patch holds one lobe inline
+//! ([`Few::One`]) or a set lent by the caller's scratch ([`Few::Set`]), so that neither a patch's
+//! size nor a shading loop's allocations grow with the set.
+
+use crate::glint::scratch::Lent;
+use crate::ndf::{Ndf, SlopeGaussian};
+use glam::{Vec2, Vec3};
+
+/// A weighted set of slope Gaussians (module docs).
+#[derive(Clone, Debug, Default)]
+pub(super) struct LobeSet {
+    n: usize,
+    w: Vec<f32>,
+    g: Vec<SlopeGaussian>,
+}
+
+/// What a few-lobe patch holds: one lobe inline, or a set lent by the caller's scratch.
+#[derive(Clone, Debug)]
+pub(super) enum Few<'a> {
+    /// No lobes (a gathered patch).
+    None,
+    /// One lobe of weight 1.
+    One(SlopeGaussian),
+    /// A weighted set.
+    Set(Lent<'a, LobeSet>),
+}
+
+impl LobeSet {
+    /// Empties the set (keeping its capacity).
+    pub fn clear(&mut self) {
+        self.n = 0;
+        self.w.clear();
+        self.g.clear();
+    }
+
+    /// Adds a lobe of weight `w` (ignored unless `w` is positive and finite).
+    pub fn push(&mut self, w: f32, g: SlopeGaussian) {
+        if w > 0.0 && w.is_finite() {
+            self.w.push(w);
+            self.g.push(g);
+            self.n += 1;
+        }
+    }
+
+    /// Scales the weights to sum to 1 (an empty set stays empty).
+    pub fn normalise(&mut self) {
+        let sum: f32 = self.weights().iter().sum();
+        if sum > 0.0 {
+            for w in &mut self.w[..self.n] {
+                *w /= sum;
+            }
+        }
+    }
+
+    /// Number of lobes.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    fn weights(&self) -> &[f32] {
+        &self.w[..self.n]
+    }
+
+    /// (weight, lobe) pairs.
+    pub fn iter(&self) -> impl Iterator<Item = (f32, &SlopeGaussian)> {
+        self.weights().iter().copied().zip(&self.g[..self.n])
+    }
+
+    /// The mean slope Σ w_i μ_i.
+    pub fn mean_slope(&self) -> Vec2 {
+        self.iter().map(|(w, g)| w * g.mean()).sum()
+    }
+
+    /// Picks lobe i with probability ∝ `p_i`, rescaling `u` into [0, 1) for the lobe's own draw.
+    fn pick(&self, p: impl Fn(usize) -> f32, u: f32) -> Option<(usize, f32)> {
+        let total: f32 = (0..self.n).map(&p).sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        let target = u.clamp(0.0, 1.0) * total;
+        let mut acc = 0.0;
+        let mut last = None;
+        for i in 0..self.n {
+            let pi = p(i);
+            if pi <= 0.0 {
+                continue;
+            }
+            last = Some(i);
+            if target < acc + pi {
+                let r = ((target - acc) / pi).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+                return Some((i, r));
+            }
+            acc += pi;
+        }
+        last.map(|i| (i, 1.0 - f32::EPSILON / 2.0))
+    }
+}
+
+impl LobeSet {
+    /// The lobe itself when the set is one lobe of weight 1 (every query then delegates to it,
+    /// bit for bit).
+    #[inline]
+    fn single(&self) -> Option<&SlopeGaussian> {
+        (self.n == 1).then(|| &self.g[0])
+    }
+}
+
+impl Ndf for LobeSet {
+    fn d(&self, m: Vec3) -> f32 {
+        if let Some(g) = self.single() {
+            return g.d(m);
+        }
+        self.iter().map(|(w, g)| w * g.d(m)).sum()
+    }
+
+    fn lambda(&self, w: Vec3) -> f32 {
+        if let Some(g) = self.single() {
+            return g.lambda(w);
+        }
+        crate::ndf::lambda_from_areas(self, w)
+    }
+
+    fn projected_area(&self, w: Vec3) -> f32 {
+        if let Some(g) = self.single() {
+            return g.projected_area(w);
+        }
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let mu = self.mean_slope();
+        (w.z - w.x * mu.x - w.y * mu.y).max(0.0)
+    }
+
+    fn visible_area(&self, w: Vec3) -> f32 {
+        if let Some(g) = self.single() {
+            return g.visible_area(w);
+        }
+        let v: f32 = self.iter().map(|(wi, g)| wi * g.visible_area(w)).sum();
+        if v.is_finite() { v } else { 0.0 }
+    }
+
+    fn sample_normal(&self, u: Vec2) -> Vec3 {
+        if let Some(g) = self.single() {
+            return g.sample_normal(u);
+        }
+        match self.pick(|i| self.w[i], u.x) {
+            Some((i, ux)) => self.g[i].sample_normal(Vec2::new(ux, u.y)),
+            None => Vec3::Z,
+        }
+    }
+
+    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        if let Some(g) = self.single() {
+            return g.sample_visible(wo, u);
+        }
+        if !(wo.z > 0.0 && wo.is_finite()) {
+            return self.sample_normal(u);
+        }
+        match self.pick(|i| self.w[i] * self.g[i].visible_area(wo), u.x) {
+            Some((i, ux)) => self.g[i].sample_visible(wo, Vec2::new(ux, u.y)),
+            None => self.sample_normal(u),
+        }
+    }
+
+    fn pdf_normal(&self, m: Vec3) -> f32 {
+        if let Some(g) = self.single() {
+            return g.pdf_normal(m);
+        }
+        if !(m.z > 0.0 && m.is_finite()) {
+            return 0.0;
+        }
+        let p = self.d(m) * m.z;
+        if p.is_finite() { p } else { 0.0 }
+    }
+
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        if let Some(g) = self.single() {
+            return g.pdf_visible(wo, m);
+        }
+        let c = wo.dot(m);
+        if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
+            return 0.0;
+        }
+        let v = self.visible_area(wo);
+        if v.is_nan() || v <= 0.0 {
+            return 0.0;
+        }
+        let p = c * self.d(m) / v;
+        if p.is_finite() { p } else { 0.0 }
+    }
+}
+
+impl Few<'_> {
+    /// The lobes as (weight, lobe) pairs (empty for [`Few::None`]).
+    pub fn lobes(&self) -> Vec<(f32, SlopeGaussian)> {
+        match self {
+            Few::None => Vec::new(),
+            Few::One(g) => vec![(1.0, *g)],
+            Few::Set(s) => s.iter().map(|(w, g)| (w, *g)).collect(),
+        }
+    }
+
+    /// The mean slope Σ w_i μ_i (zero for [`Few::None`]).
+    pub fn mean_slope(&self) -> Vec2 {
+        match self {
+            Few::None => Vec2::ZERO,
+            Few::One(g) => g.mean(),
+            Few::Set(s) => s.mean_slope(),
+        }
+    }
+}
+
+/// Runs `$body` with `$n` bound to the lobe or the set (a [`Few::None`] answers `$none`).
+macro_rules! with_few {
+    ($few:expr, $none:expr, |$n:ident| $body:expr) => {
+        match $few {
+            Few::None => $none,
+            Few::One($n) => $body,
+            Few::Set(s) => {
+                let $n: &LobeSet = s;
+                $body
+            }
+        }
+    };
+}
+
+impl Ndf for Few<'_> {
+    fn d(&self, m: Vec3) -> f32 {
+        with_few!(self, 0.0, |n| n.d(m))
+    }
+
+    fn lambda(&self, w: Vec3) -> f32 {
+        with_few!(self, 0.0, |n| n.lambda(w))
+    }
+
+    fn projected_area(&self, w: Vec3) -> f32 {
+        with_few!(self, 0.0, |n| n.projected_area(w))
+    }
+
+    fn visible_area(&self, w: Vec3) -> f32 {
+        with_few!(self, 0.0, |n| n.visible_area(w))
+    }
+
+    fn sample_normal(&self, u: Vec2) -> Vec3 {
+        with_few!(self, Vec3::Z, |n| n.sample_normal(u))
+    }
+
+    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        with_few!(self, Vec3::Z, |n| n.sample_visible(wo, u))
+    }
+
+    fn pdf_normal(&self, m: Vec3) -> f32 {
+        with_few!(self, 0.0, |n| n.pdf_normal(m))
+    }
+
+    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
+        with_few!(self, 0.0, |n| n.pdf_visible(wo, m))
+    }
+}
