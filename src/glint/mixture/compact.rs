@@ -458,6 +458,15 @@ impl LobeStore for CompactStorage {
 
     /// False: compact storage holds no filtered-mixture chain (its footprints above the cost cap
     /// get the filtered lobe).
+    fn lobe_moments(&self, i: i64, j: i64) -> [f32; 5] {
+        let l0 = &self.levels[0];
+        let [nx, ny] = l0.grid;
+        let (i, j) = (i.rem_euclid(nx as i64), j.rem_euclid(ny as i64));
+        l0.lane(j as usize * nx + i as usize)
+            .raw_moments()
+            .map(|v| v as f32)
+    }
+
     fn filtered_mixture(&self, _p: [f64; 2], _lod: f64, _set: &mut LobeSet) -> bool {
         false
     }

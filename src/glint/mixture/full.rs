@@ -109,6 +109,12 @@ impl LobeStore for FullStorage {
         self.pyramid.filtered(self.moments(), p, lod)
     }
 
+    fn lobe_moments(&self, i: i64, j: i64) -> [f32; 5] {
+        let [nx, ny] = self.levels[0].grid;
+        let (i, j) = (i.rem_euclid(nx as i64), j.rem_euclid(ny as i64));
+        self.moments()[j as usize * nx + i as usize]
+    }
+
     fn filtered_mixture(&self, p: [f64; 2], lod: f64, set: &mut LobeSet) -> bool {
         self.gmm.lookup(self.moments(), p, lod, set);
         true

@@ -511,12 +511,43 @@ impl Ndf for MixturePatch<'_> {
     fn view_visible_area(&self, wo: Vec3) -> f32 {
         match (&self.gathered, self.masking) {
             (Some(g), MaskingMode::Exact) => finite_or_zero(self.view_exact_visible_area(g, wo)),
-            _ => self.visible_area(wo),
+            (Some(_), MaskingMode::Approximate) => self.visible_area(wo),
+            (None, _) => self.few_view_visible_area(wo),
         }
     }
 }
 
 impl MixturePatch<'_> {
+    /// The few-lobe patch's V(wo) at the view: a set's kept in the view memo (a shading point
+    /// asks for V(wo) at every density and sample), a single lobe's directly.
+    fn few_view_visible_area(&self, wo: Vec3) -> f32 {
+        match &self.few {
+            Few::Set(set) if wo.z > 0.0 && wo.is_finite() => {
+                self.view.get_or(wo, || set.visible_area(wo) as f64) as f32
+            }
+            few => few.visible_area(wo),
+        }
+    }
+
+    /// The few-lobe patch's visible-normal density ⟨wo, m⟩⁺ D(m) / V(wo) with D(m) = `d()` and
+    /// V(wo) through the view memo for a set (the same value its own `pdf_visible` computes); a
+    /// single lobe's own density.
+    fn few_pdf_visible(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
+        let Few::Set(_) = &self.few else {
+            return self.few.pdf_visible(wo, m);
+        };
+        let c = wo.dot(m);
+        if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
+            return 0.0;
+        }
+        let v = self.few_view_visible_area(wo);
+        if v.is_nan() || v <= 0.0 {
+            return 0.0;
+        }
+        let p = c * d() / v;
+        if p.is_finite() { p } else { 0.0 }
+    }
+
     /// [`Ndf::pdf_normal`], with `d` giving D_P(m) for the density contract's check.
     #[inline]
     fn pdf_normal_with(&self, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
@@ -537,7 +568,7 @@ impl MixturePatch<'_> {
     #[inline]
     fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
         let Some(g) = &self.gathered else {
-            return self.few.pdf_visible(wo, m);
+            return self.few_pdf_visible(wo, m, d);
         };
         let c = wo.dot(m);
         if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {

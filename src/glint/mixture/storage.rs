@@ -73,6 +73,10 @@ pub(super) trait LobeStore {
     /// a convex combination of stored moments.
     fn filtered_moments(&self, p: [f64; 2], lod: f64) -> [f32; 5];
 
+    /// The raw moments of level-0 lobe (i, j), indices wrapped onto the lobe grid (as stored: the
+    /// moments themselves, or their compact encoding decoded).
+    fn lobe_moments(&self, i: i64, j: i64) -> [f32; 5];
+
     /// The filtered mixture of a footprint centred at `p` at level of detail `lod` (gmm.rs) into
     /// `set`, or `false` (set untouched) when the storage holds no filtered-mixture chain (then
     /// the filtered lobe serves).

@@ -73,13 +73,8 @@ pub(super) fn limit_moments<S: LobeStore>(
     ];
     let mut mean = [0.0f64; 2];
     let mut spread = [0.0f64; 3];
-    // A lookup at a lobe's own centre at level 0 returns that lobe's stored moments (the bilinear
-    // weights there are 1, 0, 0, 0; wrapping as the lattice does).
-    let at = |x: f64, y: f64| {
-        store
-            .filtered_moments([x + 0.5, y + 0.5], 0.0)
-            .map(f64::from)
-    };
+    // The stored moments of lobe (x, y), wrapping as the lattice does.
+    let at = |x: f64, y: f64| store.lobe_moments(x as i64, y as i64).map(f64::from);
     // The lobe means are the slope field smoothed by the seed kernel, s̃ = s ∗ N(0, σ_k² I); one
     // step of deconvolution, s ≈ s̃ − ½ σ_k² ∇² s̃, with the lattice Laplacian of the means.
     let sk2 = seed_variance(kernel_sigmas);
