@@ -9,15 +9,17 @@
 //! by its `sample_normal` on a fixed R2 sequence (deterministic), at [`CENTRES`] fixed footprint
 //! centres, averaged. The standard error of the mean is ≤ ½ / √(SAMPLES · CENTRES) ≈ 0.016.
 //!
+//! Measured on a mixture's first footprint that needs it (a renderer whose footprints stay small
+//! never pays for it).
+//!
 //! **Which levels.** Measured for footprints of 4^l lobe cells with 4^l in [[`FIRST_AREA`],
 //! [`LAST_AREA`]]; the full mixture's `d` costs ~0.1 ms at the last one, which bounds the build's
 //! extra time (~0.1-0.3 s per map). Coarser levels take the value measured at [`LAST_AREA`] (the
 //! filtered mixture's distance falls as footprints grow and their P-NDFs smooth out: measured in
 //! docs/results.md), finer ones are not served by the filtered mixture (error 1).
 
-use super::model::BeckmannMixture;
 use super::params::PatchOptions;
-use crate::glint::{Footprint, GlintNdf};
+use crate::glint::Footprint;
 use crate::ndf::Ndf;
 use glam::{Vec2, Vec3};
 
@@ -40,7 +42,7 @@ fn r2(k: usize) -> Vec2 {
 }
 
 /// TV between the normal densities D cos θ of two patches, by the estimator of the module docs.
-fn tv(p: &impl Ndf, q: &impl Ndf) -> f64 {
+pub(super) fn tv(p: &impl Ndf, q: &impl Ndf) -> f64 {
     let density = |n: &dyn Fn(Vec3) -> f32, m: Vec3| -> f64 {
         if m.z > 0.0 && m.is_finite() {
             (n(m) * m.z) as f64
@@ -64,13 +66,9 @@ fn tv(p: &impl Ndf, q: &impl Ndf) -> f64 {
     sum / SAMPLES as f64
 }
 
-/// Per level l of the mip chain (index l, level 0 included), the measured mean TV between the
-/// filtered mixture and the full mixture at footprints of 4^l lobe cells (module docs); empty when
-/// the mixture's storage has no filtered mixture.
-pub(super) fn filtered_mixture_errors(mix: &BeckmannMixture, levels: usize) -> Vec<f32> {
-    use rayon::prelude::*;
-    let (w, h) = mix.map_size();
-    let [hx, hy] = mix.spacing_f64();
+/// The options of the two patches compared: the full mixture, and the filtered mixture at any
+/// footprint (neither reads the measured errors).
+pub(super) fn compared_options() -> (PatchOptions, PatchOptions) {
     let full = PatchOptions {
         lod_lobes: f32::INFINITY,
         lod_tolerance: 0.0,
@@ -83,8 +81,24 @@ pub(super) fn filtered_mixture_errors(mix: &BeckmannMixture, levels: usize) -> V
         filtered_tolerance: f32::INFINITY,
         ..full
     };
-    let (nx, ny) = mix.grid();
-    let grid_area = (nx * ny) as f64;
+    (full, filtered)
+}
+
+/// Per level l of a mip chain of `levels` levels (index l, level 0 included) over a lobe grid of
+/// `grid_area` lobes spaced `spacing` texels on a `map` = (width, height) map, the measured mean TV
+/// between the filtered mixture and the full mixture at footprints of 4^l lobe cells (module docs);
+/// `tv_at(footprint)` measures one footprint (`None` when the filtered mixture does not serve it).
+/// Empty when `levels` is 0.
+pub(super) fn filtered_mixture_errors(
+    levels: usize,
+    grid_area: f64,
+    spacing: [f64; 2],
+    map: (usize, usize),
+    tv_at: impl Fn(&Footprint) -> Option<f64> + Sync,
+) -> Vec<f32> {
+    use rayon::prelude::*;
+    let (w, h) = map;
+    let [hx, hy] = spacing;
     let measured: Vec<(usize, f32)> = (0..levels)
         .into_par_iter()
         .filter_map(|l| {
@@ -96,12 +110,7 @@ pub(super) fn filtered_mixture_errors(mix: &BeckmannMixture, levels: usize) -> V
             for c in 0..CENTRES {
                 let uv = r2(1000 + c);
                 let fp = Footprint::isotropic_texels(uv, (area * hx * hy) as f32, w, h);
-                let exact = mix.patch_with(&fp, &full, None);
-                let few = mix.patch_with(&fp, &filtered, None);
-                if !few.is_filtered_mixture() {
-                    return None;
-                }
-                sum += tv(&exact, &few);
+                sum += tv_at(&fp)?;
             }
             Some((l, (sum / CENTRES as f64) as f32))
         })

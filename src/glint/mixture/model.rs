@@ -5,7 +5,6 @@
 
 use super::build;
 use super::build_filter;
-use super::calibrate;
 use super::compact::CompactStorage;
 use super::compact_encode;
 use super::full::FullStorage;
@@ -67,8 +66,8 @@ pub struct BeckmannMixture {
     /// Half-width of the slope boxes in lobe standard deviations, k = √(−2 ln tail).
     box_k: f32,
     /// The filtered mixture's measured TV to the full mixture per level of its mip chain
-    /// (calibrate.rs); empty without a filtered mixture (compact storage).
-    filtered_error: Vec<f32>,
+    /// (calibrate.rs), measured on first use; empty without a filtered mixture (compact storage).
+    filtered_error: std::sync::OnceLock<Vec<f32>>,
 }
 
 /// The lobe grid (nx, ny) = max(1, round(size / spacing)) and the spacing actually used per axis.
@@ -201,11 +200,7 @@ impl BeckmannMixture {
         params: MixtureParams,
         storage: Storage,
     ) -> Self {
-        let levels = match &storage {
-            Storage::Full(s) => s.filtered_mixture_levels(),
-            Storage::Compact(_) => 0,
-        };
-        let mut mix = BeckmannMixture {
+        BeckmannMixture {
             width,
             height,
             grid,
@@ -213,17 +208,21 @@ impl BeckmannMixture {
             storage,
             params,
             box_k: box_sigmas(params.slope_tail),
-            filtered_error: Vec::new(),
-        };
-        mix.filtered_error = calibrate::filtered_mixture_errors(&mix, levels);
-        mix
+            filtered_error: std::sync::OnceLock::new(),
+        }
     }
 
-    /// The filtered mixture's measured TV to the full mixture per level of its mip chain (index l:
-    /// footprints of 4^l lobe cells; 1 where not measured below the first measured level), empty
-    /// under compact storage. See src/glint/mixture/calibrate.rs.
-    pub fn filtered_mixture_errors(&self) -> &[f32] {
+    /// The cell of the filtered mixture's measured errors (filled on first use, patch.rs).
+    pub(super) fn filtered_error_cell(&self) -> &std::sync::OnceLock<Vec<f32>> {
         &self.filtered_error
+    }
+
+    /// Levels of the filtered mixture's mip chain (0 under compact storage, which has none).
+    pub(super) fn filtered_mixture_levels(&self) -> usize {
+        match &self.storage {
+            Storage::Full(s) => s.filtered_mixture_levels(),
+            Storage::Compact(_) => 0,
+        }
     }
 
     /// The lobes and their levels of detail.
