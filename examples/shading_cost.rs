@@ -282,10 +282,9 @@ fn chart(out: &std::path::Path, rows: &[Row]) -> Res<()> {
         .iter()
         .map(|m| series(m, &|r| r.seconds * 1e6, true))
         .collect();
-    let tv: Vec<Series> = models[1..]
-        .iter()
-        .map(|m| series(m, &|r| r.tv, false))
-        .collect();
+    // Every model in both charts (analytic GGX has no TV: an empty series), so that a model keeps
+    // its colour.
+    let tv: Vec<Series> = models.iter().map(|m| series(m, &|r| r.tv, false)).collect();
     let chart = |title, y_label, y_scale| Chart {
         title,
         x_label: "footprint (texels)",

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The plastic number g (g³ = g + 1), generator of the R2 sequence.
-const PLASTIC: f64 = 1.324_717_957_244_746;
+pub(super) const PLASTIC: f64 = 1.324_717_957_244_746;
 
 /// σ of the seed kernel for a spacing `h`: half of the peak at h/2, exp(−(h/2)²/(2σ²)) = ½, so
 /// σ = h / (2 √(2 ln 2)) ≈ 0.4247 h.

@@ -18,6 +18,7 @@
 //! filtered mixture's distance falls as footprints grow and their P-NDFs smooth out: measured in
 //! docs/results.md), finer ones are not served by the filtered mixture (error 1).
 
+use super::build::PLASTIC;
 use super::params::PatchOptions;
 use crate::glint::Footprint;
 use crate::ndf::Ndf;
@@ -32,10 +33,10 @@ pub(super) const FIRST_AREA: f64 = 64.0;
 /// Largest footprint (lobe cells) at which the error is measured.
 const LAST_AREA: f64 = 4096.0;
 
-/// The R2 sequence point k (\[Roberts2018\]): a low-discrepancy point in [0, 1)².
+/// Point k of the R2 sequence (Roberts 2018, the additive recurrence with the plastic number):
+/// a low-discrepancy point in [0, 1)².
 fn r2(k: usize) -> Vec2 {
-    const G: f64 = 1.324_717_957_244_746;
-    let a = [1.0 / G, 1.0 / (G * G)];
+    let a = [1.0 / PLASTIC, 1.0 / (PLASTIC * PLASTIC)];
     let x = (0.5 + k as f64 * a[0]).fract();
     let y = (0.5 + k as f64 * a[1]).fract();
     Vec2::new(x as f32, y as f32)

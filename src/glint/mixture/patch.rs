@@ -75,7 +75,14 @@ impl PatchLevel<'_> {
 /// - Samplers: `sample_normal` draws a lobe ∝ W_i then its slope Gaussian (exactly D_P cos θ);
 ///   `sample_visible` draws a lobe ∝ W_i V_i(wo) then that lobe's visible normal, density
 ///   Σ W_i ⟨wo,m⟩⁺ D_i / V_P(wo) = `pdf_visible` (exact V_P in both masking modes).
-/// - Level of detail: the patch is made of the nodes of one level l of merged lobes
+/// - Few-lobe forms (one slope Gaussian or a few, evaluated by brute force, O(1) per query):
+///   below [`PatchOptions::sub_texel_area`] the sub-texel limit lobe
+///   (src/glint/mixture/sub_texel.rs); from [`PatchOptions::filtered_area`] the filtered mixture
+///   (src/glint/mixture/gmm.rs) where its measured TV to the full mixture
+///   ([`BeckmannMixture::filtered_mixture_errors`]) is within
+///   [`PatchOptions::filtered_tolerance`], and beyond the cost cap; compact storage serves the
+///   single filtered lobe there. Their masking is exact (V = Σ w_i V_i, V(wo) kept per view).
+/// - Level of detail otherwise: the patch is made of the nodes of one level l of merged lobes
 ///   (src/glint/mixture/levels.rs; l = 0 is the lobes themselves): the coarsest level whose nodes
 ///   are no wider than half the footprint's smaller standard deviation and whose bound
 ///   Σ W_n e_r(n) on the TV to the full mixture at slope resolution r = `lod_resolution` (both
