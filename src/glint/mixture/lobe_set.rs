@@ -83,9 +83,21 @@ impl LobeSet {
         self.iter().map(|(w, g)| w * g.mean()).sum()
     }
 
-    /// Picks lobe i with probability ∝ `p_i`, rescaling `u` into [0, 1) for the lobe's own draw.
+    /// Picks lobe i with probability ∝ `p(i)` (each evaluated once), rescaling `u` into [0, 1) for
+    /// the lobe's own draw.
     fn pick(&self, p: impl Fn(usize) -> f32, u: f32) -> Option<(usize, f32)> {
-        let total: f32 = (0..self.n).map(&p).sum();
+        // The probabilities of the first `STACK` lobes on the stack (a filtered mixture has ≤ 32),
+        // the rest evaluated again in the scan.
+        const STACK: usize = 32;
+        let mut first = [0.0f32; STACK];
+        let mut total = 0.0f32;
+        for i in 0..self.n {
+            let pi = p(i);
+            if i < STACK {
+                first[i] = pi;
+            }
+            total += pi;
+        }
         if !(total > 0.0 && total.is_finite()) {
             return None;
         }
@@ -93,7 +105,7 @@ impl LobeSet {
         let mut acc = 0.0;
         let mut last = None;
         for i in 0..self.n {
-            let pi = p(i);
+            let pi = if i < STACK { first[i] } else { p(i) };
             if pi <= 0.0 {
                 continue;
             }
