@@ -90,14 +90,10 @@ impl LobeSet {
         // the rest evaluated again in the scan.
         const STACK: usize = 32;
         let mut first = [0.0f32; STACK];
-        let mut total = 0.0f32;
-        for i in 0..self.n {
-            let pi = p(i);
-            if i < STACK {
-                first[i] = pi;
-            }
-            total += pi;
+        for (i, f) in first.iter_mut().enumerate().take(self.n) {
+            *f = p(i);
         }
+        let total: f32 = first.iter().sum::<f32>() + (STACK..self.n).map(&p).sum::<f32>();
         if !(total > 0.0 && total.is_finite()) {
             return None;
         }
@@ -105,7 +101,7 @@ impl LobeSet {
         let mut acc = 0.0;
         let mut last = None;
         for i in 0..self.n {
-            let pi = if i < STACK { first[i] } else { p(i) };
+            let pi = first.get(i).copied().unwrap_or_else(|| p(i));
             if pi <= 0.0 {
                 continue;
             }
