@@ -2,11 +2,12 @@
 //! model and the two references, the exact P-BRDF of the map and normal-mapped rendering
 //! (\[Chermain2019\] Fig. 1 and 11); see docs/orb.md.
 //!
-//! `cargo run --release --example orb -- [--map scratched|brushed|bumpy|flakes|PATH] [--spp N]
+//! `cargo run --release --example orb -- [--map scratched|brushed|bumpy|flakes|fractal|PATH] [--spp N]
 //! [--size PIXELS] [--map-size TEXELS] [--tiles UxV] [--naive-spp N] [--sigma S]
 //! [--out DIR] [--quiet]`, or `-- --quick [--out DIR]` for the gallery's
 //! small strip (scratched 512² map, 160² pixels, 256 spp); `-- --curves [--quick] [--out DIR]` for
-//! the error-against-time curves and equal-error speedups (examples/common/orb_curves.rs).
+//! the error-against-time curves and equal-error speedups (examples/common/orb_curves.rs); `-- --bias
+//! [--out DIR]` for the decomposition of the glint models' bias floor (examples/common/orb/bias.rs).
 //!
 //! Writes one PNG per method, a labelled strip and a CSV of times and errors into DIR (default
 //! `target/brdf-out/`), and prints the table.
@@ -50,7 +51,9 @@ fn options() -> Res<OrbOptions> {
 
 fn main() -> Res<()> {
     let out = common::out_dir()?;
-    if has_flag("--curves") {
+    if has_flag("--bias") {
+        common::orb::bias::run(&out)?;
+    } else if has_flag("--curves") {
         common::orb_curves::run(&out, has_flag("--quick"))?;
     } else if has_flag("--quick") {
         common::orb::run_gallery(&out, true)?;
