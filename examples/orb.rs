@@ -51,7 +51,11 @@ fn options() -> Res<OrbOptions> {
 
 fn main() -> Res<()> {
     let out = common::out_dir()?;
-    if has_flag("--bias") {
+    if let (true, Some(csv)) = (has_flag("--bias"), arg_value("--chart")) {
+        common::orb::bias::chart_from_csv(std::path::Path::new(&csv))?;
+    } else if has_flag("--bias") && has_flag("--spacing") {
+        common::orb::bias::run_spacing(&out)?;
+    } else if has_flag("--bias") {
         common::orb::bias::run(&out)?;
     } else if has_flag("--curves") {
         common::orb_curves::run(&out, has_flag("--quick"))?;

@@ -4,8 +4,9 @@
 //! lighting. See docs/orb.md, "Bias floor decomposition".
 //!
 //! The candidates: the level of detail (`lod_lobes` ∞, `lod_tolerance` 0: the full mixture), the
-//! masking terms (approximate instead of exact), the lobes' quadrature (256 nodes per lobe, the
-//! library's default, instead of the orb's 64), the lobe spacing (0.5 texel instead of 1: twice as
+//! masking terms (approximate instead of exact), `MixtureParams::samples` 256 instead of 64 (a
+//! control: the default moment method is the separable filter, which does not read it), the lobe
+//! spacing (0.5 texel instead of 1: twice as
 //! many lobe centres per axis, the proxy for the position kernel sampled at lobe centres rather than
 //! integrated over each texel), and the light: a disc light of angular radius
 //! [`AREA_LIGHT_DEGREES`] seen from the sphere's centre, in the reference and the model alike, in
@@ -324,7 +325,7 @@ fn variants(map: &NormalMap) -> Res<Vec<Variant>> {
 struct Row {
     map: String,
     scale: f32,
-    label: &'static str,
+    label: String,
     build_s: f64,
     render_s: f64,
     vs_a: f64,
@@ -337,6 +338,60 @@ struct Row {
 pub const MAPS: [&str; 5] = ["scratched", "brushed", "bumpy", "flakes", "fractal"];
 /// Map scales k (tiles (2k, k)).
 pub const SCALES: [f32; 2] = [2.0, 16.0];
+
+/// The lobe-spacing ladder (`orb -- --bias --spacing`): the mixture (default options) built at
+/// spacings 1, 0.5 and 0.25 texel, at 34 texels per pixel under the point light, on the five maps;
+/// writes orb_bias_spacing.csv into `out`.
+pub fn run_spacing(out: &Path) -> Res<()> {
+    std::fs::create_dir_all(out)?;
+    let wall = Instant::now();
+    let mut csv = String::from(
+        "map,scale,spacing,build_s,render_s,rel_rmse_denoised,rel_rmse_denoised_vs_b,energy_error,reference_noise\n",
+    );
+    let scale = SCALES[0];
+    for name in MAPS {
+        let orb = OrbOptions {
+            map: MapSource::parse(name),
+            map_size: MAP_SIZE,
+            progress: false,
+            ..OrbOptions::default()
+        };
+        let map = load_map(&orb)?;
+        let scene = Scene::new(SIZE, Vec2::new(2.0 * scale, scale));
+        let mask = coverage(&scene);
+        let (a0, b0) = reference_half(&scene, &map, Light::Point, REFERENCE_K, orb.seed);
+        let (a1, b1) = reference_half(&scene, &map, Light::Point, REFERENCE_K, orb.seed + 1);
+        let noise_a = reference_noise(&a0, &a1, &mask);
+        for spacing in [1.0, 0.5, 0.25] {
+            let (m, build_s) = mixture(
+                &map,
+                MixtureParams {
+                    sigma_min: SIGMA_EPS,
+                    spacing,
+                    ..MixtureParams::default()
+                },
+            )?;
+            let t = Instant::now();
+            let img = render_model(&scene, &m, Light::Point);
+            let render_s = t.elapsed().as_secs_f64();
+            let ea = errors(&img, &a0, &a1, &mask);
+            let eb = errors(&img, &b0, &b1, &mask);
+            let _ = writeln!(
+                csv,
+                "{name},{scale},{spacing},{build_s:.3},{render_s:.3},{:.4},{:.4},{:.4},{noise_a:.4}",
+                ea.rel_rmse_denoised, eb.rel_rmse_denoised, ea.energy
+            );
+        }
+        eprintln!(
+            "spacing: {name} done at {:.0} s",
+            wall.elapsed().as_secs_f64()
+        );
+    }
+    let path = out.join("orb_bias_spacing.csv");
+    std::fs::write(&path, csv)?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
 
 /// Runs the decomposition; writes orb_bias.csv and orb_bias_decomposition.png into `out`.
 pub fn run(out: &Path) -> Res<Vec<Artifact>> {
@@ -367,7 +422,7 @@ pub fn run(out: &Path) -> Res<Vec<Artifact>> {
                     rows.push(Row {
                         map: name.to_string(),
                         scale,
-                        label: var.label,
+                        label: var.label.to_string(),
                         build_s: var.build_s,
                         render_s,
                         vs_a: ea.rel_rmse_denoised,
@@ -420,13 +475,43 @@ pub fn run(out: &Path) -> Res<Vec<Artifact>> {
     ])
 }
 
+/// Redraws orb_bias_decomposition.png next to `csv` from an orb_bias.csv written by [`run`]
+/// (`orb -- --bias --chart CSV`).
+pub fn chart_from_csv(csv: &Path) -> Res<()> {
+    let text = std::fs::read_to_string(csv)?;
+    let mut rows = Vec::new();
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() < 9 {
+            continue;
+        }
+        // The label may hold commas: everything between the scale and the last six fields.
+        let n = f.len();
+        rows.push(Row {
+            map: f[0].to_string(),
+            scale: f[1].parse()?,
+            label: f[2..n - 6].join(","),
+            build_s: f[n - 6].parse()?,
+            render_s: f[n - 5].parse()?,
+            vs_a: f[n - 4].parse()?,
+            vs_b: f[n - 3].parse()?,
+            energy: f[n - 2].parse()?,
+            noise_a: f[n - 1].parse()?,
+        });
+    }
+    let path = csv.with_file_name("orb_bias_decomposition.png");
+    chart(&path, &rows)?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
 /// Grouped bars: one panel per scale, maps along x, one bar per configuration.
 fn chart(path: &Path, rows: &[Row]) -> Res<()> {
     register_font();
     let mut labels: Vec<&str> = Vec::new();
     for r in rows {
-        if !labels.contains(&r.label) {
-            labels.push(r.label);
+        if !labels.contains(&r.label.as_str()) {
+            labels.push(&r.label);
         }
     }
     let (pw, ph) = (900u32, 340u32);
@@ -436,7 +521,9 @@ fn chart(path: &Path, rows: &[Row]) -> Res<()> {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         let panels = root.split_evenly((SCALES.len(), 1));
         let n = labels.len() as f64;
-        for (area, scale) in panels.iter().zip(SCALES) {
+        for (pi, (area, scale)) in panels.iter().zip(SCALES).enumerate() {
+            // Room above the bars for the legend in the first panel.
+            let top = if pi == 0 { 1.7 } else { 0.5 };
             let tpp = if scale < 4.0 { 34 } else { 2186 };
             let mut c = ChartBuilder::on(area)
                 .caption(
@@ -449,7 +536,7 @@ fn chart(path: &Path, rows: &[Row]) -> Res<()> {
                 .margin(6)
                 .x_label_area_size(22)
                 .y_label_area_size(40)
-                .build_cartesian_2d(0.0..MAPS.len() as f64, 0.0..1.0f64)?;
+                .build_cartesian_2d(0.0..MAPS.len() as f64, 0.0..top)?;
             c.configure_mesh()
                 .disable_x_mesh()
                 .x_labels(MAPS.len() * 2 + 1)
@@ -473,7 +560,7 @@ fn chart(path: &Path, rows: &[Row]) -> Res<()> {
                         let x0 = m + 0.05 + 0.9 * li as f64 / n;
                         let x1 = x0 + 0.9 / n;
                         Some(Rectangle::new(
-                            [(x0, 0.0), (x1, r.vs_a.min(1.0))],
+                            [(x0, 0.0), (x1, r.vs_a.min(top))],
                             col.filled(),
                         ))
                     })
@@ -486,12 +573,14 @@ fn chart(path: &Path, rows: &[Row]) -> Res<()> {
                 [(0.0, 0.1), (MAPS.len() as f64, 0.1)],
                 BLACK.stroke_width(1),
             ))?;
-            c.configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
-                .label_font(("sans-serif", 10))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()?;
+            if pi == 0 {
+                c.configure_series_labels()
+                    .position(SeriesLabelPosition::UpperLeft)
+                    .label_font(("sans-serif", 10))
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .draw()?;
+            }
         }
         root.present()?;
     }
