@@ -93,12 +93,12 @@ const MAPS: [&str; 5] = ["scratched", "brushed", "bumpy", "flakes", "fractal"];
 /// beyond it every pixel reads tens of thousands of lobes.
 const NO_LOD_MAX_TEXELS: f64 = 5000.0;
 /// Label of the mixture's row without level-of-detail cap.
-const NO_LOD: &str = "mixture, no LOD cap";
+const NO_LOD: &str = "mixture (no LOD cap)";
 const EVALS: [u32; 3] = [1, 4, 16];
 
 /// The glint models of one map with their build times, each given the scene's σ_ε the way its
 /// paper allows (examples/common/material.rs): the mixture with the options a user gets (lobe floor
-/// σ_ε, 64 quadrature nodes per lobe, default `PatchOptions`) and the same mixture with no level of
+/// σ_ε, default `PatchOptions`; `samples` 64 is not read by the default filter moments) and the same mixture with no level of
 /// detail (`lod_lobes` ∞, `lod_tolerance` 0: the full mixture), the bin map at its
 /// default bins smoothed by a Beckmann lobe of α = √2 σ_ε, the position-normal map with σ_r = σ_ε;
 /// and, as "paper default" rows, the bin map's one-bin resolution (σ = 0) and Yan's σ_r = 0.005.

@@ -282,14 +282,14 @@ fn variants(map: &NormalMap) -> Res<Vec<Variant>> {
         v("256 nodes/lobe", m256, m256_s, Light::Point),
         v("(iv) spacing 0.5", fine.clone(), fine_s, Light::Point),
         v(
-            "(iv) spacing 0.5, no LOD cap",
+            "(iv) spacing 0.5 + no LOD cap",
             with_options(&fine, no_lod),
             fine_s,
             Light::Point,
         ),
         v("(v) disc light", m.clone(), m_s, Light::Disc),
         v(
-            "(v) disc light, no LOD cap",
+            "(v) disc light + no LOD cap",
             with_options(&m, no_lod),
             m_s,
             Light::Disc,
@@ -301,7 +301,7 @@ fn variants(map: &NormalMap) -> Res<Vec<Variant>> {
             Light::Point,
         ),
         v(
-            "bin map, disc light",
+            "bin map + disc light",
             Configured::binmap(binmap, SIGMA_EPS),
             binmap_s,
             Light::Disc,
@@ -313,7 +313,7 @@ fn variants(map: &NormalMap) -> Res<Vec<Variant>> {
             Light::Point,
         ),
         v(
-            "position-normal, disc light",
+            "position-normal + disc light",
             Configured::new(pn),
             pn_s,
             Light::Disc,
