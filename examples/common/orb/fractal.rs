@@ -51,7 +51,7 @@ struct Wave {
 }
 
 fn waves(size: usize, p: &FractalParams, seed: u64) -> Vec<Wave> {
-    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed ^ 0xF2AC_7A1);
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed ^ 0x0F2A_C7A1);
     let f_max = size as f32 / p.min_wavelength.max(2.0);
     let (l0, l1) = (p.f_min.ln(), f_max.max(p.f_min).ln());
     (0..p.waves)
