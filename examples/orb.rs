@@ -54,7 +54,14 @@ fn main() -> Res<()> {
     if let (true, Some(csv)) = (has_flag("--bias"), arg_value("--chart")) {
         common::orb::bias::chart_from_csv(std::path::Path::new(&csv))?;
     } else if has_flag("--bias") && has_flag("--spacing") {
-        common::orb::bias::run_spacing(&out)?;
+        let scales = match arg_value("--scales") {
+            Some(list) => list
+                .split(',')
+                .map(|k| k.parse::<f32>())
+                .collect::<Result<Vec<_>, _>>()?,
+            None => vec![common::orb::bias::SCALES[0]],
+        };
+        common::orb::bias::run_spacing(&out, &scales)?;
     } else if has_flag("--bias") {
         common::orb::bias::run(&out)?;
     } else if has_flag("--curves") {

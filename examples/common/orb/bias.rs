@@ -339,16 +339,16 @@ pub const MAPS: [&str; 5] = ["scratched", "brushed", "bumpy", "flakes", "fractal
 /// Map scales k (tiles (2k, k)).
 pub const SCALES: [f32; 2] = [2.0, 16.0];
 
-/// The lobe-spacing ladder (`orb -- --bias --spacing`): the mixture (default options) built at
-/// spacings 1, 0.5 and 0.25 texel, at 34 texels per pixel under the point light, on the five maps;
-/// writes orb_bias_spacing.csv into `out`.
-pub fn run_spacing(out: &Path) -> Res<()> {
+/// The lobe-spacing ladder (`orb -- --bias --spacing [--scales K,K,…]`): the mixture (default
+/// options) built at spacings 1, 0.5 and 0.25 texel, under the point light, on the five maps at each
+/// map scale k of `scales` (tiles (2k, k); 0.35, 1, 2 give 1, 9, 34 texels per pixel); writes
+/// orb_bias_spacing.csv into `out`.
+pub fn run_spacing(out: &Path, scales: &[f32]) -> Res<()> {
     std::fs::create_dir_all(out)?;
     let wall = Instant::now();
     let mut csv = String::from(
         "map,scale,spacing,build_s,render_s,rel_rmse_denoised,rel_rmse_denoised_vs_b,energy_error,reference_noise\n",
     );
-    let scale = SCALES[0];
     for name in MAPS {
         let orb = OrbOptions {
             map: MapSource::parse(name),
@@ -357,30 +357,32 @@ pub fn run_spacing(out: &Path) -> Res<()> {
             ..OrbOptions::default()
         };
         let map = load_map(&orb)?;
-        let scene = Scene::new(SIZE, Vec2::new(2.0 * scale, scale));
-        let mask = coverage(&scene);
-        let (a0, b0) = reference_half(&scene, &map, Light::Point, REFERENCE_K, orb.seed);
-        let (a1, b1) = reference_half(&scene, &map, Light::Point, REFERENCE_K, orb.seed + 1);
-        let noise_a = reference_noise(&a0, &a1, &mask);
-        for spacing in [1.0, 0.5, 0.25] {
-            let (m, build_s) = mixture(
-                &map,
-                MixtureParams {
-                    sigma_min: SIGMA_EPS,
-                    spacing,
-                    ..MixtureParams::default()
-                },
-            )?;
-            let t = Instant::now();
-            let img = render_model(&scene, &m, Light::Point);
-            let render_s = t.elapsed().as_secs_f64();
-            let ea = errors(&img, &a0, &a1, &mask);
-            let eb = errors(&img, &b0, &b1, &mask);
-            let _ = writeln!(
-                csv,
-                "{name},{scale},{spacing},{build_s:.3},{render_s:.3},{:.4},{:.4},{:.4},{noise_a:.4}",
-                ea.rel_rmse_denoised, eb.rel_rmse_denoised, ea.energy
-            );
+        for &scale in scales {
+            let scene = Scene::new(SIZE, Vec2::new(2.0 * scale, scale));
+            let mask = coverage(&scene);
+            let (a0, b0) = reference_half(&scene, &map, Light::Point, REFERENCE_K, orb.seed);
+            let (a1, b1) = reference_half(&scene, &map, Light::Point, REFERENCE_K, orb.seed + 1);
+            let noise_a = reference_noise(&a0, &a1, &mask);
+            for spacing in [1.0, 0.5, 0.25] {
+                let (m, build_s) = mixture(
+                    &map,
+                    MixtureParams {
+                        sigma_min: SIGMA_EPS,
+                        spacing,
+                        ..MixtureParams::default()
+                    },
+                )?;
+                let t = Instant::now();
+                let img = render_model(&scene, &m, Light::Point);
+                let render_s = t.elapsed().as_secs_f64();
+                let ea = errors(&img, &a0, &a1, &mask);
+                let eb = errors(&img, &b0, &b1, &mask);
+                let _ = writeln!(
+                    csv,
+                    "{name},{scale},{spacing},{build_s:.3},{render_s:.3},{:.4},{:.4},{:.4},{noise_a:.4}",
+                    ea.rel_rmse_denoised, eb.rel_rmse_denoised, ea.energy
+                );
+            }
         }
         eprintln!(
             "spacing: {name} done at {:.0} s",
