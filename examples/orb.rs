@@ -2,11 +2,12 @@
 //! model and the two references, the exact P-BRDF of the map and normal-mapped rendering
 //! (\[Chermain2019\] Fig. 1 and 11); see docs/orb.md.
 //!
-//! `cargo run --release --example orb -- [--map scratched|brushed|bumpy|flakes|PATH] [--spp N]
+//! `cargo run --release --example orb -- [--map scratched|brushed|bumpy|flakes|fractal|PATH] [--spp N]
 //! [--size PIXELS] [--map-size TEXELS] [--tiles UxV] [--naive-spp N] [--sigma S]
 //! [--out DIR] [--quiet]`, or `-- --quick [--out DIR]` for the gallery's
 //! small strip (scratched 512² map, 160² pixels, 256 spp); `-- --curves [--quick] [--out DIR]` for
-//! the error-against-time curves and equal-error speedups (examples/common/orb_curves.rs).
+//! the error-against-time curves and equal-error speedups (examples/common/orb_curves.rs); `-- --bias
+//! [--out DIR]` for the decomposition of the glint models' bias floor (examples/common/orb/bias.rs).
 //!
 //! Writes one PNG per method, a labelled strip and a CSV of times and errors into DIR (default
 //! `target/brdf-out/`), and prints the table.
@@ -50,7 +51,20 @@ fn options() -> Res<OrbOptions> {
 
 fn main() -> Res<()> {
     let out = common::out_dir()?;
-    if has_flag("--curves") {
+    if let (true, Some(csv)) = (has_flag("--bias"), arg_value("--chart")) {
+        common::orb::bias::chart_from_csv(std::path::Path::new(&csv))?;
+    } else if has_flag("--bias") && has_flag("--spacing") {
+        let scales = match arg_value("--scales") {
+            Some(list) => list
+                .split(',')
+                .map(|k| k.parse::<f32>())
+                .collect::<Result<Vec<_>, _>>()?,
+            None => vec![common::orb::bias::SCALES[0]],
+        };
+        common::orb::bias::run_spacing(&out, &scales)?;
+    } else if has_flag("--bias") {
+        common::orb::bias::run(&out)?;
+    } else if has_flag("--curves") {
         common::orb_curves::run(&out, has_flag("--quick"))?;
     } else if has_flag("--quick") {
         common::orb::run_gallery(&out, true)?;
@@ -448,5 +462,67 @@ mod tests {
         let (t, flag) = naive_time_at(&noisy, 0.6);
         assert_eq!(flag, "=");
         assert!(t > 4.0 && t < 16.0, "{t}");
+    }
+    /// The fractal map has the requested RMS slope (computed here from the map's texels), and its
+    /// random wave directions spread the slope variance over both axes (isotropy within 30 %).
+    #[test]
+    fn fractal_map_has_its_rms_slope_and_is_isotropic() {
+        use super::common::orb::fractal::{FractalParams, fractal};
+        let p = FractalParams::default();
+        let map = fractal(64, &p, 3).unwrap();
+        let n = map.slopes().len() as f64;
+        let mx = map
+            .slopes()
+            .iter()
+            .map(|s| (s.x as f64).powi(2))
+            .sum::<f64>()
+            / n;
+        let my = map
+            .slopes()
+            .iter()
+            .map(|s| (s.y as f64).powi(2))
+            .sum::<f64>()
+            / n;
+        let rms = (0.5 * (mx + my)).sqrt();
+        assert!((rms - p.rms_slope as f64).abs() < 1e-3, "rms {rms}");
+        let ratio = mx / my;
+        assert!(
+            ratio > 0.7 && ratio < 1.0 / 0.7,
+            "x/y variance ratio {ratio}"
+        );
+    }
+
+    /// The disc light's points carry the point light's irradiance (to the disc's small change of
+    /// distance) and lie within the disc's angular radius seen from the shading point; the point
+    /// light is the shading point's own direction.
+    #[test]
+    fn disc_light_points_share_the_intensity_and_stay_on_the_disc() {
+        use super::common::orb::bias::{AREA_LIGHT_DEGREES, Light, light_points};
+        let scene = Scene::new(SIZE, Vec2::new(2.0, 1.0));
+        let sp = scene.shading(Vec2::new(12.5, 14.5)).unwrap();
+        let point = light_points(&scene, &sp, Light::Point, 0);
+        assert_eq!(point.len(), 1);
+        assert_eq!(point[0].0, sp.wi);
+        let disc = light_points(&scene, &sp, Light::Disc, 77);
+        let sum: f32 = disc.iter().map(|l| l.1).sum();
+        assert!(
+            (sum / sp.irradiance - 1.0).abs() < 0.02,
+            "{sum} vs {}",
+            sp.irradiance
+        );
+        // Hit point = normal on the unit sphere; the disc's radius over the distance to its centre.
+        let p = sp.frame.z;
+        let radius = scene.light.length() * AREA_LIGHT_DEGREES.to_radians().tan();
+        let max_angle = (radius / (scene.light - p).length()).atan() * 1.05;
+        for (wi, _) in &disc {
+            let angle = wi.dot(sp.wi).clamp(-1.0, 1.0).acos();
+            assert!(angle <= max_angle, "{angle} > {max_angle}");
+        }
+        // Not all in one place: the spread reaches half the radius.
+        let widest = disc
+            .iter()
+            .map(|l| l.0.dot(sp.wi).clamp(-1.0, 1.0).acos())
+            .fold(0.0f32, f32::max);
+        assert!(widest > 0.5 * max_angle / 1.05, "{widest}");
     }
 }

@@ -33,8 +33,9 @@ pub struct CurveOptions {
     pub size: u32,
     /// Procedural map size (texels per side).
     pub map_size: usize,
-    /// Map scales: the map is tiled (2k, k) times over the sphere's (u, v).
-    pub scales: Vec<u32>,
+    /// Map scales: the map is tiled (2k, k) times over the sphere's (u, v) (k < 1: a part of the
+    /// map covers the sphere).
+    pub scales: Vec<f32>,
     /// Reference: 2 halves of k × k positions per pixel.
     pub reference_k: u32,
     /// Naive: 1, 4, 16, … up to this many spp.
@@ -49,7 +50,8 @@ impl CurveOptions {
         CurveOptions {
             size: 128,
             map_size: 512,
-            scales: vec![2, 16, 128],
+            // 1, 9, 34, 2 186 and 139 898 texels per pixel (median).
+            scales: vec![0.35, 1.0, 2.0, 16.0, 128.0],
             reference_k: 48,
             naive_max_spp: 4096,
             budget_s: 40.0,
@@ -61,7 +63,7 @@ impl CurveOptions {
         CurveOptions {
             size: 64,
             map_size: 256,
-            scales: vec![2, 32],
+            scales: vec![2.0, 32.0],
             reference_k: 32,
             naive_max_spp: 1024,
             budget_s: 10.0,
@@ -73,7 +75,7 @@ impl CurveOptions {
 #[derive(Clone, Debug)]
 struct Point {
     map: String,
-    scale: u32,
+    scale: f32,
     texels_per_pixel: f64,
     method: String,
     evals: u32,
@@ -85,12 +87,19 @@ struct Point {
     noise_a: f64,
 }
 
-const MAPS: [&str; 4] = ["scratched", "brushed", "bumpy", "flakes"];
+/// The crate's four procedural maps and the example's fractal height field (orb/fractal.rs).
+const MAPS: [&str; 5] = ["scratched", "brushed", "bumpy", "flakes", "fractal"];
+/// The mixture without level-of-detail cap is rendered only up to this footprint (texels per pixel):
+/// beyond it every pixel reads tens of thousands of lobes.
+const NO_LOD_MAX_TEXELS: f64 = 5000.0;
+/// Label of the mixture's row without level-of-detail cap.
+const NO_LOD: &str = "mixture (no LOD cap)";
 const EVALS: [u32; 3] = [1, 4, 16];
 
 /// The glint models of one map with their build times, each given the scene's σ_ε the way its
-/// paper allows (examples/common/material.rs): the mixture as a path tracer would use it (lobe floor
-/// σ_ε, 64 quadrature nodes per lobe, queried with `lod_lobes` 256, examples/render.rs), the bin map at its
+/// paper allows (examples/common/material.rs): the mixture with the options a user gets (lobe floor
+/// σ_ε, default `PatchOptions`; `samples` 64 is not read by the default filter moments) and the same mixture with no level of
+/// detail (`lod_lobes` ∞, `lod_tolerance` 0: the full mixture), the bin map at its
 /// default bins smoothed by a Beckmann lobe of α = √2 σ_ε, the position-normal map with σ_r = σ_ε;
 /// and, as "paper default" rows, the bin map's one-bin resolution (σ = 0) and Yan's σ_r = 0.005.
 pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
@@ -100,9 +109,11 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
         samples: 64,
         ..MixtureParams::default()
     };
-    let mut mixture = Configured::new(Arc::new(BeckmannMixture::build(map, params)?.into()));
-    mixture.options.mixture = PatchOptions {
-        lod_lobes: 256.0,
+    let mixture = Configured::new(Arc::new(BeckmannMixture::build(map, params)?.into()));
+    let mut full = mixture.clone();
+    full.options.mixture = PatchOptions {
+        lod_lobes: f32::INFINITY,
+        lod_tolerance: 0.0,
         ..PatchOptions::default()
     };
     let mixture_s = t.elapsed().as_secs_f64();
@@ -136,7 +147,8 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
         paper_sigma,
     };
     Ok(vec![
-        row("mixture (lod 256)", mixture, mixture_s, None),
+        row("mixture", mixture, mixture_s, None),
+        row(NO_LOD, full, mixture_s, None),
         row(
             "bin map",
             Configured::binmap(binmap.clone(), SIGMA_EPS),
@@ -243,7 +255,7 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
         let map = load_map(&orb)?;
         let models = build_models(&map)?;
         for &k in &opts.scales {
-            let scene = Scene::new(opts.size, Vec2::new(2.0 * k as f32, k as f32));
+            let scene = Scene::new(opts.size, Vec2::new(2.0 * k, k));
             let mask = coverage(&scene);
             let tpp = texels_per_pixel(&scene, &mask, map.width(), map.height());
             let t = Instant::now();
@@ -297,6 +309,9 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
                 ..
             } in &models
             {
+                if label == NO_LOD && tpp > NO_LOD_MAX_TEXELS {
+                    continue;
+                }
                 for evals in EVALS {
                     let projected = pilot_seconds(&scene, &mask, model, evals);
                     if projected > opts.budget_s {
@@ -454,6 +469,7 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res
         let panels = body.split_evenly((rows as usize, cols as usize));
         let colours = [
             BLUE,
+            RGBColor(120, 170, 255),
             RED,
             RGBColor(240, 150, 150),
             RGBColor(0, 150, 0),
@@ -481,7 +497,7 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res
             let tpp = here.first().map_or(0.0, |p| p.texels_per_pixel);
             let mut c = ChartBuilder::on(area)
                 .caption(
-                    format!("{map}, tiles {}x{scale}, ~{tpp:.0} texels/px", 2 * scale),
+                    format!("{map}, tiles {}x{scale}, ~{tpp:.0} texels/px", 2.0 * scale),
                     ("sans-serif", 13),
                 )
                 .margin(4)

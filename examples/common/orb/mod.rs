@@ -22,7 +22,9 @@
 //! printed table and the CSV), [`chart`] (tone mapping, the PNGs and the labelled strip); [`run`]
 //! does all of it for one map.
 
+pub mod bias;
 pub mod chart;
+pub mod fractal;
 pub mod metrics;
 pub mod render;
 pub mod scene;
@@ -48,7 +50,8 @@ use std::time::Instant;
 /// Where the normal map comes from.
 #[derive(Clone, Debug, PartialEq)]
 pub enum MapSource {
-    /// One of the crate's procedural generators: "scratched", "brushed", "bumpy" or "flakes".
+    /// One of the crate's procedural generators ("scratched", "brushed", "bumpy", "flakes") or the
+    /// example's fractal height field ("fractal", [`fractal::fractal`]).
     Procedural(String),
     /// A normal-map image (PNG/EXR, OpenGL convention, below-horizon normals clamped to z ≥ 0.01).
     File(PathBuf),
@@ -58,7 +61,9 @@ impl MapSource {
     /// Parses `--map`: a generator name, otherwise a path.
     pub fn parse(s: &str) -> MapSource {
         match s {
-            "scratched" | "brushed" | "bumpy" | "flakes" => MapSource::Procedural(s.to_string()),
+            "scratched" | "brushed" | "bumpy" | "flakes" | "fractal" => {
+                MapSource::Procedural(s.to_string())
+            }
             _ => MapSource::File(PathBuf::from(s)),
         }
     }
@@ -128,6 +133,7 @@ pub fn load_map(opts: &OrbOptions) -> Res<NormalMap> {
             "brushed" => brushed(s, s, BrushedParams::default(), opts.seed)?,
             "bumpy" => bumpy(s, s, 0.25, 4.0, opts.seed)?,
             "flakes" => flakes(s, s, FlakesParams::default(), opts.seed)?,
+            "fractal" => fractal::fractal(s, &fractal::FractalParams::default(), opts.seed)?,
             _ => scratched(s, s, ScratchedParams::default(), opts.seed)?,
         },
         MapSource::File(path) => {

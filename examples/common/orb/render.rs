@@ -158,6 +158,28 @@ pub fn reference_pixel(
     let Some(h) = (sp.wo + sp.wi).try_normalize() else {
         return (Vec3::ZERO, Vec3::ZERO);
     };
+    // eval × the geometric cos θi × I / r².
+    let light = sp.wi.z.max(0.0) * sp.irradiance;
+    let fresnel_a = scene.fresnel.eval(sp.wo.dot(h));
+    let a = fresnel_a * (r.pbrdf() as f32 * light);
+    (
+        if a.is_finite() { a } else { Vec3::ZERO },
+        normal_mapped_pixel(scene, map, sigma_eps, sp, samples, seed),
+    )
+}
+
+/// Reference (b) of one pixel alone (the second half of [`reference_pixel`], same positions for
+/// the same seed): conventional normal mapping averaged over `samples` positions of the pixel's
+/// Gaussian footprint, as a radiance. Naive sampling is this estimator.
+pub fn normal_mapped_pixel(
+    scene: &Scene,
+    map: &NormalMap,
+    sigma_eps: f32,
+    sp: &ShadingPoint,
+    samples: usize,
+    seed: u64,
+) -> Vec3 {
+    let fp = sp.footprint();
     let (mut sum, mut n) = (Vec3::ZERO, 0u32);
     for_each_footprint_slope(map, &fp, Kernel::Gaussian, samples, seed, |slope| {
         if let Some(brdf) = conventional_brdf(slope, sigma_eps, scene.fresnel) {
@@ -165,14 +187,8 @@ pub fn reference_pixel(
         }
         n += 1;
     });
-    // eval × the geometric cos θi × I / r².
-    let light = sp.wi.z.max(0.0) * sp.irradiance;
-    let fresnel_a = scene.fresnel.eval(sp.wo.dot(h));
-    let finite = |v: Vec3| if v.is_finite() { v } else { Vec3::ZERO };
-    (
-        finite(fresnel_a * (r.pbrdf() as f32 * light)),
-        finite(sum / n.max(1) as f32 * light),
-    )
+    let b = sum / n.max(1) as f32 * (sp.wi.z.max(0.0) * sp.irradiance);
+    if b.is_finite() { b } else { Vec3::ZERO }
 }
 
 /// Conventional normal mapping at one position of slope `slope`: a near-specular Beckmann lobe
@@ -274,7 +290,7 @@ pub fn render_naive(
         };
         let pixel = y as u64 * scene.size as u64 + x as u64;
         let seed = (0xA5A5_0000 ^ seed).wrapping_mul(0xD1B5_4A32_D192_ED03) ^ pixel;
-        reference_pixel(scene, map, sigma_eps, &sp, spp as usize, seed).1
+        normal_mapped_pixel(scene, map, sigma_eps, &sp, spp as usize, seed)
     })
 }
 
