@@ -20,6 +20,23 @@
 //! - **Truths** (re-exported here): [`binned_pndf`], [`convolved_pndf`], [`tv_distance`],
 //!   [`FootprintBrdf`] and the [`HemisphereBins`] they are tabulated on.
 //!
+//! ## Which model where
+//!
+//! Measured on a metallic sphere under a point light against the exact P-BRDF, every model at the
+//! material's σ_ε = 0.01 and its default options, five maps (docs/glint.md, "Which model where";
+//! docs/data/orb_curves.csv). "Texels per pixel" is the pixel footprint's area on the map.
+//!
+//! | texels per pixel | first to a given error | not worth it |
+//! |---|---|---|
+//! | below ~10 | naive normal mapping, a few samples per pixel | every glint model at its defaults (the mixture at `spacing` 0.25 reaches 0.01-0.14, at 8-12× the render time and 16× the build) |
+//! | ~10 to ~2 000 | the mixture to errors of 0.1-0.5 (1.1-30× sooner than naive; its floor there is its lobe spacing), position-normal on flakes | any model for errors below 0.1 at ~34 texels per pixel |
+//! | beyond ~10⁵ (distant surfaces) | the bin map, smoothed at σ_ε (0.025-0.064, 6-110× sooner than naive, build included) | position-normal (8-10 ms per shading point behind its query cap) |
+//!
+//! Cost of one renderer shading point at each footprint (every model at its defaults, against an
+//! analytic GGX one): docs/results.md, "Cost and error of a shading point against footprint". The
+//! mixture chooses its own form per footprint (the sub-texel lobe, the gathered lobes, the
+//! filtered mixture: [`mixture::PatchOptions`]).
+//!
 //! ## Adding a model
 //!
 //! 1. A folder `src/glint/<model>/` whose `mod.rs` holds the model type, its parameters, its
