@@ -82,7 +82,8 @@ fn level_of_detail_respects_its_tolerance() {
     assert!(merged >= 3, "only {merged} cases used a level ≥ 1");
 }
 
-/// A patch at a level of detail l ≥ 1 (tolerance 1: the coarsest level the footprint allows).
+/// A patch at a level of detail l ≥ 1 (tolerance 1: the coarsest level the footprint allows; the
+/// filtered mixture off).
 fn merged_patch<'a>(mix: &'a BeckmannMixture, area: f32, masking: MaskingMode) -> MixturePatch<'a> {
     let p = mix.patch_with(
         &footprint(area, Vec2::new(0.3, 0.3)),
@@ -90,6 +91,7 @@ fn merged_patch<'a>(mix: &'a BeckmannMixture, area: f32, masking: MaskingMode) -
             masking,
             lod_lobes: f32::INFINITY,
             lod_tolerance: 1.0,
+            filtered_area: f32::INFINITY,
             ..PatchOptions::default()
         },
         None,
@@ -142,6 +144,7 @@ fn chi_square_and_furnace_at_a_merged_level() {
             masking: MaskingMode::Exact,
             lod_lobes: 8.0,
             lod_tolerance: 0.0,
+            filtered_area: f32::INFINITY,
             ..PatchOptions::default()
         },
         None,

@@ -269,6 +269,7 @@ fn lod_diagnose() {
             let opts = |lobes: f32| PatchOptions {
                 lod_lobes: lobes,
                 lod_tolerance: 0.0,
+                filtered_area: f32::INFINITY,
                 ..PatchOptions::default()
             };
             let full_p = mix.patch_with(&fp, &opts(f32::INFINITY), None);
@@ -434,6 +435,7 @@ fn level_of_detail_respects_its_tolerance_at_its_resolution() {
                 &PatchOptions {
                     lod_lobes: f32::INFINITY,
                     lod_tolerance: 0.0,
+                    filtered_area: f32::INFINITY,
                     ..PatchOptions::default()
                 },
                 None,
@@ -458,6 +460,7 @@ fn level_of_detail_respects_its_tolerance_at_its_resolution() {
                             lod_lobes: f32::INFINITY,
                             lod_tolerance: tol,
                             lod_resolution: r,
+                            filtered_area: f32::INFINITY,
                             ..PatchOptions::default()
                         },
                         None,
@@ -512,6 +515,7 @@ fn lod_resolution_is_total() {
                 lod_lobes: f32::INFINITY,
                 lod_tolerance: 0.3,
                 lod_resolution: r,
+                filtered_area: f32::INFINITY,
                 ..PatchOptions::default()
             },
             None,
