@@ -187,7 +187,7 @@ pub fn tiles_for(scene: &Scene, target: f32, map_size: usize) -> Vec2 {
     let mut k = 1.0f64;
     for _ in 0..8 {
         let a = mean_texels_per_pixel(scene, unit * k as f32, map_size);
-        if !(a > 0.0) {
+        if a.is_nan() || a <= 0.0 {
             break;
         }
         k *= (target as f64 / a).sqrt();
