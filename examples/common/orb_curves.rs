@@ -90,7 +90,7 @@ const EVALS: [u32; 3] = [1, 4, 16];
 
 /// The glint models of one map with their build times, each given the scene's σ_ε the way its
 /// paper allows (examples/common/material.rs): the mixture as a path tracer would use it (lobe floor
-/// σ_ε, 64 quadrature nodes per lobe, queried with `lod_lobes` 256, examples/render.rs), the bin map at its
+/// σ_ε, 64 quadrature nodes per lobe, queried with `lod_lobes` 256), the bin map at its
 /// default bins smoothed by a Beckmann lobe of α = √2 σ_ε, the position-normal map with σ_r = σ_ε;
 /// and, as "paper default" rows, the bin map's one-bin resolution (σ = 0) and Yan's σ_r = 0.005.
 pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {

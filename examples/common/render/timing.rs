@@ -240,7 +240,7 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
     let position_normal = timed_build("position-normal", &mut || {
         Ok(PositionNormalMap::build(&map, PositionNormalParams::default())?.into())
     })?;
-    println!("builds ({n}² scratched map, default parameters, one thread):\n{builds}");
+    println!("builds ({n}² scratched map, default parameters, wall time):\n{builds}");
     let coat = GlintMaterial::new(mixture.clone(), DielectricFresnel::new(1.5)?)
         .over_base(Vec3::new(0.5, 0.03, 0.02))?;
     let plain = |m: &Arc<GlintModel>| GlintMaterial::new(m.clone(), silver);
