@@ -2,20 +2,37 @@
 //! public API only (the scene, camera and integrator are in `examples/common/render.rs`).
 //!
 //! `cargo run --release --example render [-- --quick] [--out DIR] [--spp N] [--width W]`
+//! `cargo run --release --example render -- --timing [--quick] [--texels 10,500,30000]`
 //!
 //! Writes into DIR (default `target/brdf-out/`) a hammered normal map PNG (generated from a height
 //! field, then loaded back like any asset) and four tone-mapped renders of the same scene: analytic
 //! gold, scratched silver glints (procedural map), hammered copper glints (the PNG map), and a glint
-//! clear coat over red paint (layered). `--quick` is the gallery's small, fast setting. See
-//! docs/render.md.
+//! clear coat over red paint (layered). `--quick` is the gallery's small, fast setting.
+//!
+//! `--timing` instead measures frame times: analytic GGX, the three glint models at their defaults
+//! and conventional normal mapping on one scratched map at three map scales, alternating, and writes
+//! `render_timing.csv` (examples/common/render/timing.rs). See docs/render.md.
 
 mod common;
 
 use common::Res;
 use common::render::showcase::{Options, run_with};
+use common::render::timing::{TimingOptions, run_timing};
 
 fn main() -> Res<()> {
     let out = common::out_dir()?;
+    if common::has_flag("--timing") {
+        let mut opts = if common::has_flag("--quick") {
+            TimingOptions::quick()
+        } else {
+            TimingOptions::full()
+        };
+        if let Some(list) = common::arg_value("--texels") {
+            opts.texels_per_pixel = list.split(',').map(str::parse).collect::<Result<_, _>>()?;
+        }
+        run_timing(&out, &opts)?;
+        return Ok(());
+    }
     let mut opts = if common::has_flag("--quick") {
         Options::quick()
     } else {
@@ -119,5 +136,20 @@ mod tests {
         );
         assert!(mean <= 1.0 + 4.0 * se, "furnace mean {mean} > 1 + 4 × {se}");
         assert!(mean > 0.5, "furnace mean {mean}");
+    }
+
+    /// The timing harness's footprint measure: the mean texel area of the camera's pixel footprints
+    /// on the sphere grows as the tiling squared, and the tiling chosen for a target meets it.
+    #[test]
+    fn timing_texels_per_pixel_follow_the_tiling() {
+        use super::common::render::timing::{mean_texels_per_pixel, tiles_for, timing_scene};
+        let scene = timing_scene(brdf::Material::mirror(NoFresnel), 64, 48);
+        let a = mean_texels_per_pixel(&scene, Vec2::new(2.0, 1.0), 1024);
+        let b = mean_texels_per_pixel(&scene, Vec2::new(4.0, 2.0), 1024);
+        assert!(a > 0.0 && (b / a - 4.0).abs() < 0.01, "{a} → {b}");
+        for target in [10.0f32, 500.0, 30_000.0] {
+            let got = mean_texels_per_pixel(&scene, tiles_for(&scene, target, 1024), 1024);
+            assert!((got / target as f64 - 1.0).abs() < 0.01, "{target}: {got}");
+        }
     }
 }

@@ -55,8 +55,10 @@ fn coat_albedo<D: Ndf, F: Fresnel>(coat: &MicrofacetBrdf<D, F>, wo: Vec3) -> f64
 
 /// White base under a dielectric coat (Schlick, f0 = 0.04): the furnace is ≤ 1, and it is 1 minus
 /// the coat's masking loss: E ≥ 1 − (1 − E_s/R̂)·R̂ − 0.01, i.e. the base returns what the coat does not
-/// reflect at its first bounce (the 0.01 covers R̂'s 16-point quadrature error and Monte Carlo noise;
-/// observed ≥ 0.97 up to 70° for α = 0.1).
+/// reflect at its first bounce (the 0.01 covers Monte Carlo noise in E and E_s). Up to 60° for α ≤ 0.3
+/// E ≥ 0.965: with R̂ from a 4 × 4 grid of visible normals E is ≥ 0.97 there; the four-point R̂
+/// overestimates R by up to ~0.005 more at α = 0.3, 60° (E = 0.9685), darkening the base, never
+/// brightening it.
 #[test]
 fn white_base_furnace_is_at_most_one_and_close_to_it() {
     let schlick = SchlickFresnel::new(Vec3::splat(0.04)).unwrap();
@@ -79,7 +81,7 @@ fn white_base_furnace_is_at_most_one_and_close_to_it() {
                 "α={alpha} θo={theta}: {e} vs E_s + 1 − R̂ = {expected}"
             );
             if alpha <= 0.3 && theta <= 60.0 {
-                assert!(e >= 0.97, "α={alpha} θo={theta}: {e}");
+                assert!(e >= 0.965, "α={alpha} θo={theta}: {e}");
             }
         }
     }
@@ -206,6 +208,119 @@ fn chi_square_of_the_layered_sampler() {
         })
         .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// R(wo) = ∫ F(wo·m) D_wo(m) dm converged: F averaged over a 128 × 128 grid of cell centres pushed
+/// through the coat's visible-normal sampler (a failed sample counts F = 1, as in `LayeredBrdf`).
+fn converged_reflectance<D: Ndf, F: Fresnel>(coat: &MicrofacetBrdf<D, F>, wo: Vec3) -> Vec3 {
+    grid_reflectance(coat, wo, 128)
+}
+
+/// F averaged over a K × K grid of cell centres pushed through the coat's visible-normal sampler.
+fn grid_reflectance<D: Ndf, F: Fresnel>(coat: &MicrofacetBrdf<D, F>, wo: Vec3, k: usize) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    for j in 0..k {
+        for i in 0..k {
+            let u = Vec2::new((i as f32 + 0.5) / k as f32, (j as f32 + 0.5) / k as f32);
+            let m = coat.ndf().sample_visible(wo, u);
+            let c = wo.dot(m);
+            sum += if m.is_finite() && c > 0.0 {
+                coat.fresnel().eval(c)
+            } else {
+                Vec3::ONE
+            };
+        }
+    }
+    sum / (k * k) as f32
+}
+
+/// The coat's few-point R̂(wo) against the converged R(wo), for a dielectric (Schlick f0 = 0.04) and a
+/// conductor (gold) coat, on GGX α ∈ {0.1, 0.3, 0.8} and on glint patches of 1, 9 and 64 texels,
+/// views up to 75°, every channel:
+/// - on GGX within 0.06 of R (measured worst 0.045; a 4 × 4 grid of visible normals: 0.024);
+/// - on a glint patch, whose visible normals are a mixture of narrow lobes, within 0.01 of the
+///   error a 4 × 4 grid of visible normals makes (measured ≤ 0.002: the four points pick the lobes
+///   the grid's four columns pick) and within 0.2 of R (measured worst 0.146, the grid's 0.147);
+/// - RMS over all cases within 0.035 (measured 0.025).
+#[test]
+fn first_bounce_reflectance_is_close_to_converged() {
+    let schlick = SchlickFresnel::new(Vec3::splat(0.04)).unwrap();
+    let gold = ConductorFresnel::GOLD;
+    let model = glint_patch_model();
+    let patches: Vec<_> = [1.0f32, 9.0, 64.0]
+        .iter()
+        .map(|&a| model.patch(&Footprint::isotropic_texels(Vec2::new(0.4, 0.6), a, 32, 32)))
+        .collect();
+    let (mut sq, mut n, mut worst) = (0.0f64, 0usize, [0.0f32; 2]);
+    let mut check = |name: &str, glint: bool, r_hat: Vec3, r: Vec3, r_grid: Vec3| {
+        let err = (r_hat - r).abs().max_element();
+        let err_grid = (r_grid - r).abs().max_element();
+        if glint {
+            assert!(
+                err <= 0.2 && err <= err_grid + 0.01,
+                "{name}: R̂ {r_hat} vs R {r} (4 × 4 grid {r_grid})"
+            );
+        } else {
+            assert!(err <= 0.06, "{name}: R̂ {r_hat} vs R {r}");
+        }
+        sq += (err as f64).powi(2);
+        n += 1;
+        worst[glint as usize] = worst[glint as usize].max(err);
+    };
+    for theta in [0.0, 30.0, 60.0, 75.0] {
+        for phi in [20.0, 140.0, 260.0] {
+            let wo = support::dir(theta, phi);
+            for alpha in [0.1f32, 0.3, 0.8] {
+                let ggx = Ggx::isotropic(alpha).unwrap();
+                let a = LayeredBrdf::new(MicrofacetBrdf::new(ggx, schlick), Vec3::ONE).unwrap();
+                let b = LayeredBrdf::new(MicrofacetBrdf::new(ggx, gold), Vec3::ONE).unwrap();
+                let name = format!("ggx α={alpha} θo={theta} φo={phi}");
+                let rs = converged_reflectance(a.specular(), wo);
+                check(
+                    &name,
+                    false,
+                    a.first_bounce_reflectance(wo),
+                    rs,
+                    grid_reflectance(a.specular(), wo, 4),
+                );
+                let rg = converged_reflectance(b.specular(), wo);
+                check(
+                    &name,
+                    false,
+                    b.first_bounce_reflectance(wo),
+                    rg,
+                    grid_reflectance(b.specular(), wo, 4),
+                );
+            }
+            for (k, patch) in patches.iter().enumerate() {
+                let a = LayeredBrdf::new(MicrofacetBrdf::new(patch, schlick), Vec3::ONE).unwrap();
+                let b = LayeredBrdf::new(MicrofacetBrdf::new(patch, gold), Vec3::ONE).unwrap();
+                let name = format!("glint patch {k} θo={theta} φo={phi}");
+                let rs = converged_reflectance(a.specular(), wo);
+                check(
+                    &name,
+                    true,
+                    a.first_bounce_reflectance(wo),
+                    rs,
+                    grid_reflectance(a.specular(), wo, 4),
+                );
+                let rg = converged_reflectance(b.specular(), wo);
+                check(
+                    &name,
+                    true,
+                    b.first_bounce_reflectance(wo),
+                    rg,
+                    grid_reflectance(b.specular(), wo, 4),
+                );
+            }
+        }
+    }
+    let rms = (sq / n as f64).sqrt();
+    eprintln!(
+        "R̂ against converged R: worst GGX {}, worst glint {}, RMS {rms:.4}",
+        worst[0], worst[1]
+    );
+    assert!(rms <= 0.035, "RMS {rms}");
 }
 
 #[test]

@@ -19,6 +19,7 @@ use rayon::prelude::*;
 use std::f32::consts::PI;
 
 pub mod showcase;
+pub mod timing;
 
 /// Offset of secondary ray origins along the normal (scene units; the scene is ~1 unit across).
 const RAY_EPSILON: f32 = 1e-4;

@@ -7,8 +7,8 @@ use crate::common::{Artifact, Res, save_rgb};
 use brdf::fresnel::{ConductorFresnel, DielectricFresnel};
 use brdf::glint::mixture::MixtureParams;
 use brdf::glint::{
-    BeckmannMixture, FlakesParams, GlintModel, GlintOptions, NormalMap, NormalRepair,
-    ScratchedParams, TangentConvention, flakes, scratched,
+    BeckmannMixture, FlakesParams, GlintModel, NormalMap, NormalRepair, ScratchedParams,
+    TangentConvention, flakes, scratched,
 };
 use brdf::material::AnyFresnel;
 use brdf::{Ggx, GlintMaterial, Lambert, Material, Vec2, Vec3};
@@ -58,19 +58,15 @@ impl Options {
 }
 
 /// A glint material of `map`: the Beckmann mixture of \[Chermain2019\] with 64 quadrature nodes
-/// per lobe (the orb example's setting, 4× faster to build than the default), queried with its
-/// level of detail at 256 lobes, so that the wide footprints of secondary hits cost one filtered
-/// lobe (the default threshold, 16384, lets a bounce off the ground query thousands of lobes:
-/// minutes per image).
+/// per lobe (the orb example's setting, 4× faster to build than the default), queried at the
+/// default options (`GlintOptions::default()`): the renderer sets no level of detail.
 pub fn glint_material(map: &NormalMap, fresnel: impl Into<AnyFresnel>) -> Res<GlintMaterial> {
     let params = MixtureParams {
         samples: 64,
         ..MixtureParams::default()
     };
-    let mut options = GlintOptions::default();
-    options.mixture.lod_lobes = 256.0;
     let model = GlintModel::from(BeckmannMixture::build(map, params)?);
-    Ok(GlintMaterial::new(model, fresnel).with_options(options))
+    Ok(GlintMaterial::new(model, fresnel))
 }
 
 /// A hammered-metal height field (overlapping parabolic dents, the deepest wins), `n` × `n`, tiled,
