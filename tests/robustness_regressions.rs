@@ -44,7 +44,19 @@ fn regression_pdf_normal_of_infinite_directions() {
         Vec3::new(0.0, 0.0, f32::INFINITY),
         Vec3::new(0.0, -0.0, 4.839_110_6e37),
     ] {
-        assert_eq!(mixture.patch(&fp).pdf_normal(m), 0.0, "{m}");
+        // The gathered mixture, where the regression was found (a zero footprint is otherwise
+        // served by the sub-texel lobe, a single Gaussian: checked total below).
+        let gathered = brdf::glint::mixture::PatchOptions {
+            sub_texel_area: 0.0,
+            ..Default::default()
+        };
+        assert_eq!(
+            mixture.patch_with(&fp, &gathered, None).pdf_normal(m),
+            0.0,
+            "{m}"
+        );
+        let p = mixture.patch(&fp).pdf_normal(m);
+        assert!(p.is_finite() && p >= 0.0, "{m}: {p}");
         let p = pn.patch(&fp).pdf_normal(m);
         assert!(p.is_finite() && p >= 0.0, "{m}: {p}");
     }

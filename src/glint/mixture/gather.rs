@@ -464,8 +464,9 @@ pub(super) struct Footprinted<'a, L> {
     pub filtered: SlopeGaussian,
     pub gathered: Option<Gathered<'a>>,
     /// What serves the patch when `gathered` is `None`: the filtered lobe, the sub-texel limit
-    /// lobe (sub_texel.rs) or the filtered mixture (gmm.rs), with its error estimate (the filtered
-    /// mixture's fit error; 1 for the single lobes, which have none).
+    /// lobe (sub_texel.rs) or the filtered mixture (gmm.rs), with its error (the filtered
+    /// mixture's measured TV to the full mixture, calibrate.rs; 1 for the single lobes, which have
+    /// none).
     pub set: Option<(Few<'a>, SetKind, f32)>,
 }
 
@@ -496,9 +497,13 @@ fn filtered_error_at(errors: &[f32], lod: f64) -> f32 {
     errors[lo].max(errors[hi])
 }
 
-/// The per-footprint work of a patch of `store` (module docs): the filtered lobe, the level of
-/// detail (the coarsest whose weighted merge-error bound meets `options.lod_tolerance`, moved
-/// coarser by the cost cap, see [`level_range`]) and the gather there, its buffers lent by `slots`.
+/// The per-footprint work of a patch of `store` (module docs): below `options.sub_texel_area` the
+/// sub-texel limit lobe; from `options.filtered_area`, where the filtered mixture's measured error
+/// meets `options.filtered_tolerance`, the filtered mixture (its lobes lent by `sets`); otherwise the
+/// filtered lobe, the level of detail (the coarsest whose weighted merge-error bound meets
+/// `options.lod_tolerance`, moved coarser by the cost cap, see [`level_range`]; past the cap the
+/// filtered mixture, or the filtered lobe without one) and the gather there, its buffers lent by
+/// `slots`.
 /// `weight_sigmas`, `kernel_sigmas` and `sigma_min` are the mixture's parameters,
 /// `filtered_error` the filtered mixture's measured error per level (calibrate.rs).
 pub(super) fn footprint_patch<'a, S: LobeStore>(

@@ -221,7 +221,9 @@ impl<'a> MixturePatch<'a> {
     /// patch's slope density and that of the level-0 lobes its nodes replace, each node's weight
     /// W_n spread evenly over its lobes, both blurred by an isotropic Gaussian of std r in slope
     /// space, r the largest of [`super::LOD_RESOLUTIONS`] not above `PatchOptions::lod_resolution`
-    /// (0 at level 0; 1 under the filtered lobe, which has no bound). The difference between that
+    /// (0 at level 0; under the filtered mixture its measured TV to the full mixture instead,
+    /// [`BeckmannMixture::filtered_mixture_errors`]; 1 under the filtered lobe and the sub-texel
+    /// lobe, which have none). The difference between that
     /// even spread and the full mixture's own weights is not bounded (measured 0.0005-0.013 in TV,
     /// docs/mixture.md). See src/glint/mixture/levels.rs.
     pub fn lod_error(&self) -> f32 {
