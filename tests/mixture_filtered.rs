@@ -6,12 +6,11 @@
 mod support;
 
 use brdf::Vec2;
-use brdf::bxdf::{Bxdf, MicrofacetBrdf};
+use brdf::bxdf::MicrofacetBrdf;
 use brdf::fresnel::NoFresnel;
 use brdf::glint::mixture::{LobeStorage, MixtureParams, PatchOptions};
 use brdf::glint::{BeckmannMixture, Footprint, GlintNdf};
 use brdf::ndf::Ndf;
-use rand::RngExt;
 
 const N: usize = 128;
 
@@ -118,18 +117,7 @@ fn furnace_of_the_filtered_mixture() {
         let brdf = MicrofacetBrdf::new(&patch, NoFresnel);
         for theta in [0.0f64, 45.0, 75.0] {
             let wo = support::dir(theta, 30.0);
-            let n = 50_000;
-            let (mut sum, mut sum2) = (0.0f64, 0.0f64);
-            for _ in 0..n {
-                let u = Vec2::new(rng.random(), rng.random());
-                let w = brdf
-                    .sample(wo, rng.random(), u)
-                    .map_or(0.0, |s| s.weight().x as f64);
-                sum += w;
-                sum2 += w * w;
-            }
-            let mean = sum / n as f64;
-            let se = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
+            let (mean, se) = support::bxdf::sampled_albedo(&brdf, wo, 50_000, &mut rng);
             let (q, q_err) = support::bxdf::albedo_half_vector(&brdf, wo, 256, 512);
             println!("{name} θo {theta}: furnace {mean:.4} ± {se:.4}, quadrature {q:.4}");
             assert!(mean <= 1.0 + 4.0 * se + 1e-6, "{mean} ± {se}");

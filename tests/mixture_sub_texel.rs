@@ -5,12 +5,11 @@
 mod support;
 
 use brdf::Vec2;
-use brdf::bxdf::{Bxdf, MicrofacetBrdf};
+use brdf::bxdf::MicrofacetBrdf;
 use brdf::fresnel::NoFresnel;
 use brdf::glint::mixture::{DEFAULT_SUB_TEXEL_AREA, MixtureParams, PatchOptions};
 use brdf::glint::{self, BeckmannMixture, Footprint, GlintNdf, NormalMap};
 use brdf::ndf::Ndf;
-use rand::RngExt;
 
 const N: usize = 64;
 
@@ -190,18 +189,7 @@ fn furnace_of_the_limit_lobe() {
         let brdf = MicrofacetBrdf::new(&patch, NoFresnel);
         for theta in [0.0f64, 45.0, 75.0] {
             let wo = support::dir(theta, 30.0);
-            let n = 50_000;
-            let (mut sum, mut sum2) = (0.0f64, 0.0f64);
-            for _ in 0..n {
-                let u = Vec2::new(rng.random(), rng.random());
-                let w = brdf
-                    .sample(wo, rng.random(), u)
-                    .map_or(0.0, |s| s.weight().x as f64);
-                sum += w;
-                sum2 += w * w;
-            }
-            let mean = sum / n as f64;
-            let se = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
+            let (mean, se) = support::bxdf::sampled_albedo(&brdf, wo, 50_000, &mut rng);
             println!("c {c}, θo {theta}: furnace {mean:.4} ± {se:.4}");
             assert!(mean <= 1.0 + 4.0 * se + 1e-6, "{mean} ± {se}");
             assert!(mean > 0.0, "{mean}");

@@ -131,6 +131,25 @@ pub fn random_upper(rng: &mut impl rand::Rng) -> Vec3 {
     Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
+/// The white furnace the way a renderer integrates it: the mean of channel 0 of
+/// `sample().weight()` over `n` draws at `wo` (a missing sample counts 0) and its standard error.
+pub fn sampled_albedo(b: &dyn Bxdf, wo: Vec3, n: usize, rng: &mut impl rand::Rng) -> (f64, f64) {
+    let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+    for _ in 0..n {
+        let u = glam::Vec2::new(rng.random(), rng.random());
+        let w = b
+            .sample(wo, rng.random(), u)
+            .map_or(0.0, |s| s.weight().x as f64);
+        sum += w;
+        sum2 += w * w;
+    }
+    let mean = sum / n as f64;
+    (
+        mean,
+        ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt(),
+    )
+}
+
 /// Tolerance of a furnace comparison: 4 × the quadrature's error estimate (which overestimates the
 /// error of the finer rule, see `support::quadrature`) plus 1e-5 for the f32 rounding of the integrand
 /// (relative ~1e-7 per value, accumulated over a sum of positive terms).

@@ -130,3 +130,19 @@ pub(super) fn filtered_mixture_errors(
         })
         .collect()
 }
+
+/// The filtered mixture's measured error at level of detail `lod`: the larger of the two levels
+/// a trilinear lookup reads (1 where not measured, NaN `lod` → level 0).
+pub(super) fn error_at(errors: &[f32], lod: f64) -> f32 {
+    if errors.is_empty() {
+        return 1.0;
+    }
+    let top = errors.len() - 1;
+    let lod = if lod.is_nan() {
+        0.0
+    } else {
+        lod.clamp(0.0, top as f64)
+    };
+    let (lo, hi) = (lod.floor() as usize, (lod.ceil() as usize).min(top));
+    errors[lo].max(errors[hi])
+}

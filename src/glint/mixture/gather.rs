@@ -11,6 +11,7 @@
 
 use super::blocks::SIDE;
 use super::build::kernel_sigma;
+use super::calibrate;
 use super::lanes::LANES;
 use super::levels::resolution_index;
 use super::lobe_set::{Few, LobeSet};
@@ -481,22 +482,6 @@ pub(super) enum SetKind {
     FilteredMixture,
 }
 
-/// The filtered mixture's measured error at level of detail `lod`: the larger of the two levels
-/// a trilinear lookup reads (1 where not measured, NaN `lod` → level 0).
-fn filtered_error_at(errors: &[f32], lod: f64) -> f32 {
-    if errors.is_empty() {
-        return 1.0;
-    }
-    let top = errors.len() - 1;
-    let lod = if lod.is_nan() {
-        0.0
-    } else {
-        lod.clamp(0.0, top as f64)
-    };
-    let (lo, hi) = (lod.floor() as usize, (lod.ceil() as usize).min(top));
-    errors[lo].max(errors[hi])
-}
-
 /// The per-footprint work of a patch of `store` (module docs): below `options.sub_texel_area` the
 /// sub-texel limit lobe; from `options.filtered_area`, where the filtered mixture's measured error
 /// meets `options.filtered_tolerance`, the filtered mixture (its lobes lent by `sets`); otherwise the
@@ -529,7 +514,7 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
     let filtered = SlopeGaussian::from_moments(store.filtered_moments(fp.c, lod), sigma_min);
     // The filtered mixture where the storage has one (with its measured error at this level),
     // else the filtered lobe.
-    let error = filtered_error_at(filtered_error, lod);
+    let error = calibrate::error_at(filtered_error, lod);
     let few = || {
         let mut set = Lent::new(sets);
         if store.filtered_mixture(fp.c, lod, &mut set) && set.len() > 0 {

@@ -43,7 +43,8 @@
 //! 7. `calibrate.rs` (the filtered mixture's measured error), `gather.rs` (per-footprint work:
 //!    level choice, weights), `passes.rs` (the per-query loops over blocks, generic over the
 //!    storage), `patch.rs` ([`MixturePatch`]);
-//! 8. this file: the re-exports and `impl GlintNdf`; and the unit
+//! 8. this file: the re-exports, `impl GlintNdf` and the filtered mixture's measured errors
+//!    ([`BeckmannMixture::filtered_mixture_errors`], which builds patches); and the unit
 //!    test of the runtime dispatch (`dispatch_tests.rs`).
 
 mod blocks;
@@ -84,6 +85,31 @@ pub use params::{
 pub use patch::MixturePatch;
 
 use crate::glint::{Footprint, GlintNdf, GlintScratch};
+
+impl BeckmannMixture {
+    /// The filtered mixture's measured TV to the full mixture per level of its mip chain (index l:
+    /// footprints of 4^l lobe cells; 1 below the first measured level), empty under compact
+    /// storage: what [`PatchOptions::filtered_tolerance`] is compared with. Measured on first use
+    /// (~0.1-0.3 s, deterministic) and kept. See src/glint/mixture/calibrate.rs.
+    pub fn filtered_mixture_errors(&self) -> &[f32] {
+        self.filtered_error_cell().get_or_init(|| {
+            let (nx, ny) = self.grid();
+            let (full, filtered) = calibrate::compared_options();
+            calibrate::filtered_mixture_errors(
+                self.filtered_mixture_levels(),
+                (nx * ny) as f64,
+                self.spacing_f64(),
+                self.map_size(),
+                |fp| {
+                    let exact = MixturePatch::new(self, fp, full, None);
+                    let few = MixturePatch::new(self, fp, filtered, None);
+                    few.is_filtered_mixture()
+                        .then(|| calibrate::tv(&exact, &few))
+                },
+            )
+        })
+    }
+}
 
 impl GlintNdf for BeckmannMixture {
     type Patch<'a> = MixturePatch<'a>;

@@ -7,7 +7,6 @@
 //! loop over blocks, and runs the block pass (passes.rs) compiled for that pair.
 
 use super::blocks;
-use super::calibrate;
 use super::compact::CompactView;
 use super::full::FullLevel;
 use super::gather::{FootprintLobes, Gathered, SetKind, SlotBuffers, footprint_patch};
@@ -437,31 +436,6 @@ impl<'a> MixturePatch<'a> {
     #[cfg(test)]
     pub(super) fn simd_name(&self) -> &'static str {
         self.simd.name()
-    }
-}
-
-impl BeckmannMixture {
-    /// The filtered mixture's measured TV to the full mixture per level of its mip chain (index l:
-    /// footprints of 4^l lobe cells; 1 below the first measured level), empty under compact
-    /// storage: what [`PatchOptions::filtered_tolerance`] is compared with. Measured on first use
-    /// (~0.1-0.3 s, deterministic) and kept. See src/glint/mixture/calibrate.rs.
-    pub fn filtered_mixture_errors(&self) -> &[f32] {
-        self.filtered_error_cell().get_or_init(|| {
-            let (nx, ny) = self.grid();
-            let (full, filtered) = calibrate::compared_options();
-            calibrate::filtered_mixture_errors(
-                self.filtered_mixture_levels(),
-                (nx * ny) as f64,
-                self.spacing_f64(),
-                self.map_size(),
-                |fp| {
-                    let exact = MixturePatch::new(self, fp, full, None);
-                    let few = MixturePatch::new(self, fp, filtered, None);
-                    few.is_filtered_mixture()
-                        .then(|| calibrate::tv(&exact, &few))
-                },
-            )
-        })
     }
 }
 
