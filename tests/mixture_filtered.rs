@@ -10,7 +10,6 @@ use brdf::bxdf::MicrofacetBrdf;
 use brdf::fresnel::NoFresnel;
 use brdf::glint::mixture::{LobeStorage, MixtureParams, PatchOptions};
 use brdf::glint::{BeckmannMixture, Footprint, GlintNdf};
-use brdf::ndf::Ndf;
 
 const N: usize = 128;
 
@@ -86,22 +85,7 @@ fn chi_square_of_the_filtered_mixture() {
         "{}",
         patch.few_lobes().count()
     );
-    let chi2 = |name: String| support::chi2::Chi2::new(name, 3);
-    chi2("filtered mixture normals".into())
-        .run(
-            |_, u| Some(patch.sample_normal(u)),
-            |m| patch.pdf_normal(m) as f64,
-        )
-        .unwrap();
-    for theta in [30.0, 75.0] {
-        let wo = support::dir(theta, 20.0);
-        chi2(format!("filtered mixture visible {theta}"))
-            .run(
-                |_, u| Some(patch.sample_visible(wo, u)),
-                |m| patch.pdf_visible(wo, m) as f64,
-            )
-            .unwrap();
-    }
+    support::chi2_few_lobe_samplers(&patch, "filtered mixture", &[30.0, 75.0]);
 }
 
 /// White furnace in the renderer's measure (F = 1): the mean of `sample().weight()` ≤ 1 + 4
@@ -117,15 +101,8 @@ fn furnace_of_the_filtered_mixture() {
         let brdf = MicrofacetBrdf::new(&patch, NoFresnel);
         for theta in [0.0f64, 45.0, 75.0] {
             let wo = support::dir(theta, 30.0);
-            let (mean, se) = support::bxdf::sampled_albedo(&brdf, wo, 50_000, &mut rng);
-            let (q, q_err) = support::bxdf::albedo_half_vector(&brdf, wo, 256, 512);
-            println!("{name} θo {theta}: furnace {mean:.4} ± {se:.4}, quadrature {q:.4}");
-            assert!(mean <= 1.0 + 4.0 * se + 1e-6, "{mean} ± {se}");
-            assert!(q <= 1.0 + support::bxdf::furnace_tol(q_err), "{q}");
-            assert!(
-                (q - mean).abs() < 4.0 * se + support::bxdf::furnace_tol(q_err),
-                "{q} vs {mean}"
-            );
+            let label = format!("{name} θo {theta}");
+            support::bxdf::assert_half_vector_furnace(&brdf, wo, 50_000, &mut rng, &label);
         }
     }
 }

@@ -150,6 +150,30 @@ pub fn sampled_albedo(b: &dyn Bxdf, wo: Vec3, n: usize, rng: &mut impl rand::Rng
     )
 }
 
+/// The white furnace of a half-vector BRDF (microfacet) at `wo` both ways a renderer integrates
+/// it: [`sampled_albedo`] over `n` draws and the quadrature of eval · cos θi over the half vector
+/// ([`albedo_half_vector`], 256 × 512). Asserts that neither exceeds 1 (within 4 standard errors,
+/// the quadrature's tolerance) and that they agree; returns the sampled mean. `label` names the case
+/// in the printout and the failures.
+pub fn assert_half_vector_furnace(
+    b: &dyn Bxdf,
+    wo: Vec3,
+    n: usize,
+    rng: &mut impl rand::Rng,
+    label: &str,
+) -> f64 {
+    let (mean, se) = sampled_albedo(b, wo, n, rng);
+    let (q, q_err) = albedo_half_vector(b, wo, 256, 512);
+    println!("{label}: furnace {mean:.4} ± {se:.4}, quadrature {q:.4} ± {q_err:.1e}");
+    assert!(mean <= 1.0 + 4.0 * se + 1e-6, "{label}: {mean} ± {se}");
+    assert!(q <= 1.0 + furnace_tol(q_err), "{label}: {q}");
+    assert!(
+        (q - mean).abs() < 4.0 * se + furnace_tol(q_err),
+        "{label}: quadrature {q} vs sampled {mean}"
+    );
+    mean
+}
+
 /// Tolerance of a furnace comparison: 4 × the quadrature's error estimate (which overestimates the
 /// error of the finer rule, see `support::quadrature`) plus 1e-5 for the f32 rounding of the integrand
 /// (relative ~1e-7 per value, accumulated over a sum of positive terms).

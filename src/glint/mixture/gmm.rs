@@ -21,6 +21,7 @@
 //! Cost: ~20 ns of build per lobe (one reduction of ≤ 4 [`GMM_LOBES`] components per node), 96
 //! bytes per node of the levels ≥ 1 (≤ 32 bytes per lobe), and O(1) per query.
 
+use super::hierarchy::{bilinear_nodes, trilinear_levels};
 use super::lobe_set::LobeSet;
 use crate::glint::kernels::slope_tree::level_sizes;
 use crate::ndf::SlopeGaussian;
@@ -209,43 +210,17 @@ impl GmmPyramid {
     /// mip chain (src/glint/mixture/hierarchy.rs), `lobes` the level-0 raw moments; at most 8
     /// nodes × [`GMM_LOBES`] lobes.
     pub fn lookup(&self, lobes: &[[f32; 5]], p: [f64; 2], lod: f64, set: &mut LobeSet) {
-        let top = (self.sizes.len() - 1) as f64;
-        let lod = if lod.is_nan() {
-            0.0
-        } else {
-            lod.clamp(0.0, top)
-        };
-        let p = if p[0].is_finite() && p[1].is_finite() {
-            p
-        } else {
-            [0.0, 0.0]
-        };
-        let l0 = lod.floor();
-        let t = lod - l0;
-        let l0 = l0 as usize;
+        let (p, l0, t) = trilinear_levels(self.sizes.len(), p, lod);
         set.clear();
         let mut add_level = |l: usize, wl: f64| {
             if wl <= 0.0 {
                 return;
             }
-            let [w, h] = self.sizes[l];
-            let scale = (1u64 << l) as f64;
-            let (px, py) = (p[0] / scale - 0.5, p[1] / scale - 0.5);
-            let (bx, by) = (px.floor(), py.floor());
-            let (fx, fy) = (px - bx, py - by);
-            for (dx, dy, wb) in [
-                (0.0, 0.0, (1.0 - fx) * (1.0 - fy)),
-                (1.0, 0.0, fx * (1.0 - fy)),
-                (0.0, 1.0, (1.0 - fx) * fy),
-                (1.0, 1.0, fx * fy),
-            ] {
+            for (k, wb) in bilinear_nodes(p, l, self.sizes[l]) {
                 let wn = wl * wb;
                 if wn <= 0.0 {
                     continue;
                 }
-                let i = ((bx + dx) as i64).rem_euclid(w as i64) as usize;
-                let j = ((by + dy) as i64).rem_euclid(h as i64) as usize;
-                let k = j * w + i;
                 if l == 0 {
                     set.push(
                         wn as f32,

@@ -99,6 +99,25 @@ pub(super) fn trilinear(
     size: impl Fn(usize) -> [usize; 2],
     at: impl Fn(usize, usize) -> [f64; 5],
 ) -> [f32; 5] {
+    let (p, l0, t) = trilinear_levels(n_levels, p, lod);
+    let bilinear = |l: usize| -> [f64; 5] {
+        let c = bilinear_nodes(p, l, size(l)).map(|(k, wt)| (at(l, k), wt));
+        std::array::from_fn(|k| c.iter().map(|(m, wt)| m[k] * wt).sum())
+    };
+    let a = bilinear(l0);
+    let out = if t > 0.0 && l0 + 1 < n_levels {
+        let b = bilinear(l0 + 1);
+        std::array::from_fn(|k| a[k] * (1.0 - t) + b[k] * t)
+    } else {
+        a
+    };
+    out.map(|v| v as f32)
+}
+
+/// A trilinear lookup's inputs made total: the position `p` (non-finite → the origin), the lower
+/// level l0 = ⌊lod⌋ and the blend t ∈ [0, 1) toward l0 + 1, `lod` clamped to [0, n_levels − 1]
+/// (NaN → 0).
+pub(super) fn trilinear_levels(n_levels: usize, p: [f64; 2], lod: f64) -> ([f64; 2], usize, f64) {
     let top = (n_levels - 1) as f64;
     let lod = if lod.is_nan() {
         0.0
@@ -110,35 +129,29 @@ pub(super) fn trilinear(
     } else {
         [0.0, 0.0]
     };
-    let bilinear = |l: usize| -> [f64; 5] {
-        let [w, h] = size(l);
-        let scale = (1u64 << l) as f64;
-        let px = p[0] / scale - 0.5;
-        let py = p[1] / scale - 0.5;
-        let (bx, by) = (px.floor(), py.floor());
-        let (fx, fy) = (px - bx, py - by);
-        let node = |i: f64, j: f64| {
-            let i = (i as i64).rem_euclid(w as i64) as usize;
-            let j = (j as i64).rem_euclid(h as i64) as usize;
-            at(l, j * w + i)
-        };
-        let c = [
-            (node(bx, by), (1.0 - fx) * (1.0 - fy)),
-            (node(bx + 1.0, by), fx * (1.0 - fy)),
-            (node(bx, by + 1.0), (1.0 - fx) * fy),
-            (node(bx + 1.0, by + 1.0), fx * fy),
-        ];
-        std::array::from_fn(|k| c.iter().map(|(m, wt)| m[k] * wt).sum())
-    };
     let l0 = lod.floor();
-    let t = lod - l0;
-    let l0 = l0 as usize;
-    let a = bilinear(l0);
-    let out = if t > 0.0 && l0 + 1 < n_levels {
-        let b = bilinear(l0 + 1);
-        std::array::from_fn(|k| a[k] * (1.0 - t) + b[k] * t)
-    } else {
-        a
+    (p, l0 as usize, lod - l0)
+}
+
+/// The four nodes of level `l` (a grid of `size`, nodes 2^l level-0 lobes wide) around `p` (level-0
+/// lobe units, lobe i centred at i + ½) and their bilinear weights: (row-major node index, weight)
+/// for the offsets (0, 0), (1, 0), (0, 1), (1, 1), indices wrapped onto the grid.
+pub(super) fn bilinear_nodes(p: [f64; 2], l: usize, size: [usize; 2]) -> [(usize, f64); 4] {
+    let [w, h] = size;
+    let scale = (1u64 << l) as f64;
+    let px = p[0] / scale - 0.5;
+    let py = p[1] / scale - 0.5;
+    let (bx, by) = (px.floor(), py.floor());
+    let (fx, fy) = (px - bx, py - by);
+    let node = |i: f64, j: f64| {
+        let i = (i as i64).rem_euclid(w as i64) as usize;
+        let j = (j as i64).rem_euclid(h as i64) as usize;
+        j * w + i
     };
-    out.map(|v| v as f32)
+    [
+        (node(bx, by), (1.0 - fx) * (1.0 - fy)),
+        (node(bx + 1.0, by), fx * (1.0 - fy)),
+        (node(bx, by + 1.0), (1.0 - fx) * fy),
+        (node(bx + 1.0, by + 1.0), fx * fy),
+    ]
 }
