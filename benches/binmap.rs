@@ -143,6 +143,7 @@ fn smoothed(c: &mut Criterion) {
             &fp,
             &brdf::glint::binmap::PatchOptions {
                 smoothing_alpha: alpha,
+                ..Default::default()
             },
             None,
         );
@@ -162,6 +163,7 @@ fn smoothed(c: &mut Criterion) {
             &fp,
             &brdf::glint::binmap::PatchOptions {
                 smoothing_alpha: 0.1,
+                ..Default::default()
             },
             None,
         );

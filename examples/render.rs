@@ -2,7 +2,8 @@
 //! public API only (the scene, camera and integrator are in `examples/common/render.rs`).
 //!
 //! `cargo run --release --example render [-- --quick] [--out DIR] [--spp N] [--width W]`
-//! `cargo run --release --example render -- --timing [--quick] [--texels 10,500,30000]`
+//! `cargo run --release --example render -- --timing [--quick] [--texels 10,500,30000]
+//! [--materials mixture,bin]`
 //!
 //! Writes into DIR (default `target/brdf-out/`) a hammered normal map PNG (generated from a height
 //! field, then loaded back like any asset) and four tone-mapped renders of the same scene: analytic
@@ -29,6 +30,9 @@ fn main() -> Res<()> {
         };
         if let Some(list) = common::arg_value("--texels") {
             opts.texels_per_pixel = list.split(',').map(str::parse).collect::<Result<_, _>>()?;
+        }
+        if let Some(list) = common::arg_value("--materials") {
+            opts.materials = list.split(',').map(str::to_string).collect();
         }
         run_timing(&out, &opts)?;
         return Ok(());

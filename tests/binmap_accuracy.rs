@@ -62,6 +62,7 @@ fn smoothed_d_cos_integrates_to_one() {
         &Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 64.0, 32, 32),
         &brdf::glint::binmap::PatchOptions {
             smoothing_alpha: alpha,
+            ..Default::default()
         },
         None,
     );
@@ -182,7 +183,8 @@ fn exact_masses_on_another_grid() {
         bm.patch_with(
             &fp,
             &brdf::glint::binmap::PatchOptions {
-                smoothing_alpha: 0.1
+                smoothing_alpha: 0.1,
+                ..Default::default()
             },
             None
         )
@@ -239,6 +241,7 @@ fn accuracy_table() {
                 &fp,
                 &brdf::glint::binmap::PatchOptions {
                     smoothing_alpha: 0.02,
+                    ..Default::default()
                 },
                 None,
             );

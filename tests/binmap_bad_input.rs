@@ -68,6 +68,7 @@ fn bad_input_is_total() {
                 fp,
                 &brdf::glint::binmap::PatchOptions {
                     smoothing_alpha: 0.2,
+                    ..Default::default()
                 },
                 None,
             ),
@@ -75,6 +76,7 @@ fn bad_input_is_total() {
                 fp,
                 &brdf::glint::binmap::PatchOptions {
                     smoothing_alpha: f32::NAN,
+                    ..Default::default()
                 },
                 None,
             ),

@@ -44,6 +44,7 @@ fn white_furnace() {
                         &fp,
                         &brdf::glint::binmap::PatchOptions {
                             smoothing_alpha: 0.1,
+                            ..Default::default()
                         },
                         None,
                     ),
@@ -214,6 +215,7 @@ fn furnace_up_to_grazing_stays_below_one() {
                     &fp,
                     &brdf::glint::binmap::PatchOptions {
                         smoothing_alpha: 0.1,
+                        ..Default::default()
                     },
                     None,
                 ),

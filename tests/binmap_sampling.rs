@@ -93,6 +93,7 @@ fn chi_square_of_the_smoothed_sampler() {
             &Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, 64, 64),
             &brdf::glint::binmap::PatchOptions {
                 smoothing_alpha: 0.1,
+                ..Default::default()
             },
             None,
         );
@@ -189,6 +190,7 @@ fn chi_square_of_the_smoothed_visible_sampler() {
         &Footprint::isotropic_texels(Vec2::new(0.37, 0.61), 16.0, 64, 64),
         &brdf::glint::binmap::PatchOptions {
             smoothing_alpha: 0.1,
+            ..Default::default()
         },
         None,
     );

@@ -359,6 +359,7 @@ fn bin_map_weights_are_bounded() {
         for alpha in [0.0, 0.05] {
             let options = binmap::PatchOptions {
                 smoothing_alpha: alpha,
+                ..Default::default()
             };
             let patch = bm.patch_with(&fp, &options, None);
             // Unsmoothed: the bins' bilinear visible density (module docs of the bin map's

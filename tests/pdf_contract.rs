@@ -171,6 +171,7 @@ fn glint_patches(models: &Models) -> Vec<Named<'_>> {
         for alpha in [0.0, 0.05, 3.0, 1e4, f32::MAX] {
             let options = binmap::PatchOptions {
                 smoothing_alpha: alpha,
+                ..Default::default()
             };
             v.push((
                 format!("bin map {texels} texels α {alpha}"),
@@ -195,6 +196,7 @@ fn glint_patches(models: &Models) -> Vec<Named<'_>> {
     for alpha in [0.0, 0.05] {
         let options = binmap::PatchOptions {
             smoothing_alpha: alpha,
+            ..Default::default()
         };
         v.push((
             format!("bin map 1×1 flat α {alpha}"),

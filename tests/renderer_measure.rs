@@ -121,6 +121,7 @@ impl Models {
                 fp,
                 &brdf::glint::binmap::PatchOptions {
                     smoothing_alpha: SMOOTHING,
+                    ..Default::default()
                 },
                 None,
             ),
@@ -437,6 +438,7 @@ fn glint_model_patches_equal_their_models_patches() {
                 &fp,
                 &brdf::glint::binmap::PatchOptions {
                     smoothing_alpha: SMOOTHING,
+                    ..Default::default()
                 },
                 None,
             ),

@@ -71,7 +71,7 @@ proptest! {
             mixture.patch_with(&footprint, &exact, None),
             mixture.patch_with(&footprint, &approximate, None),
             bin_map.patch(&footprint),
-            bin_map.patch_with(&footprint, &brdf::glint::binmap::PatchOptions { smoothing_alpha: smoothing }, None),
+            bin_map.patch_with(&footprint, &brdf::glint::binmap::PatchOptions { smoothing_alpha: smoothing, ..Default::default() }, None),
             pn.patch(&footprint),
         );
         let patches: [(&str, &dyn Ndf); 5] = [

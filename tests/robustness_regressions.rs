@@ -130,6 +130,7 @@ fn regression_glint_furnaces_at_grazing_angles() {
             &fp,
             &brdf::glint::binmap::PatchOptions {
                 smoothing_alpha: 0.1,
+                ..Default::default()
             },
             None,
         ),

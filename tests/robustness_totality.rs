@@ -171,7 +171,7 @@ proptest! {
             check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), wo, wi, uc, u);
         }
         let bin_map = BinMap::build(&map, small_bins()).unwrap();
-        for patch in [bin_map.patch(&footprint), bin_map.patch_with(&footprint, &brdf::glint::binmap::PatchOptions { smoothing_alpha: smoothing }, None)] {
+        for patch in [bin_map.patch(&footprint), bin_map.patch_with(&footprint, &brdf::glint::binmap::PatchOptions { smoothing_alpha: smoothing, ..Default::default() }, None)] {
             check_ndf(&patch, wo, wi, uc, u);
             check_bxdf(&MicrofacetBrdf::new(&patch, NoFresnel), wo, wi, uc, u);
         }

@@ -284,6 +284,7 @@ fn bin_map_round_trip_is_exact() {
                     f,
                     &brdf::glint::binmap::PatchOptions {
                         smoothing_alpha: 0.1,
+                        ..Default::default()
                     },
                     None,
                 ),
@@ -291,6 +292,7 @@ fn bin_map_round_trip_is_exact() {
                     f,
                     &brdf::glint::binmap::PatchOptions {
                         smoothing_alpha: 0.1,
+                        ..Default::default()
                     },
                     None,
                 ),

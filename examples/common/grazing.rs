@@ -265,6 +265,7 @@ fn glint_rows(name: &str, map: &NormalMap, settings: &Settings) -> Res<Vec<Row>>
             &fp,
             &brdf::glint::binmap::PatchOptions {
                 smoothing_alpha: 0.1,
+                ..Default::default()
             },
             None,
         ),

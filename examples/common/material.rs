@@ -45,6 +45,7 @@ pub fn beckmann_alpha(sigma: f32) -> f32 {
 pub fn binmap_options(sigma: f32) -> BinMapOptions {
     BinMapOptions {
         smoothing_alpha: beckmann_alpha(sigma),
+        ..BinMapOptions::default()
     }
 }
 

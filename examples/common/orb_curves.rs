@@ -89,17 +89,18 @@ struct Point {
 
 /// The crate's four procedural maps and the example's fractal height field (orb/fractal.rs).
 const MAPS: [&str; 5] = ["scratched", "brushed", "bumpy", "flakes", "fractal"];
-/// The mixture without level-of-detail cap is rendered only up to this footprint (texels per pixel):
+/// The mixture without level of detail is rendered only up to this footprint (texels per pixel):
 /// beyond it every pixel reads tens of thousands of lobes.
 const NO_LOD_MAX_TEXELS: f64 = 5000.0;
-/// Label of the mixture's row without level-of-detail cap.
-const NO_LOD: &str = "mixture (no LOD cap)";
+/// Label of the mixture's row without level of detail (the full mixture at every footprint).
+const NO_LOD: &str = "mixture (no LOD)";
 const EVALS: [u32; 3] = [1, 4, 16];
 
 /// The glint models of one map with their build times, each given the scene's σ_ε the way its
 /// paper allows (examples/common/material.rs): the mixture with the options a user gets (lobe floor
-/// σ_ε, default `PatchOptions`; `samples` 64 is not read by the default filter moments) and the same mixture with no level of
-/// detail (`lod_lobes` ∞, `lod_tolerance` 0: the full mixture), the bin map at its
+/// σ_ε, default `PatchOptions`; `samples` 64 is not read by the default filter moments) and the same
+/// mixture with no level of detail (`lod_lobes` ∞, `lod_tolerance` 0, `sub_texel_area` 0,
+/// `filtered_area` ∞: the full mixture at every footprint), the bin map at its
 /// default bins smoothed by a Beckmann lobe of α = √2 σ_ε, the position-normal map with σ_r = σ_ε;
 /// and, as "paper default" rows, the bin map's one-bin resolution (σ = 0) and Yan's σ_r = 0.005.
 pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
@@ -114,6 +115,8 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
     full.options.mixture = PatchOptions {
         lod_lobes: f32::INFINITY,
         lod_tolerance: 0.0,
+        sub_texel_area: 0.0,
+        filtered_area: f32::INFINITY,
         ..PatchOptions::default()
     };
     let mixture_s = t.elapsed().as_secs_f64();

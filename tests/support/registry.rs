@@ -50,6 +50,7 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
     let mut smoothed = GlintOptions::default();
     smoothed.bin_map = binmap::PatchOptions {
         smoothing_alpha: 0.05,
+        ..Default::default()
     };
     let mut coarse = GlintOptions::default();
     coarse.mixture = PatchOptions {

@@ -10,6 +10,8 @@
 //! - the Beckmann mixture, the inverse bin map and the position-normal map, each
 //!   `GlintModel::from(Model::build(&map, Params::default()))` in a `GlintMaterial` with the
 //!   default `GlintOptions`, silver Fresnel;
+//! - the bin map again with `exact_masking_texels` = 64 (per-query option): footprints above 64
+//!   texels take the masking of their moment lobe (O(1)) instead of their own bins;
 //! - conventional normal mapping for reference: `Material::NormalMapped` of GGX α = 0.02 (silver)
 //!   through the tilt adapter (the map's interpolated normal at the footprint's centre);
 //! - the mixture as a glint clear coat (dielectric Fresnel η = 1.5) over red Lambert paint
@@ -30,8 +32,8 @@ use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::MixtureParams;
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, Footprint, GlintModel, NormalMap, PositionNormalMap, ScratchedParams,
-    scratched,
+    BeckmannMixture, BinMap, Footprint, GlintModel, GlintOptions, NormalMap, PositionNormalMap,
+    ScratchedParams, scratched,
 };
 use brdf::material::{NormalMappedMaterial, NormalMapping};
 use brdf::{Ggx, GlintMaterial, Material, Vec2, Vec3};
@@ -53,6 +55,9 @@ pub struct TimingOptions {
     pub texels_per_pixel: Vec<f32>,
     /// Rounds of the round-robin (≥ 2).
     pub rounds: usize,
+    /// Materials to time, by label substring (case-insensitive; `=label` for the label alone);
+    /// empty: all. Analytic GGX is always timed (every ratio is against it).
+    pub materials: Vec<String>,
 }
 
 impl TimingOptions {
@@ -65,6 +70,7 @@ impl TimingOptions {
             map_size: 1024,
             texels_per_pixel: vec![10.0, 500.0, 30_000.0],
             rounds: 3,
+            materials: Vec::new(),
         }
     }
 
@@ -149,12 +155,11 @@ fn sphere_pixels(scene: &Scene) -> Vec<usize> {
         .collect()
 }
 
-/// Mean area, in texels of a `map_size`² map tiled `tiles` times over the sphere's uv, of the
-/// camera's pixel footprints at the centres of the sphere's pixels.
-pub fn mean_texels_per_pixel(scene: &Scene, tiles: Vec2, map_size: usize) -> f64 {
+/// Areas, in texels of a `map_size`² map tiled `tiles` times over the sphere's uv, of the camera's
+/// pixel footprints at the centres of the sphere's pixels.
+fn pixel_areas(scene: &Scene, tiles: Vec2, map_size: usize) -> Vec<f64> {
     let cam = &scene.camera;
-    let mut sum = 0.0;
-    let mut n = 0usize;
+    let mut areas = Vec::new();
     for y in 0..cam.height {
         for x in 0..cam.width {
             let d = cam.direction_to(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
@@ -170,12 +175,34 @@ pub fn mean_texels_per_pixel(scene: &Scene, tiles: Vec2, map_size: usize) -> f64
             );
             let a = mapped.area_texels(map_size, map_size) as f64;
             if a.is_finite() {
-                sum += a;
-                n += 1;
+                areas.push(a);
             }
         }
     }
-    sum / n.max(1) as f64
+    areas
+}
+
+/// Mean area, in texels of a `map_size`² map tiled `tiles` times over the sphere's uv, of the
+/// camera's pixel footprints at the centres of the sphere's pixels.
+pub fn mean_texels_per_pixel(scene: &Scene, tiles: Vec2, map_size: usize) -> f64 {
+    let areas = pixel_areas(scene, tiles, map_size);
+    areas.iter().sum::<f64>() / areas.len().max(1) as f64
+}
+
+/// Fractions of the sphere's pixels whose per-sample footprint (the pixel's area / `spp`) is below
+/// 2 texels, in [2, 4096) and at least 4096: the ranges of the mixture's default forms (sub-texel
+/// lobe, gathered lobes, filtered mixture where its measured error allows).
+pub fn per_sample_split(scene: &Scene, tiles: Vec2, map_size: usize, spp: u32) -> [f64; 3] {
+    let areas = pixel_areas(scene, tiles, map_size);
+    let n = areas.len().max(1) as f64;
+    let per = |lo: f64, hi: f64| {
+        areas
+            .iter()
+            .filter(|&&a| (lo..hi).contains(&(a / spp.max(1) as f64)))
+            .count() as f64
+            / n
+    };
+    [per(0.0, 2.0), per(2.0, 4096.0), per(4096.0, f64::INFINITY)]
 }
 
 /// The tiling (2k, k) (square texels on the sphere: u spans 2πr, v spans πr) whose mean pixel
@@ -222,50 +249,82 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
     let map = Arc::new(scratched(n, n, ScratchedParams::default(), 7)?);
     let alpha = std::f32::consts::SQRT_2 * rms_slope(&map);
     let silver = ConductorFresnel::SILVER;
+    let wanted = |label: &str| {
+        label == "analytic GGX"
+            || opts.materials.is_empty()
+            || opts.materials.iter().any(|m| match m.strip_prefix('=') {
+                Some(exact) => label.eq_ignore_ascii_case(exact),
+                None => label.to_lowercase().contains(&m.to_lowercase()),
+            })
+    };
     let mut builds = String::new();
+    // Builds the model of the materials `labels` if one of them is timed.
     let mut timed_build =
-        |name: &str, f: &mut dyn FnMut() -> Res<GlintModel>| -> Res<Arc<GlintModel>> {
+        |labels: &[&str], f: &mut dyn FnMut() -> Res<GlintModel>| -> Res<Option<Arc<GlintModel>>> {
+            if !labels.iter().any(|l| wanted(l)) {
+                return Ok(None);
+            }
             let t = Instant::now();
             let model = Arc::new(f()?);
             let s = t.elapsed().as_secs_f64();
-            let _ = writeln!(builds, "  {name}: {s:.2} s");
-            Ok(model)
+            let _ = writeln!(builds, "  {}: {s:.2} s", labels[0]);
+            Ok(Some(model))
         };
-    let mixture = timed_build("Beckmann mixture", &mut || {
-        Ok(BeckmannMixture::build(&map, MixtureParams::default())?.into())
+    // The filtered mixture's errors are measured on first use; a renderer that wants no hitch in
+    // its first frame asks for them at load, as here (timed with the build).
+    let mixture = timed_build(&["Beckmann mixture", "mixture coat"], &mut || {
+        let m = BeckmannMixture::build(&map, MixtureParams::default())?;
+        m.filtered_mixture_errors();
+        Ok(m.into())
     })?;
-    let bin_map = timed_build("bin map", &mut || {
+    let bin_map = timed_build(&["bin map"], &mut || {
         Ok(BinMap::build(&map, BinMapParams::default())?.into())
     })?;
-    let position_normal = timed_build("position-normal", &mut || {
+    let position_normal = timed_build(&["position-normal"], &mut || {
         Ok(PositionNormalMap::build(&map, PositionNormalParams::default())?.into())
     })?;
-    println!("builds ({n}² scratched map, default parameters, wall time):\n{builds}");
-    let coat = GlintMaterial::new(mixture.clone(), DielectricFresnel::new(1.5)?)
-        .over_base(Vec3::new(0.5, 0.03, 0.02))?;
+    println!(
+        "builds ({n}² scratched map, default parameters, wall time; the mixture's includes its \
+         filtered mixture's errors):\n{builds}"
+    );
     let plain = |m: &Arc<GlintModel>| GlintMaterial::new(m.clone(), silver);
     let glint = |m: GlintMaterial| -> Box<dyn Fn(Vec2) -> Res<Material>> {
         Box::new(move |tiles| Ok(m.clone().with_uv_scale(tiles)?.into()))
     };
+    let entry = |label: &'static str, model: &Option<Arc<GlintModel>>| {
+        model.as_ref().map(|m| Entry {
+            label,
+            make: glint(plain(m)),
+        })
+    };
+    let coat = match &mixture {
+        Some(m) => Some(Entry {
+            label: "mixture coat",
+            make: glint(
+                GlintMaterial::new(m.clone(), DielectricFresnel::new(1.5)?)
+                    .over_base(Vec3::new(0.5, 0.03, 0.02))?,
+            ),
+        }),
+        None => None,
+    };
     let nm_map = map.clone();
-    let entries = [
-        Entry {
+    let all = [
+        Some(Entry {
             label: "analytic GGX",
             make: Box::new(move |_| Ok(Material::microfacet(Ggx::isotropic(alpha)?, silver))),
-        },
-        Entry {
-            label: "Beckmann mixture",
-            make: glint(plain(&mixture)),
-        },
-        Entry {
-            label: "bin map",
-            make: glint(plain(&bin_map)),
-        },
-        Entry {
-            label: "position-normal",
-            make: glint(plain(&position_normal)),
-        },
-        Entry {
+        }),
+        entry("Beckmann mixture", &mixture),
+        entry("bin map", &bin_map),
+        bin_map.as_ref().map(|m| {
+            let mut options = GlintOptions::default();
+            options.bin_map.exact_masking_texels = 64.0;
+            Entry {
+                label: "bin map, moment masking > 64 texels",
+                make: glint(plain(m).with_options(options)),
+            }
+        }),
+        entry("position-normal", &position_normal),
+        Some(Entry {
             label: "normal mapping",
             make: Box::new(move |tiles| {
                 let base = Material::microfacet(Ggx::isotropic(0.02)?, silver);
@@ -274,12 +333,14 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
                     .with_uv_scale(tiles)?;
                 Ok(nm.into())
             }),
-        },
-        Entry {
-            label: "mixture coat",
-            make: glint(coat),
-        },
+        }),
+        coat,
     ];
+    let entries: Vec<Entry> = all
+        .into_iter()
+        .flatten()
+        .filter(|e| wanted(e.label))
+        .collect();
     println!(
         "scene: unit sphere, point light + constant sky, {}×{}, {} spp; analytic GGX α = √2 × RMS slope = {alpha:.4}",
         opts.width, opts.height, opts.spp
@@ -294,6 +355,15 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
             (t, tiles, mean_texels_per_pixel(&probe, tiles, n))
         })
         .collect();
+    for &(t, tiles, a) in &scales {
+        let [lo, mid, hi] = per_sample_split(&probe, tiles, n, opts.spp);
+        println!(
+            "~{t} texels per pixel (mean {a:.0}): per-sample footprints < 2 texels {:.0} %, 2-4096 {:.0} %, >= 4096 {:.0} %",
+            100.0 * lo,
+            100.0 * mid,
+            100.0 * hi
+        );
+    }
     let spp = opts.spp.max(1) as f64;
     let mut rows: Vec<TimingRow> = scales
         .iter()

@@ -75,12 +75,12 @@ pub const DEFAULT_LOOKUP: BinLookup = BinLookup::Dense;
 /// than 4 texels take their masking lobe from level 2.
 pub const MASKING_FIRST_LEVEL: usize = 2;
 
-/// Largest footprint (texels²) whose patch computes its masking terms from its own bins (one
-/// O(s² |A|) pass over the footprint's sub-texels at patch construction, then O(bins in A) per
-/// direction) and has the visible-normal sampler; larger footprints use the filtered-moment lobe
-/// (O(1)) and the normal sampler. 4096 texels: measured in docs/results.md (white furnace with both,
-/// cost of the pass).
-pub const EXACT_MASKING_TEXELS: f32 = 4096.0;
+/// Default [`PatchOptions::exact_masking_texels`]: 4096 texels. Below it a footprint's masking is
+/// the exact Smith terms of its own bins; the O(1) moment lobe above loses 1-20 % of the albedo at
+/// θo = 45-85° on the procedural maps (and adds up to 7 % on small footprints), which is why the
+/// limit is not lower although the pass dominates the bin map's frame time from ~500 texels per
+/// pixel (docs/results.md, "Inverse bin map: the masking level of detail").
+pub const DEFAULT_EXACT_MASKING_TEXELS: f32 = 4096.0;
 
 /// Build parameters of a [`BinMap`]. `Default` gives the documented `DEFAULT_*` values.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -135,12 +135,21 @@ pub struct PatchOptions {
     /// The smoothing follows the idea of the authors' later full paper (a Beckmann lobe per bin);
     /// \[Atanasov2020\] itself has one-bin angular resolution.
     pub smoothing_alpha: f32,
+    /// Largest footprint (texels²) whose patch computes its masking terms from its own bins: one
+    /// O(s² |A|) pass over the footprint's sub-texels at patch construction, then O(bins in A) per
+    /// direction, and the visible-normal sampler. Larger footprints take the Smith terms of the
+    /// footprint's filtered-moment lobe (O(1), conservative) and the normal sampler. NaN or values
+    /// not > 0 give every footprint the moment lobe; `f32::INFINITY` gives every footprint its own
+    /// bins. `Default` gives [`DEFAULT_EXACT_MASKING_TEXELS`]; docs/binmap.md gives the error and
+    /// cost that chose it.
+    pub exact_masking_texels: f32,
 }
 
 impl Default for PatchOptions {
     fn default() -> Self {
         PatchOptions {
             smoothing_alpha: DEFAULT_SMOOTHING_ALPHA,
+            exact_masking_texels: DEFAULT_EXACT_MASKING_TEXELS,
         }
     }
 }
@@ -674,7 +683,13 @@ impl GlintNdf for BinMap {
         let alpha = options.smoothing_alpha;
         let alpha = (alpha.is_finite() && alpha > 0.0)
             .then(|| alpha.clamp(crate::ndf::MIN_ALPHA, crate::ndf::MAX_ALPHA));
-        BinMapPatch::new(self, footprint, alpha, scratch)
+        BinMapPatch::new(
+            self,
+            footprint,
+            alpha,
+            options.exact_masking_texels,
+            scratch,
+        )
     }
 }
 

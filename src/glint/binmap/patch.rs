@@ -6,10 +6,10 @@
 //! # Reference
 //! \[Atanasov2020\] §2 (D_A^H), §2.2 (evaluation through 𝓑⁻¹).
 
+use super::BinMap;
 use super::clip::Parallelogram;
 use super::forest::QueryStats;
 use super::masking::{Buf, ExactMasking, PatchBin};
-use super::{BinMap, EXACT_MASKING_TEXELS};
 use crate::glint::scratch::Lent;
 use crate::glint::{Footprint, GlintScratch, HemisphereBins, MIN_WIDTH_TEXELS};
 use crate::ndf::SlopeGaussian;
@@ -40,7 +40,7 @@ const SMOOTH_TAIL: f64 = 1e-6;
 /// terms (their lobes are listed at patch construction), otherwise ∝ (n α)² bin lookups over a
 /// window of bins around h (whichever is smaller).
 ///
-/// **Masking** (the talk defines none). For footprints of at most [`EXACT_MASKING_TEXELS`] texels,
+/// **Masking** (the talk defines none). For footprints of at most `exact_masking_texels` texels,
 /// Smith terms of the bin-map D itself, from the footprint's bins enumerated once per patch
 /// (O(s² |A|), through 𝓑). Each bin's D is constant, so with m̄_j = (1/|H|) ∫_{H_j} m dω the bin's mean
 /// direction vector (tabulated per bin at build), the projected area A(w) = max(Σ_j mass_j ⟨w, m̄_j⟩
@@ -78,7 +78,7 @@ const SMOOTH_TAIL: f64 = 1e-6;
 /// sample weight D ⟨wo, m⟩ / pdf is nearly constant; [`Ndf::pdf_visible`] returns this density
 /// exactly. The smoothed patch chooses lobe j ∝ mass_j V_j(wo) and draws its visible normal:
 /// density ⟨wo, m⟩⁺ Σ_j mass_j D_j(m) / Σ_j mass_j V_j(wo). Footprints above
-/// [`EXACT_MASKING_TEXELS`] (no bin list) and views nothing faces draw from `sample_normal`, with
+/// `exact_masking_texels` (no bin list) and views nothing faces draw from `sample_normal`, with
 /// `pdf_normal` as their density. Cost O(bins of the footprint) per call. docs/binmap.md.
 ///
 /// Total: invalid directions give 0; a degenerate footprint falls back to a square of side
@@ -96,7 +96,7 @@ pub struct BinMapPatch<'a> {
     /// Translations bringing each periodic image of the map's tile that meets A onto the map.
     images: Buf<'a, [f64; 2]>,
     pub(super) lobe: SlopeGaussian,
-    /// Exact masking terms for footprints of at most [`EXACT_MASKING_TEXELS`].
+    /// Exact masking terms for footprints of at most `exact_masking_texels`.
     pub(super) exact: Option<ExactMasking<'a>>,
     /// Smoothing lobes' slope σ, if any.
     pub(super) sigma: Option<f64>,
@@ -132,6 +132,7 @@ impl<'a> BinMapPatch<'a> {
         map: &'a BinMap,
         footprint: &Footprint,
         alpha: Option<f32>,
+        exact_masking_texels: f32,
         scratch: Option<&'a GlintScratch>,
     ) -> Self {
         let mut bufs = Bufs::new(scratch);
@@ -173,7 +174,7 @@ impl<'a> BinMapPatch<'a> {
             bins,
             lobes,
         } = bufs;
-        let exact = (area_texels <= EXACT_MASKING_TEXELS as f64).then(|| {
+        let exact = (area_texels <= exact_masking_texels as f64).then(|| {
             ExactMasking::new(map, &para, images.as_slice(), sigma, &mut acc, bins, lobes)
         });
         BinMapPatch {
@@ -220,7 +221,7 @@ impl<'a> BinMapPatch<'a> {
     }
 
     /// Whether the masking terms are computed from the footprint's bins (|A| ≤
-    /// [`EXACT_MASKING_TEXELS`]) rather than from the masking lobe.
+    /// `exact_masking_texels`) rather than from the masking lobe.
     pub fn has_exact_masking(&self) -> bool {
         self.exact.is_some()
     }
@@ -489,6 +490,7 @@ mod tests {
                 &fp,
                 &super::super::PatchOptions {
                     smoothing_alpha: alpha,
+                    ..Default::default()
                 },
                 None,
             );

@@ -225,7 +225,7 @@ pub struct PatchOptions {
     /// ([`DEFAULT_FILTERED_AREA`]; `f32::INFINITY` never).
     pub filtered_area: f32,
     /// Largest measured TV between the filtered mixture and the full mixture at the footprint's
-    /// level ([`DEFAULT_FILTERED_TOLERANCE`], measured per mixture at build time,
+    /// level ([`DEFAULT_FILTERED_TOLERANCE`]; measured per mixture on first use,
     /// src/glint/mixture/calibrate.rs) at which the filtered mixture serves a footprint of at
     /// least `filtered_area`; above it the footprint is gathered (the level of detail and the
     /// cost cap `lod_lobes` decide). `f32::INFINITY` always serves it.

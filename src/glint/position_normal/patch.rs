@@ -247,8 +247,8 @@ pub struct PositionNormalPatch<'a> {
 }
 
 /// Largest patch (number of elements kept) whose masking terms use the exact V(w) = Σ W_i V_i(w);
-/// larger patches use Scarf's moment bound (O(1) per direction instead of O(elements)). 4096, the
-/// bin map's [`EXACT_MASKING_TEXELS`](crate::glint::binmap::EXACT_MASKING_TEXELS) at one element per texel.
+/// larger patches use Scarf's moment bound (O(1) per direction instead of O(elements)). 4096: a
+/// footprint of 4096 texels at one element per texel.
 pub const EXACT_MASKING_ELEMENTS: usize = 4096;
 
 impl<'a> PositionNormalPatch<'a> {

@@ -1,0 +1,131 @@
+//! The bin map's masking level of detail (`binmap::PatchOptions::exact_masking_texels`): footprints
+//! above the limit take the Smith terms of the footprint's filtered-moment lobe instead of their own
+//! bins. The option's semantics, and (ignored) the table of docs/results.md that kept the default:
+//! the renderer's albedo (mean `sample().weight()`, geometric cos θi) and G1(wo) of the two forms.
+
+mod support;
+
+use brdf::fresnel::NoFresnel;
+use brdf::glint::binmap::{BinMapParams, DEFAULT_EXACT_MASKING_TEXELS, PatchOptions};
+use brdf::glint::{BinMap, Footprint, GlintNdf, NormalMap};
+use brdf::ndf::Ndf;
+use brdf::{MicrofacetBrdf, Vec2, Vec3};
+use std::time::Instant;
+use support::albedo;
+
+/// The view at θo (degrees), azimuth 30°.
+fn view(theta_deg: f32) -> Vec3 {
+    let (t, p) = (theta_deg.to_radians(), 30f32.to_radians());
+    Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+}
+
+/// Options with the exact-masking limit `limit` (texels), no smoothing.
+fn options(limit: f32) -> PatchOptions {
+    PatchOptions {
+        exact_masking_texels: limit,
+        ..PatchOptions::default()
+    }
+}
+
+/// (albedo, its standard error, G1(wo)) of the patch of `fp` under `opts`.
+fn measure(bm: &BinMap, fp: &Footprint, opts: &PatchOptions, wo: Vec3, n: usize) -> [f64; 3] {
+    let patch = bm.patch_with(fp, opts, None);
+    let (a, se) = albedo(&MicrofacetBrdf::new(&patch, NoFresnel), wo, n);
+    let g1 = 1.0 / (1.0 + patch.lambda(wo) as f64);
+    [a, se, g1]
+}
+
+fn maps(size: usize) -> Vec<(&'static str, NormalMap)> {
+    use brdf::glint::{FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched};
+    vec![
+        ("bumpy", bumpy(size, size, 0.25, 4.0, 1).unwrap()),
+        (
+            "brushed",
+            brushed(size, size, Default::default(), 2).unwrap(),
+        ),
+        (
+            "scratched",
+            scratched(size, size, ScratchedParams::default(), 3).unwrap(),
+        ),
+        (
+            "flakes",
+            flakes(size, size, FlakesParams::default(), 4).unwrap(),
+        ),
+    ]
+}
+
+/// Above the default limit the patch uses the moment lobe, at or below it its own bins; the limit
+/// is a per-query option (∞: always the bins; 0 or NaN: always the lobe).
+#[test]
+fn the_limit_chooses_the_masking_form() {
+    let map = brdf::glint::bumpy(64, 64, 0.25, 4.0, 1).unwrap();
+    let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
+    let at = |area: f32| Footprint::isotropic_texels(Vec2::new(0.4, 0.6), area, 64, 64);
+    let d = DEFAULT_EXACT_MASKING_TEXELS;
+    assert!(bm.patch(&at(0.5 * d)).has_exact_masking());
+    assert!(!bm.patch(&at(2.0 * d)).has_exact_masking());
+    assert!(
+        bm.patch_with(&at(2.0 * d), &options(f32::INFINITY), None)
+            .has_exact_masking()
+    );
+    for limit in [0.0, -1.0, f32::NAN] {
+        assert!(
+            !bm.patch_with(&at(4.0), &options(limit), None)
+                .has_exact_masking()
+        );
+    }
+}
+
+/// The table of docs/results.md ("Inverse bin map: the masking level of detail"): per map (512²,
+/// default build) and footprint, the albedo and G1(wo) of the moment lobe against the footprint's
+/// own bins at θo = 0°, 45°, 70°, 85°, and the time of `patch_with` of each. Command:
+/// `cargo test --release --test binmap_masking_lod -- --ignored masking_table --nocapture`.
+#[test]
+#[ignore]
+fn masking_table() {
+    let n = 1 << 14;
+    println!(
+        "| map | texels | albedo ratio (lobe ÷ bins) 0° / 45° / 70° / 85° | G1 ratio 85° | \
+         patch_with bins / lobe |"
+    );
+    println!("|---|---|---|---|---|");
+    for (name, map) in maps(512) {
+        let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
+        for area in [16.0f32, 64.0, 256.0, 1024.0, 4096.0] {
+            let centres = [Vec2::new(0.37, 0.61), Vec2::new(0.71, 0.23)];
+            let mut ratios = vec![];
+            let mut g1_85 = 0.0;
+            for theta in [0.0, 45.0, 70.0, 85.0] {
+                let wo = view(theta);
+                let (mut lobe, mut bins) = (0.0, 0.0);
+                for c in centres {
+                    let fp = Footprint::isotropic_texels(c, area, 512, 512);
+                    let [a, _, g1] = measure(&bm, &fp, &options(0.0), wo, n);
+                    let [ae, _, g1e] = measure(&bm, &fp, &options(f32::INFINITY), wo, n);
+                    lobe += a;
+                    bins += ae;
+                    if theta == 85.0 {
+                        g1_85 += 0.5 * g1 / g1e;
+                    }
+                }
+                ratios.push(format!("{:.3}", lobe / bins));
+            }
+            let time = |opts: PatchOptions| {
+                let reps = 200;
+                let t = Instant::now();
+                for k in 0..reps {
+                    let c = Vec2::new(0.1 + 0.004 * k as f32, 0.3);
+                    let fp = Footprint::isotropic_texels(c, area, 512, 512);
+                    std::hint::black_box(bm.patch_with(&fp, &opts, None).has_exact_masking());
+                }
+                t.elapsed().as_secs_f64() / reps as f64 * 1e6
+            };
+            println!(
+                "| {name} | {area} | {} | {g1_85:.3} | {:.1} / {:.1} µs |",
+                ratios.join(" / "),
+                time(options(f32::INFINITY)),
+                time(options(0.0)),
+            );
+        }
+    }
+}
