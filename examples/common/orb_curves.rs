@@ -110,7 +110,11 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
         samples: 64,
         ..MixtureParams::default()
     };
-    let mixture = Configured::new(Arc::new(BeckmannMixture::build(map, params)?.into()));
+    let built = BeckmannMixture::build(map, params)?;
+    // The filtered mixture's errors (measured on first use) count as build time: the sweep's
+    // largest footprints need them.
+    built.filtered_mixture_errors();
+    let mixture = Configured::new(Arc::new(built.into()));
     let mut full = mixture.clone();
     full.options.mixture = PatchOptions {
         lod_lobes: f32::INFINITY,
