@@ -10,8 +10,8 @@
 //! - the Beckmann mixture, the inverse bin map and the position-normal map, each
 //!   `GlintModel::from(Model::build(&map, Params::default()))` in a `GlintMaterial` with the
 //!   default `GlintOptions`, silver Fresnel;
-//! - the bin map again with `exact_masking_texels` = 64 (per-query option): footprints above 64
-//!   texels take the masking of their moment lobe (O(1)) instead of their own bins;
+//! - the bin map again with `exact_masking_texels` at its floor, 128 (per-query option): footprints
+//!   above 128 texels take the masking of their moment lobe (O(1)) instead of their own bins;
 //! - conventional normal mapping for reference: `Material::NormalMapped` of GGX α = 0.02 (silver)
 //!   through the tilt adapter (the map's interpolated normal at the footprint's centre);
 //! - the mixture as a glint clear coat (dielectric Fresnel η = 1.5) over red Lambert paint
@@ -84,6 +84,9 @@ impl TimingOptions {
         }
     }
 }
+
+/// Label of the bin map with `exact_masking_texels` at its floor (128).
+const BIN_MAP_MOMENT: &str = "bin map, moment masking > 128 texels";
 
 /// One material of the harness: its label and how to make it for a map tiling.
 struct Entry {
@@ -277,7 +280,7 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         m.filtered_mixture_errors();
         Ok(m.into())
     })?;
-    let bin_map = timed_build(&["bin map"], &mut || {
+    let bin_map = timed_build(&["bin map", BIN_MAP_MOMENT], &mut || {
         Ok(BinMap::build(&map, BinMapParams::default())?.into())
     })?;
     let position_normal = timed_build(&["position-normal"], &mut || {
@@ -317,9 +320,9 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         entry("bin map", &bin_map),
         bin_map.as_ref().map(|m| {
             let mut options = GlintOptions::default();
-            options.bin_map.exact_masking_texels = 64.0;
+            options.bin_map.exact_masking_texels = brdf::glint::binmap::MIN_MOMENT_MASKING_TEXELS;
             Entry {
-                label: "bin map, moment masking > 64 texels",
+                label: BIN_MAP_MOMENT,
                 make: glint(plain(m).with_options(options)),
             }
         }),

@@ -76,11 +76,20 @@ pub const DEFAULT_LOOKUP: BinLookup = BinLookup::Dense;
 pub const MASKING_FIRST_LEVEL: usize = 2;
 
 /// Default [`PatchOptions::exact_masking_texels`]: 4096 texels. Below it a footprint's masking is
-/// the exact Smith terms of its own bins; the O(1) moment lobe above loses 1-20 % of the albedo at
-/// θo = 45-85° on the procedural maps (and adds up to 7 % on small footprints), which is why the
-/// limit is not lower although the pass dominates the bin map's frame time from ~500 texels per
-/// pixel (docs/results.md, "Inverse bin map: the masking level of detail").
+/// the exact Smith terms of its own bins; the O(1) moment lobe above loses up to 10 % of the albedo
+/// at θo = 45°, 22 % at 70° and 59 % at 85° on the procedural maps, whatever the footprint's size
+/// (and adds up to 7 % at 16 texels), which is why the limit is not lower although the pass
+/// dominates the bin map's frame time from ~500 texels per pixel (docs/results.md, "Inverse bin
+/// map: the masking level of detail").
 pub const DEFAULT_EXACT_MASKING_TEXELS: f32 = 4096.0;
+
+/// Smallest footprint (texels²) that takes the moment lobe's masking whatever
+/// [`PatchOptions::exact_masking_texels`] says: 128. Below it the mip chain's moments (kept from
+/// level [`MASKING_FIRST_LEVEL`], read at radius ½√|A|) are not the footprint's, so Scarf's bound is
+/// not an upper bound on its visible area and the furnace exceeds 1 (measured up to 1.41 at 85° and
+/// 1.10 at 45° on 64-texel footprints); from 128 texels it stays within 1 % of 1 on the test maps,
+/// the excess the default limit also has above 4096 (tests/binmap_masking_lod.rs).
+pub const MIN_MOMENT_MASKING_TEXELS: f32 = 128.0;
 
 /// Build parameters of a [`BinMap`]. `Default` gives the documented `DEFAULT_*` values.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -138,10 +147,10 @@ pub struct PatchOptions {
     /// Largest footprint (texels²) whose patch computes its masking terms from its own bins: one
     /// O(s² |A|) pass over the footprint's sub-texels at patch construction, then O(bins in A) per
     /// direction, and the visible-normal sampler. Larger footprints take the Smith terms of the
-    /// footprint's filtered-moment lobe (O(1), conservative) and the normal sampler. NaN or values
-    /// not > 0 give every footprint the moment lobe; `f32::INFINITY` gives every footprint its own
-    /// bins. `Default` gives [`DEFAULT_EXACT_MASKING_TEXELS`]; docs/binmap.md gives the error and
-    /// cost that chose it.
+    /// footprint's filtered-moment lobe (O(1)) and the normal sampler. Values below
+    /// [`MIN_MOMENT_MASKING_TEXELS`] (NaN included) act as it: smaller footprints always keep their
+    /// own bins. `f32::INFINITY` gives every footprint its own bins. `Default` gives
+    /// [`DEFAULT_EXACT_MASKING_TEXELS`]; docs/binmap.md gives the error and cost that chose it.
     pub exact_masking_texels: f32,
 }
 
@@ -683,13 +692,13 @@ impl GlintNdf for BinMap {
         let alpha = options.smoothing_alpha;
         let alpha = (alpha.is_finite() && alpha > 0.0)
             .then(|| alpha.clamp(crate::ndf::MIN_ALPHA, crate::ndf::MAX_ALPHA));
-        BinMapPatch::new(
-            self,
-            footprint,
-            alpha,
-            options.exact_masking_texels,
-            scratch,
-        )
+        let limit = options.exact_masking_texels;
+        let limit = if limit.is_nan() {
+            MIN_MOMENT_MASKING_TEXELS
+        } else {
+            limit.max(MIN_MOMENT_MASKING_TEXELS)
+        };
+        BinMapPatch::new(self, footprint, alpha, limit, scratch)
     }
 }
 
