@@ -2,7 +2,7 @@
 //! default build and per-query options and for an analytic GGX material: `Material::bsdf` with a
 //! `GlintScratch` (the patch), `eval_pdf` toward two directions and one `sample`, all at one wo.
 //! 512² `scratched` map, gold Fresnel; 32 shading points at fixed random uv and directions per
-//! iteration (throughput: shading points). The measuring example `shading_cost` charts the same
+//! iteration (throughput: shading points), the inputs and calls of examples/common/shading_points.rs. The measuring example `shading_cost` charts the same
 //! loop with the error of each patch (docs/results.md, "Cost and error of a shading point against
 //! footprint").
 //!
@@ -11,48 +11,19 @@
 
 use brdf::fresnel::ConductorFresnel;
 use brdf::glint::{
-    BeckmannMixture, BinMap, Footprint, GlintModel, GlintScratch, PositionNormalMap,
-    ScratchedParams, scratched,
+    BeckmannMixture, BinMap, GlintModel, GlintScratch, PositionNormalMap, ScratchedParams,
+    scratched,
 };
 use brdf::material::{GlintMaterial, Material};
 use brdf::ndf::Ggx;
-use brdf::{Bxdf, Vec2, Vec3};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use rand::{Rng, RngExt, SeedableRng};
-use std::hint::black_box;
 use std::sync::Arc;
 
 const SIZE: usize = 512;
 const POINTS: usize = 32;
 
-/// One shading point's inputs.
-struct Point {
-    uv: Vec2,
-    wo: Vec3,
-    wi: [Vec3; 2],
-    uc: f32,
-    u: Vec2,
-}
-
-fn upper(rng: &mut impl Rng, min_z: f32) -> Vec3 {
-    let z = min_z + (1.0 - min_z) * rng.random::<f32>();
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = std::f32::consts::TAU * rng.random::<f32>();
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
-}
-
-fn points() -> Vec<Point> {
-    let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
-    (0..POINTS)
-        .map(|_| Point {
-            uv: Vec2::new(rng.random(), rng.random()),
-            wo: upper(&mut rng, 0.2),
-            wi: [upper(&mut rng, 0.05), upper(&mut rng, 0.05)],
-            uc: rng.random(),
-            u: Vec2::new(rng.random(), rng.random()),
-        })
-        .collect()
-}
+#[path = "../examples/common/shading_points.rs"]
+mod shading_points;
 
 fn shading_point(c: &mut Criterion) {
     let map = scratched(SIZE, SIZE, ScratchedParams::default(), 7).unwrap();
@@ -80,7 +51,7 @@ fn shading_point(c: &mut Criterion) {
             ),
         ),
     ];
-    let pts = points();
+    let pts = shading_points::points(POINTS, 11);
     let scratch = GlintScratch::default();
     for (name, material) in &materials {
         let mut g = c.benchmark_group(format!("shading_point/{name}"));
@@ -89,11 +60,7 @@ fn shading_point(c: &mut Criterion) {
             g.bench_with_input(BenchmarkId::from_parameter(area), &area, |b, &area| {
                 b.iter(|| {
                     for p in &pts {
-                        let fp = Footprint::isotropic_texels(p.uv, area, SIZE, SIZE);
-                        let bsdf = material.bsdf(&fp, &scratch);
-                        black_box(bsdf.eval_pdf(p.wo, p.wi[0]));
-                        black_box(bsdf.eval_pdf(p.wo, p.wi[1]));
-                        black_box(bsdf.sample(p.wo, p.uc, p.u));
+                        shading_points::shade(material, p, area, SIZE, &scratch);
                     }
                 })
             });

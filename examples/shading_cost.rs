@@ -16,6 +16,7 @@
 
 mod common;
 
+use brdf::Vec2;
 use brdf::fresnel::ConductorFresnel;
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::MixtureParams;
@@ -26,54 +27,19 @@ use brdf::glint::{
 };
 use brdf::material::{GlintMaterial, Material};
 use brdf::ndf::Ggx;
-use brdf::{Bxdf, Vec2, Vec3};
 use common::Res;
 use common::material::{SIGMA_EPS, binmap_options};
-use rand::{RngExt, SeedableRng};
+use common::shading_points::{Point, points, shade};
 use std::fmt::Write as _;
-use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Instant;
-
-/// One shading point's inputs.
-struct Point {
-    uv: Vec2,
-    wo: Vec3,
-    wi: [Vec3; 2],
-    uc: f32,
-    u: Vec2,
-}
-
-fn upper(rng: &mut impl rand::Rng, min_z: f32) -> Vec3 {
-    let z = min_z + (1.0 - min_z) * rng.random::<f32>();
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = std::f32::consts::TAU * rng.random::<f32>();
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
-}
-
-fn points(n: usize, seed: u64) -> Vec<Point> {
-    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-    (0..n)
-        .map(|_| Point {
-            uv: Vec2::new(rng.random(), rng.random()),
-            wo: upper(&mut rng, 0.2),
-            wi: [upper(&mut rng, 0.05), upper(&mut rng, 0.05)],
-            uc: rng.random(),
-            u: Vec2::new(rng.random(), rng.random()),
-        })
-        .collect()
-}
 
 /// Seconds per shading point of `material` at footprints of `area` texels on a `size`² map.
 fn time_per_point(material: &Material, pts: &[Point], area: f32, size: usize) -> f64 {
     let scratch = GlintScratch::default();
     let t = Instant::now();
     for p in pts {
-        let fp = Footprint::isotropic_texels(p.uv, area, size, size);
-        let b = material.bsdf(&fp, &scratch);
-        black_box(b.eval_pdf(p.wo, p.wi[0]));
-        black_box(b.eval_pdf(p.wo, p.wi[1]));
-        black_box(b.sample(p.wo, p.uc, p.u));
+        shade(material, p, area, size, &scratch);
     }
     t.elapsed().as_secs_f64() / pts.len() as f64
 }

@@ -17,6 +17,7 @@ pub mod orb;
 pub mod orb_curves;
 pub mod pndf_images;
 pub mod render;
+pub mod shading_points;
 
 use plotters::prelude::*;
 use std::error::Error;
