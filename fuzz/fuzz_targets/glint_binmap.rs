@@ -21,6 +21,8 @@ struct Input {
     hashed: bool,
     sigma_min: f32,
     smoothing_alpha: f32,
+    /// The masking level of detail: any value (NaN, negative, huge) must give a total patch.
+    exact_masking_texels: f32,
     footprint: FootprintInput,
     probe: Probe,
 }
@@ -49,6 +51,7 @@ fuzz_target!(|input: Input| {
         &footprint,
         &brdf::glint::binmap::PatchOptions {
             smoothing_alpha: input.smoothing_alpha,
+            exact_masking_texels: input.exact_masking_texels,
         },
         None,
     );

@@ -27,6 +27,7 @@ fuzz_target!(|data: &[u8]| {
                 &footprint,
                 &brdf::glint::binmap::PatchOptions {
                     smoothing_alpha: 0.1,
+                    ..Default::default()
                 },
                 None,
             ),
