@@ -9,11 +9,11 @@ use brdf::fresnel::NoFresnel;
 use brdf::glint::binmap::{
     BinMapParams, DEFAULT_EXACT_MASKING_TEXELS, MIN_MOMENT_MASKING_TEXELS, PatchOptions,
 };
-use brdf::glint::{BinMap, Footprint, GlintNdf, NormalMap};
+use brdf::glint::{BinMap, Footprint, GlintNdf};
 use brdf::ndf::Ndf;
 use brdf::{MicrofacetBrdf, Vec2, Vec3};
 use std::time::Instant;
-use support::albedo;
+use support::{albedo, procedural_maps};
 
 /// The view at θo (degrees), azimuth 30°.
 fn view(theta_deg: f32) -> Vec3 {
@@ -35,25 +35,6 @@ fn measure(bm: &BinMap, fp: &Footprint, opts: &PatchOptions, wo: Vec3, n: usize)
     let (a, se) = albedo(&MicrofacetBrdf::new(&patch, NoFresnel), wo, n);
     let g1 = 1.0 / (1.0 + patch.lambda(wo) as f64);
     [a, se, g1]
-}
-
-fn maps(size: usize) -> Vec<(&'static str, NormalMap)> {
-    use brdf::glint::{FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched};
-    vec![
-        ("bumpy", bumpy(size, size, 0.25, 4.0, 1).unwrap()),
-        (
-            "brushed",
-            brushed(size, size, Default::default(), 2).unwrap(),
-        ),
-        (
-            "scratched",
-            scratched(size, size, ScratchedParams::default(), 3).unwrap(),
-        ),
-        (
-            "flakes",
-            flakes(size, size, FlakesParams::default(), 4).unwrap(),
-        ),
-    ]
 }
 
 /// Above the default limit the patch uses the moment lobe, at or below it its own bins; the limit
@@ -91,7 +72,7 @@ fn the_limit_chooses_the_masking_form() {
 #[test]
 fn the_moment_lobe_masking_stays_within_one_and_a_half_percent_of_the_furnace() {
     let n = 2048;
-    for (name, map) in maps(256) {
+    for (name, map) in procedural_maps(256) {
         let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
         for area in [160.0f32, 256.0, 1024.0, 4096.0] {
             let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.61), area, 256, 256);
@@ -120,7 +101,7 @@ fn masking_table() {
          patch_with bins / lobe |"
     );
     println!("|---|---|---|---|---|");
-    for (name, map) in maps(512) {
+    for (name, map) in procedural_maps(512) {
         let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
         for area in [16.0f32, 64.0, 256.0, 1024.0, 4096.0] {
             let centres = [Vec2::new(0.37, 0.61), Vec2::new(0.71, 0.23)];
