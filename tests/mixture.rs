@@ -6,7 +6,7 @@
 
 mod support;
 
-use brdf::glint::mixture::{MaskingMode, MixtureParams, MomentMethod, PatchOptions};
+use brdf::glint::mixture::{MaskingMode, MixtureParams, MomentMethod, PatchOptions, SeedKernel};
 use brdf::glint::{self, BeckmannMixture, Footprint, GlintNdf, MixturePatch, NormalMap};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
@@ -79,9 +79,9 @@ fn hierarchy_d_equals_the_brute_force_sum() {
 }
 
 /// P22 of one lobe at slope s in f64 from its public mean and Cholesky factor (L⁻¹ by substitution),
-/// and whether s lies in the lobe's slope box |s − μ| ≤ k (√Σxx, √Σyy), with the box's margin
-/// (|d|/half-width − 1, the smaller of the two axes' in absolute value).
-fn p22_f64(g: &brdf::ndf::SlopeGaussian, s: [f64; 2], k: f64) -> (f64, bool, f64) {
+/// whether s lies in the lobe's slope box |s − μ| ≤ k (√Σxx, √Σyy), with the box's margin
+/// (|d|/half-width − 1, the smaller of the two axes' in absolute value), and the exponent ½ |z|².
+fn p22_f64(g: &brdf::ndf::SlopeGaussian, s: [f64; 2], k: f64) -> (f64, bool, f64, f64) {
     let (mu, l) = (g.mean(), g.cholesky());
     let (l11, l21, l22) = (l.x_axis.x as f64, l.x_axis.y as f64, l.y_axis.y as f64);
     let (dx, dy) = (s[0] - mu.x as f64, s[1] - mu.y as f64);
@@ -91,7 +91,7 @@ fn p22_f64(g: &brdf::ndf::SlopeGaussian, s: [f64; 2], k: f64) -> (f64, bool, f64
     let (hx, hy) = (k * l11, k * (l21 * l21 + l22 * l22).sqrt());
     let inside = dx.abs() <= hx && dy.abs() <= hy;
     let margin = (dx.abs() / hx - 1.0).abs().min((dy.abs() / hy - 1.0).abs());
-    (p, inside, margin)
+    (p, inside, margin, 0.5 * (zx * zx + zy * zy))
 }
 
 proptest::proptest! {
@@ -100,7 +100,8 @@ proptest::proptest! {
     /// D_P by the lobe blocks (f32 lanes, polynomial exp) = Σ W_i P22_i(s) (1 + |s|²)² summed here
     /// in f64 over the patch's public (W_i, lobe_i), with the same slope-box truncation, to 1e-5
     /// relative. Lobes within 1e-4 (relative) of their box's edge may fall either side in f32: their
-    /// contributions are added to the allowance. Slopes: the patch's own samples (where D_P is
+    /// contributions are added to the allowance, and so is the f32 rounding of each lobe's exponent
+    /// (relative 8 ε ½|z|² of its term). Slopes: the patch's own samples (where D_P is
     /// large) and uniform in [−1.2, 1.2]² (tails, empty regions); footprints from sub-texel to
     /// twice the map (folded axes), anisotropic, anywhere (wrapping).
     #[test]
@@ -124,9 +125,13 @@ proptest::proptest! {
         let k = mix.box_sigmas() as f64;
         let (mut reference, mut edge) = (0.0f64, 0.0f64);
         for (w, g) in patch.weighted_lobes() {
-            let (p, inside, margin) = p22_f64(&g, s, k);
+            let (p, inside, margin, e) = p22_f64(&g, s, k);
             if inside {
                 reference += w as f64 * p;
+                // The lanes form the exponent e = ½ |z|² in f32: its rounding (a few ulp of e,
+                // 8 ε e here) is a relative error of as much in exp(−e), which exceeds 1e-5 in the
+                // far tail (e ≳ 10; the 5.26σ box reaches e ≈ 28 at its corners).
+                edge += w as f64 * p * 8.0 * f32::EPSILON as f64 * e;
             }
             if margin < 1e-4 {
                 edge += w as f64 * p;
@@ -141,6 +146,52 @@ proptest::proptest! {
             (d - reference).abs() <= 1e-5 * reference + edge + 1e-37,
             "{name}: D {d} vs f64 sum {reference} (edge allowance {edge})"
         );
+    }
+}
+
+/// The default seed kernel resolves by spacing (the cell from one texel up, the Gaussian below), the
+/// built mixture names the kernel it used, and the two kernels place their lobes where their docs
+/// say: on a map whose slope is linear in x, a lobe's mean x̃ is the slope at its centre.
+#[test]
+fn seed_kernel_resolves_by_spacing_and_places_the_lobes() {
+    assert_eq!(SeedKernel::Auto.resolve(1.0), SeedKernel::Cell);
+    assert_eq!(SeedKernel::Auto.resolve(2.0), SeedKernel::Cell);
+    assert_eq!(SeedKernel::Auto.resolve(0.5), SeedKernel::Gaussian);
+    assert_eq!(SeedKernel::Gaussian.resolve(1.0), SeedKernel::Gaussian);
+    assert_eq!(SeedKernel::Cell.resolve(0.25), SeedKernel::Cell);
+    // Slope x̃ = a (x − 8) over x in [4, 12] texels (texel i at i + ½), flat in y; lobes away
+    // from the ends see a linear field, so their mean is the slope at their centre.
+    let (n, a) = (16usize, 0.02f32);
+    let slopes = (0..n * n)
+        .map(|k| {
+            let x = (k % n) as f32 + 0.5;
+            Vec2::new(a * (x.clamp(4.0, 12.0) - 8.0), 0.0)
+        })
+        .collect();
+    let map = NormalMap::from_slopes(n, n, slopes).unwrap();
+    for (spacing, want) in [(1.0, SeedKernel::Cell), (0.5, SeedKernel::Gaussian)] {
+        let params = MixtureParams {
+            spacing,
+            ..MixtureParams::default()
+        };
+        assert_eq!(params.seed, SeedKernel::Auto);
+        let mix = BeckmannMixture::build(&map, params).unwrap();
+        assert_eq!(mix.params().seed, want);
+        let h = spacing as f64;
+        let lobes = (n as f64 / h) as i64;
+        for i in 0..lobes {
+            let x = (i as f64 + 0.5) * h + want.origin();
+            if !(6.0..=10.0).contains(&x) {
+                continue;
+            }
+            let m = mix.lobe(i, 3).mean();
+            // The bilinear blend of unit normals divided by its z is not exactly linear in x̃ (the
+            // normals' lengths differ by O(a²)): 1e-5 covers it at a = 0.02 and 4 texels.
+            assert!(
+                (m.x as f64 - a as f64 * (x - 8.0)).abs() < 1e-5,
+                "spacing {spacing}, lobe {i} at {x}: mean {m}"
+            );
+        }
     }
 }
 

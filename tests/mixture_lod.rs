@@ -355,14 +355,19 @@ fn lod_diagnose() {
 }
 
 /// The node weights W'_n of a level-l patch, written out here as docs/mixture.md states them (not
-/// through the patch code): the Gaussian of covariance (Σ_P + (σ_k² + (4^l − 1)/12) I) / 4^l at the
-/// node centres (X + ½, Y + ½) in node units, over ±3 σ per axis of it (`weight_sigmas`),
-/// normalised; keyed by unwrapped node index.
+/// through the patch code): the Gaussian of covariance (Σ_P + (σ_k² + (4^l − 1)/12) I) / 4^l (σ_k²
+/// the seed kernel's weight variance) at the node centres (X + ½, Y + ½) in node units (lobe units
+/// counted from the seed's origin), over ±3 σ per axis of it (`weight_sigmas`), normalised; keyed
+/// by unwrapped node index.
 fn own_node_weights(mix: &BeckmannMixture, fp: &Footprint, l: u32) -> Vec<((i64, i64), f64)> {
     let (nx, ny) = mix.grid();
+    // Lobe units are texels here (spacing 1); lobe i sits at i + ½ + the seed's origin.
+    assert_eq!(mix.spacing(), (1.0, 1.0));
     let (c, s) = fp.gaussian_texels(nx, ny);
+    let seed = mix.params().seed;
+    let c = c - Vec2::splat(seed.origin() as f32);
     let n2 = 4f64.powi(l as i32);
-    let k2 = (1.0 / (2.0 * (2.0 * std::f64::consts::LN_2).sqrt())).powi(2) + (n2 - 1.0) / 12.0;
+    let k2 = seed.weight_variance() + (n2 - 1.0) / 12.0;
     let (a, b, d) = (
         (s.x_axis.x as f64 + k2) / n2,
         s.x_axis.y as f64 / n2,

@@ -14,7 +14,10 @@ use brdf::{MicrofacetBrdf, Vec2, Vec3};
 use support::mixture::*;
 
 /// Σ_i W_i ∫ g(s) P22_i(s) ds, each lobe integrated in its whitened coordinates s = μ + L z on
-/// z ∈ [−7, 7]² with step 0.5 (and 1.0 for the error estimate), P22_i from the lobe.
+/// z ∈ [−7, 7]² with step 0.25 (and 0.5 for the error estimate), P22_i from the lobe. The step is
+/// that fine because g may have a kink (⟨w, m⟩⁺) inside a lobe, where the trapezoid rule is only
+/// O(step²) and the two-step estimate can fall short of the error when the kink's position against
+/// the grid happens to favour the coarse rule.
 fn integrate_per_lobe(patch: &MixturePatch, g: &dyn Fn([f64; 2]) -> f64) -> (f64, f64) {
     let (mut fine, mut coarse) = (0.0, 0.0);
     for (w, lobe) in patch.weighted_lobes() {
@@ -22,9 +25,9 @@ fn integrate_per_lobe(patch: &MixturePatch, g: &dyn Fn([f64; 2]) -> f64) -> (f64
         let (l11, l21, l22) = (l.x_axis.x as f64, l.x_axis.y as f64, l.y_axis.y as f64);
         let mu = lobe.mean();
         let (mut f, mut c) = (0.0, 0.0);
-        for j in -14i32..=14 {
-            for i in -14i32..=14 {
-                let (zx, zy) = (i as f64 * 0.5, j as f64 * 0.5);
+        for j in -28i32..=28 {
+            for i in -28i32..=28 {
+                let (zx, zy) = (i as f64 * 0.25, j as f64 * 0.25);
                 let s = [mu.x as f64 + l11 * zx, mu.y as f64 + l21 * zx + l22 * zy];
                 let p = lobe.p22(Vec2::new(s[0] as f32, s[1] as f32)) as f64 * l11 * l22;
                 let v = g(s) * p;
@@ -34,8 +37,8 @@ fn integrate_per_lobe(patch: &MixturePatch, g: &dyn Fn([f64; 2]) -> f64) -> (f64
                 }
             }
         }
-        fine += w as f64 * f * 0.25;
-        coarse += w as f64 * c;
+        fine += w as f64 * f * 0.0625;
+        coarse += w as f64 * c * 0.25;
     }
     (fine, (fine - coarse).abs())
 }

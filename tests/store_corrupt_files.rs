@@ -11,8 +11,8 @@ use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{BeckmannMixture, BinMap, NormalMap, PositionNormalMap};
 use support::format::reseal;
 use support::store::{
-    as_version_2, at, load_mixture, map, mixture_as_version_3, position_normal_as_version_3, saved,
-    small_compact_file, small_mixture_file,
+    as_version_2, at, load_mixture, map, mixture_as_version_3, mixture_as_version_4,
+    position_normal_as_version_3, saved, small_compact_file, small_mixture_file,
 };
 
 #[test]
@@ -28,14 +28,16 @@ fn every_truncation_is_an_error() {
     }
 }
 
-/// A version-4 file of `kind` (of [`small_files`]) as format `version` (2 or 3) wrote it: the
-/// patch options that the mixtures and the position-normal map stored then (at their defaults), and
-/// for a full mixture of version 2 no merge errors.
+/// A version-5 file of `kind` (of [`small_files`]) as format `version` (2, 3 or 4) wrote it: no
+/// seed kernel in the mixtures; in versions 2 and 3 the patch options that the mixtures and the
+/// position-normal map stored then (at their defaults), and for a full mixture of version 2 no merge
+/// errors.
 fn as_version(kind: &str, file: &[u8], version: u32) -> Vec<u8> {
     let mut f = match (kind, version) {
+        ("mixture" | "compact mixture", 4) => return mixture_as_version_4(file),
         ("mixture", 2) => return as_version_2(file),
         ("mixture" | "compact mixture", _) => mixture_as_version_3(file, 0, 16384.0),
-        ("position-normal", _) => position_normal_as_version_3(file, 128.0),
+        ("position-normal", 2 | 3) => position_normal_as_version_3(file, 128.0),
         _ => file.to_vec(),
     };
     f[8..12].copy_from_slice(&version.to_le_bytes());
@@ -83,7 +85,15 @@ fn every_flipped_byte_is_an_error() {
                 let e = load(&f).unwrap_err();
                 let expected = match k {
                     0..8 => matches!(e, Error::BadMagic { .. }),
-                    // No flip of these masks turns version 4 into a version still read (2 or 3).
+                    // Of these masks only 0x01 on the low byte turns version 5 into one still read
+                    // (4): then the payload, read in the older layout, is refused or fails its
+                    // checksum (the header is checksummed).
+                    8 if mask == 0x01 => matches!(
+                        e,
+                        Error::InvalidFile { .. }
+                            | Error::ChecksumMismatch { .. }
+                            | Error::Truncated { .. }
+                    ),
                     8..12 => matches!(e, Error::UnsupportedVersion { .. }),
                     12..16 => matches!(e, Error::WrongModelKind { .. }),
                     // The payload length: too long leaves bytes over or runs out; too short cuts a
@@ -112,24 +122,25 @@ fn header_errors_name_what_is_wrong() {
     let e = load_mixture(&f).unwrap_err();
     assert!(e.to_string().contains("BRDFGLNT"), "{e}");
     let mut f = file.clone();
-    f[8..12].copy_from_slice(&5u32.to_le_bytes());
+    f[8..12].copy_from_slice(&6u32.to_le_bytes());
     let e = load_mixture(&reseal(f)).unwrap_err();
     assert!(
         matches!(
             e,
             Error::UnsupportedVersion {
-                found: 5,
-                supported: 4
+                found: 6,
+                supported: 5
             }
         ),
         "{e}"
     );
-    // Format versions 2 and 3 are still read for every kind but the bin map (which gained 𝓑 in
+    // Format versions 2 to 4 are still read for every kind but the bin map (which gained 𝓑 in
     // version 3, and is read from version 3 on; the full mixture gained its merge errors in version
     // 3, recomputed when absent; versions 2 and 3 of the mixtures and the position-normal map store
-    // patch options, read and ignored); older versions are not.
+    // patch options, read and ignored; mixtures before version 5 are Gaussian-seeded); older
+    // versions are not.
     for (kind, file, load) in small_files() {
-        for version in [2u32, 3] {
+        for version in [2u32, 3, 4] {
             let old = as_version(kind, &file, version);
             let r = load(&old);
             if kind == "bin map" && version == 2 {
@@ -138,7 +149,7 @@ fn header_errors_name_what_is_wrong() {
                         r,
                         Err(Error::UnsupportedVersion {
                             found: 2,
-                            supported: 4
+                            supported: 5
                         })
                     ),
                     "{kind}: {r:?}"

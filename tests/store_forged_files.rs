@@ -170,16 +170,16 @@ fn inconsistent_bin_maps_are_errors() {
 }
 
 /// Offsets in the compact mixture file of a 6² map (docs/format.md, kind 5; lobe grid 6², levels of
-/// detail 6² and 3²; format version 4): the parameters as kind 2 up to 68, level count 68; level 0:
-/// frame count 76, 4 frames 84..148, block count 148, 4 blocks 156..796, error count 796 (0); level
-/// 1: frame count 804, 1 frame 812..828, block count 828, 1 block 836..996, error count 996, 9 codes
-/// 1004..1013.
+/// detail 6² and 3²; format version 5): the parameters as kind 2 up to 72, level count 72; level 0:
+/// frame count 80, 4 frames 88..152, block count 152, 4 blocks 160..800, error count 800 (0); level
+/// 1: frame count 808, 1 frame 816..832, block count 832, 1 block 840..1000, error count 1000, 9
+/// codes 1008..1017.
 mod compact_at {
-    pub const LEVELS: usize = 68;
-    pub const FRAME0: usize = 84;
-    pub const BLOCK0: usize = 156;
-    pub const ERROR_COUNT1: usize = 996;
-    pub const END: usize = 1013;
+    pub const LEVELS: usize = 72;
+    pub const FRAME0: usize = 88;
+    pub const BLOCK0: usize = 160;
+    pub const ERROR_COUNT1: usize = 1000;
+    pub const END: usize = 1017;
 }
 
 /// Compact files whose checksums are valid but whose contents no build writes: each an
@@ -326,6 +326,15 @@ fn inconsistent_contents_with_valid_checksums_are_errors() {
                 f
             },
             "spacing",
+        ),
+        (
+            "unknown seed kernel",
+            {
+                let mut f = file.clone();
+                set(&mut f, at::SEED, &2u32.to_le_bytes());
+                f
+            },
+            "seed kernel",
         ),
         (
             "NaN moment",

@@ -4,10 +4,12 @@
 mod support;
 
 use brdf::glint::binmap::BinMapParams;
-use brdf::glint::mixture::{LobeStorage, MixtureParams};
+use brdf::glint::mixture::{LobeStorage, MixtureParams, SeedKernel};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{BeckmannMixture, BinMap, PositionNormalMap};
-use support::store::{map, mixture_as_version_3, position_normal_as_version_3, saved};
+use support::store::{
+    map, mixture_as_version_3, mixture_as_version_4, position_normal_as_version_3, saved,
+};
 
 /// Writes the seed files of the store fuzz targets (small valid files of each kind):
 /// `cargo test --test store_fuzz_seeds -- --ignored`.
@@ -31,11 +33,29 @@ fn write_fuzz_seeds() {
             ..MixtureParams::default()
         };
         let mx = BeckmannMixture::build(&m, params).unwrap();
-        let file = saved(|w| mx.save(w));
-        // The same file as format version 3 wrote it (with patch options, read and ignored).
-        let v3 = mixture_as_version_3(&file, 1, 256.0);
-        write("store_mixture", &format!("mixture{n}"), file);
-        write("store_mixture", &format!("mixture{n}_v3"), v3);
+        write(
+            "store_mixture",
+            &format!("mixture{n}"),
+            saved(|w| mx.save(w)),
+        );
+        // A Gaussian-seeded one, also as format versions 4 (no seed kernel) and 3 (with patch
+        // options, read and ignored) wrote it.
+        let gauss = MixtureParams {
+            seed: SeedKernel::Gaussian,
+            ..params
+        };
+        let file = saved(|w| BeckmannMixture::build(&m, gauss).unwrap().save(w));
+        write(
+            "store_mixture",
+            &format!("mixture{n}_v4"),
+            mixture_as_version_4(&file),
+        );
+        write(
+            "store_mixture",
+            &format!("mixture{n}_v3"),
+            mixture_as_version_3(&file, 1, 256.0),
+        );
+        write("store_mixture", &format!("mixture{n}_gaussian"), file);
         // Compact storage (model kind 5): 1², 3² (no level-2 node: the single block's own frame)
         // and 8² (frames from the quadtree's level 2).
         for k in [n, n + 5] {

@@ -57,15 +57,15 @@ fn lying_sizes_allocate_no_more_than_the_file_holds() {
         .unwrap()
         .save(&mut file)
         .unwrap();
-    // Format version 4 (docs/format.md: lobe count at 68, lobes at 76). Declare a 40000² map (1.6·10⁹
+    // Format version 5 (docs/format.md: lobe count at 72, lobes at 80). Declare a 40000² map (1.6·10⁹
     // lobes, 32 GB) and a payload that claims it all; keep 1 MiB of
     // real lobe data (zeros are valid moments) so that the loader reads some before running out.
     file[24..32].copy_from_slice(&40000u64.to_le_bytes());
     file[32..40].copy_from_slice(&40000u64.to_le_bytes());
-    file[68..76].copy_from_slice(&1_600_000_000u64.to_le_bytes());
-    file[16..24].copy_from_slice(&(52 + 32_000_000_000u64).to_le_bytes());
-    file.truncate(76);
-    file.resize(76 + (1 << 20) + 8, 0);
+    file[72..80].copy_from_slice(&1_600_000_000u64.to_le_bytes());
+    file[16..24].copy_from_slice(&(56 + 32_000_000_000u64).to_le_bytes());
+    file.truncate(80);
+    file.resize(80 + (1 << 20) + 8, 0);
     let file = reseal(file);
     let (r, peak) = peak_during(|| BeckmannMixture::load(&mut file.as_slice()));
     assert!(
@@ -93,11 +93,11 @@ fn lying_sizes_allocate_no_more_than_the_file_holds() {
     file[24..32].copy_from_slice(&32768u64.to_le_bytes());
     file[32..40].copy_from_slice(&32768u64.to_le_bytes());
     // Levels 32768², 16384², …, 1²: 16.
-    file[68..76].copy_from_slice(&16u64.to_le_bytes());
-    file[76..84].copy_from_slice(&(8192u64 * 8192).to_le_bytes());
-    file[16..24].copy_from_slice(&(60 + 12_000_000_000u64).to_le_bytes());
-    file.truncate(84);
-    file.resize(84 + (1 << 20) + 8, 0);
+    file[72..80].copy_from_slice(&16u64.to_le_bytes());
+    file[80..88].copy_from_slice(&(8192u64 * 8192).to_le_bytes());
+    file[16..24].copy_from_slice(&(64 + 12_000_000_000u64).to_le_bytes());
+    file.truncate(88);
+    file.resize(88 + (1 << 20) + 8, 0);
     let file = reseal(file);
     let (r, peak) = peak_during(|| BeckmannMixture::load(&mut file.as_slice()));
     assert!(

@@ -3,7 +3,7 @@
 #![no_main]
 
 use arbitrary::Arbitrary;
-use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams, PatchOptions, SeedKernel};
 use brdf::glint::{BeckmannMixture, GlintNdf};
 use brdf::{MicrofacetBrdf, fresnel::NoFresnel};
 use brdf_fuzz::{FootprintInput, MapInput, Probe, check_bxdf, check_ndf};
@@ -17,6 +17,7 @@ struct Input {
     samples: u8,
     approximate: bool,
     compact: bool,
+    gaussian_seed: bool,
     lod_lobes: f32,
     footprint: FootprintInput,
     probe: Probe,
@@ -32,6 +33,11 @@ fuzz_target!(|input: Input| {
             LobeStorage::Compact
         } else {
             LobeStorage::Full
+        },
+        seed: if input.gaussian_seed {
+            SeedKernel::Gaussian
+        } else {
+            SeedKernel::Cell
         },
         ..MixtureParams::default()
     };

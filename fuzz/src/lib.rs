@@ -112,12 +112,12 @@ pub fn format_checksum(bytes: &[u8]) -> u64 {
 }
 
 /// The format version the crate writes (bytes 8..12 of every file it saves).
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 
 /// A model loaded from `bytes`, saved again: a file of the current format version must come back
 /// byte for byte (trailing bytes after it are not read); an older one the loader accepted (format
-/// version 3, or 2 for every kind but the bin map) must come back as a current file that loads and
-/// saves to itself.
+/// versions 3 and 4, or 2 for every kind but the bin map) must come back as a current file that
+/// loads and saves to itself.
 pub fn check_resave<M>(
     bytes: &[u8],
     model: &M,
@@ -139,8 +139,8 @@ pub fn check_resave<M>(
         assert_eq!(&bytes[..again.len()], &again[..]);
     } else {
         assert!(
-            version == 2 || version == 3,
-            "only versions 2 and 3 are read besides the current one"
+            (2..=4).contains(&version),
+            "only versions 2 to 4 are read besides the current one"
         );
         assert_eq!(saved(&load(&again).unwrap()), again);
     }

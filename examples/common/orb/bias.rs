@@ -5,10 +5,10 @@
 //!
 //! The candidates: the level of detail (`lod_lobes` ∞, `lod_tolerance` 0: the full mixture), the
 //! masking terms (approximate instead of exact), `MixtureParams::samples` 256 instead of 64 (a
-//! control: the default moment method is the separable filter, which does not read it), the lobe
-//! spacing (0.5 texel instead of 1: twice as
-//! many lobe centres per axis, the proxy for the position kernel sampled at lobe centres rather than
-//! integrated over each texel), and the light: a disc light of angular radius
+//! control: the default moment method is the separable filter, which does not read it), the seed
+//! kernel (the paper's Gaussian on the texel centres instead of the default cell between them), the
+//! lobe spacing (0.5 texel instead of 1: twice as many lobe centres per axis, each lobe over a
+//! quarter of the area), and the light: a disc light of angular radius
 //! [`AREA_LIGHT_DEGREES`] seen from the sphere's centre, in the reference and the model alike, in
 //! place of the point light.
 
@@ -21,7 +21,7 @@ use crate::common::{Artifact, Res, register_font, save_rgb};
 use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf};
 use brdf::fresnel::Fresnel;
 use brdf::glint::binmap::BinMapParams;
-use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
+use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions, SeedKernel};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
     BeckmannMixture, BinMap, GlintModel, GlintNdf, Kernel, NormalMap, PositionNormalMap,
@@ -226,9 +226,20 @@ fn variants(map: &NormalMap) -> Res<Vec<Variant>> {
             ..base
         },
     )?;
+    let (gauss, gauss_s) = mixture(
+        map,
+        MixtureParams {
+            seed: SeedKernel::Gaussian,
+            ..base
+        },
+    )?;
+    // Every level of detail off (the full mixture at every footprint), as the curves' "mixture (no
+    // LOD)": no cap, no merged levels, no sub-texel lobe, no filtered mixture.
     let no_lod = PatchOptions {
         lod_lobes: f32::INFINITY,
         lod_tolerance: 0.0,
+        sub_texel_area: 0.0,
+        filtered_area: f32::INFINITY,
         ..PatchOptions::default()
     };
     let approx = PatchOptions {
@@ -267,12 +278,7 @@ fn variants(map: &NormalMap) -> Res<Vec<Variant>> {
     };
     Ok(vec![
         v("mixture", m.clone(), m_s, Light::Point),
-        v(
-            "(i) no LOD cap",
-            with_options(&m, no_lod),
-            m_s,
-            Light::Point,
-        ),
+        v("(i) no LOD", with_options(&m, no_lod), m_s, Light::Point),
         v(
             "(ii) approx. masking",
             with_options(&m, approx),
@@ -280,16 +286,17 @@ fn variants(map: &NormalMap) -> Res<Vec<Variant>> {
             Light::Point,
         ),
         v("256 nodes/lobe", m256, m256_s, Light::Point),
+        v("(iii) Gaussian seed", gauss, gauss_s, Light::Point),
         v("(iv) spacing 0.5", fine.clone(), fine_s, Light::Point),
         v(
-            "(iv) spacing 0.5 + no LOD cap",
+            "(iv) spacing 0.5 + no LOD",
             with_options(&fine, no_lod),
             fine_s,
             Light::Point,
         ),
         v("(v) disc light", m.clone(), m_s, Light::Disc),
         v(
-            "(v) disc light + no LOD cap",
+            "(v) disc light + no LOD",
             with_options(&m, no_lod),
             m_s,
             Light::Disc,
@@ -340,14 +347,14 @@ pub const MAPS: [&str; 5] = ["scratched", "brushed", "bumpy", "flakes", "fractal
 pub const SCALES: [f32; 2] = [2.0, 16.0];
 
 /// The lobe-spacing ladder (`orb -- --bias --spacing [--scales K,K,…]`): the mixture (default
-/// options) built at spacings 1, 0.5 and 0.25 texel, under the point light, on the five maps at each
+/// options) built at spacings 1, 0.5 and 0.25 texel with each seed kernel, under the point light, on the five maps at each
 /// map scale k of `scales` (tiles (2k, k); 0.35, 1, 2 give 1, 9, 34 texels per pixel); writes
 /// orb_bias_spacing.csv into `out`.
 pub fn run_spacing(out: &Path, scales: &[f32]) -> Res<()> {
     std::fs::create_dir_all(out)?;
     let wall = Instant::now();
     let mut csv = String::from(
-        "map,scale,spacing,build_s,render_s,rel_rmse_denoised,rel_rmse_denoised_vs_b,energy_error,reference_noise\n",
+        "map,scale,seed,spacing,build_s,render_s,rel_rmse_denoised,rel_rmse_denoised_vs_b,energy_error,reference_noise\n",
     );
     for name in MAPS {
         let orb = OrbOptions {
@@ -363,12 +370,16 @@ pub fn run_spacing(out: &Path, scales: &[f32]) -> Res<()> {
             let (a0, b0) = reference_half(&scene, &map, Light::Point, REFERENCE_K, orb.seed);
             let (a1, b1) = reference_half(&scene, &map, Light::Point, REFERENCE_K, orb.seed + 1);
             let noise_a = reference_noise(&a0, &a1, &mask);
-            for spacing in [1.0, 0.5, 0.25] {
+            for (seed, spacing) in [SeedKernel::Cell, SeedKernel::Gaussian]
+                .into_iter()
+                .flat_map(|k| [1.0, 0.5, 0.25].map(|h| (k, h)))
+            {
                 let (m, build_s) = mixture(
                     &map,
                     MixtureParams {
                         sigma_min: SIGMA_EPS,
                         spacing,
+                        seed,
                         ..MixtureParams::default()
                     },
                 )?;
@@ -379,7 +390,7 @@ pub fn run_spacing(out: &Path, scales: &[f32]) -> Res<()> {
                 let eb = errors(&img, &b0, &b1, &mask);
                 let _ = writeln!(
                     csv,
-                    "{name},{scale},{spacing},{build_s:.3},{render_s:.3},{:.4},{:.4},{:.4},{noise_a:.4}",
+                    "{name},{scale},{seed:?},{spacing},{build_s:.3},{render_s:.3},{:.4},{:.4},{:.4},{noise_a:.4}",
                     ea.rel_rmse_denoised, eb.rel_rmse_denoised, ea.energy
                 );
             }

@@ -1,12 +1,14 @@
-//! Per-lobe slope moments of the interpolated normal map under the Gaussian seed kernels k_i,
-//! integrated by quasi-Monte Carlo (\[Chermain2019\] eq. 5-6).
+//! Per-lobe slope moments of the interpolated normal map under the seed kernels k_i (the cell or
+//! the Gaussian, [`SeedKernel`]), integrated by quasi-Monte Carlo (\[Chermain2019\] eq. 5-6).
 //!
 //! Every lobe sees the same kernel shape, so the quadrature nodes are computed once: an R2
 //! low-discrepancy point set (Roberts 2018, the additive recurrence with the plastic number) in
-//! [0, 1)², mapped through the inverse cdf of a Gaussian truncated at ±T σ per axis. Each node then
-//! has weight 1/N, and E_i[f] ≈ (1/N) Σ_k f(ñ(u_i + d_k)), accumulated in `f64`.
+//! [0, 1)², mapped linearly onto the cell or through the inverse cdf of a Gaussian truncated at ±T σ
+//! per axis. Each node then has weight 1/N, and E_i[f] ≈ (1/N) Σ_k f(ñ(u_i + d_k)), accumulated in
+//! `f64`.
 
-use super::MixtureParams;
+use super::params::kernel_sigma;
+use super::{MixtureParams, SeedKernel};
 use crate::glint::NormalMap;
 use crate::ndf::gauss;
 use glam::Vec2;
@@ -15,12 +17,6 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The plastic number g (g³ = g + 1), generator of the R2 sequence.
 pub(super) const PLASTIC: f64 = 1.324_717_957_244_746;
-
-/// σ of the seed kernel for a spacing `h`: half of the peak at h/2, exp(−(h/2)²/(2σ²)) = ½, so
-/// σ = h / (2 √(2 ln 2)) ≈ 0.4247 h.
-pub(super) fn kernel_sigma(h: f64) -> f64 {
-    h / (2.0 * (2.0 * std::f64::consts::LN_2).sqrt())
-}
 
 /// The N quadrature offsets (texel units) of a Gaussian kernel of per-axis standard deviations
 /// `sigma`, truncated at ±`t` σ per axis.
@@ -33,6 +29,18 @@ pub(super) fn qmc_offsets(n: usize, sigma: [f64; 2], t: f64) -> Vec<Vec2> {
             let r = a.map(|ai| (0.5 + k as f64 * ai).fract());
             let z = r.map(|ri| gauss::inv_std_cdf(p_lo + ri * span));
             Vec2::new((z[0] * sigma[0]) as f32, (z[1] * sigma[1]) as f32)
+        })
+        .collect()
+}
+
+/// The N quadrature offsets (texel units) of the uniform density over a cell of `spacing` texels
+/// per axis: the R2 points of [`qmc_offsets`], mapped linearly onto [−h/2, h/2).
+pub(super) fn cell_offsets(n: usize, spacing: [f64; 2]) -> Vec<Vec2> {
+    let a = [1.0 / PLASTIC, 1.0 / (PLASTIC * PLASTIC)];
+    (0..n)
+        .map(|k| {
+            let r = a.map(|ai| (0.5 + k as f64 * ai).fract() - 0.5);
+            Vec2::new((r[0] * spacing[0]) as f32, (r[1] * spacing[1]) as f32)
         })
         .collect()
 }
@@ -65,14 +73,21 @@ pub(super) fn all_moments(
     progress: Option<&(dyn Fn(f32) + Sync)>,
 ) -> Vec<[f32; 5]> {
     let [nx, ny] = grid;
-    let sigma = spacing.map(kernel_sigma);
-    let offsets = qmc_offsets(params.samples, sigma, params.kernel_sigmas as f64);
+    let offsets = match params.seed {
+        SeedKernel::Gaussian => qmc_offsets(
+            params.samples,
+            spacing.map(kernel_sigma),
+            params.kernel_sigmas as f64,
+        ),
+        SeedKernel::Cell | SeedKernel::Auto => cell_offsets(params.samples, spacing),
+    };
+    let o = params.seed.origin();
     let done = AtomicUsize::new(0);
     let mut out = vec![[0.0f32; 5]; nx * ny];
     out.par_chunks_mut(nx).enumerate().for_each(|(j, row)| {
-        let y = ((j as f64 + 0.5) * spacing[1]) as f32;
+        let y = ((j as f64 + 0.5) * spacing[1] + o) as f32;
         for (i, m) in row.iter_mut().enumerate() {
-            let x = ((i as f64 + 0.5) * spacing[0]) as f32;
+            let x = ((i as f64 + 0.5) * spacing[0] + o) as f32;
             *m = lobe_moments(map, Vec2::new(x, y), &offsets);
         }
         if let Some(p) = progress {
@@ -92,6 +107,29 @@ mod tests {
         let s = kernel_sigma(1.0);
         // exp(−(½)²/(2σ²)) = ½ by definition; f64 rounding only.
         assert!(((-0.25 / (2.0 * s * s)).exp() - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn cell_offsets_have_the_cells_moments() {
+        // Uniform on [−h/2, h/2): mean 0, variance h²/12; R2 points are equidistributed, so 4096
+        // of them reproduce both to ~1/N (bound 1e-3, relative for the variance).
+        let h = [1.0, 0.5];
+        let o = cell_offsets(4096, h);
+        let n = o.len() as f64;
+        for (axis, &hk) in h.iter().enumerate() {
+            let v: Vec<f64> = o.iter().map(|d| d[axis] as f64).collect();
+            let m = v.iter().sum::<f64>() / n;
+            let var = v.iter().map(|x| x * x).sum::<f64>() / n - m * m;
+            assert!(m.abs() < 1e-3 * hk, "axis {axis}: mean {m}");
+            assert!(
+                (var / (hk * hk / 12.0) - 1.0).abs() < 1e-3,
+                "axis {axis}: var {var}"
+            );
+            assert!(
+                v.iter().all(|x| x.abs() <= 0.5 * hk),
+                "axis {axis}: outside the cell"
+            );
+        }
     }
 
     #[test]

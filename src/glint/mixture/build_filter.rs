@@ -19,6 +19,7 @@
 //! result does not depend on the thread count (every node row and every lobe's sums are computed
 //! the same way in a fixed order whichever band holds them).
 
+use super::SeedKernel;
 use crate::glint::NormalMap;
 use crate::ndf::gauss;
 use glam::Vec3;
@@ -61,21 +62,34 @@ fn gauss_moments(l: f64, r: f64, sigma: f64) -> [f64; 3] {
     ]
 }
 
+/// The moments [∫ 1, ∫ v, ∫ v²] over [l, r] (unnormalised: the weights are normalised per lobe).
+fn uniform_moments(l: f64, r: f64) -> [f64; 3] {
+    if r <= l {
+        return [0.0; 3];
+    }
+    [r - l, 0.5 * (r * r - l * l), (r * r * r - l * l * l) / 3.0]
+}
+
 impl AxisWeights {
-    /// Weights of `n` lobes at centres (i + ½)·`spacing`, kernel σ `sigma`, truncated at ±`t` σ,
-    /// `s` nodes per texel (a multiple of 4).
+    /// Weights of `n` lobes at centres (i + ½)·`spacing` + the seed's origin, `s` nodes per texel
+    /// (a multiple of 4): under [`SeedKernel::Gaussian`] a Gaussian of σ `sigma` truncated at ±`t` σ,
+    /// under [`SeedKernel::Cell`] the uniform density over the cell of width `spacing`.
     ///
     /// Product Simpson rule with exact kernel weights: the nodes are grouped in pairs of steps
     /// [x₂ₘ, x₂ₘ₊₂] (texel centres, at nodes S k + S/2, are even nodes, so no pair straddles a kink
-    /// of the bilinear interpolation), f is replaced on each pair by its quadratic interpolant, and
-    /// each Lagrange basis polynomial is integrated exactly against the truncated Gaussian.
-    fn new(n: usize, spacing: f64, sigma: f64, t: f64, s: usize) -> AxisWeights {
+    /// of the bilinear interpolation; the cells' edges, texel centres at integer 1/h, are even nodes
+    /// too), f is replaced on each pair by its quadratic interpolant, and each Lagrange basis
+    /// polynomial is integrated exactly against the kernel.
+    fn new(n: usize, spacing: f64, seed: SeedKernel, sigma: f64, t: f64, s: usize) -> AxisWeights {
         let step = 1.0 / s as f64;
-        let half = t * sigma;
+        let half = match seed {
+            SeedKernel::Cell | SeedKernel::Auto => 0.5 * spacing,
+            SeedKernel::Gaussian => t * sigma,
+        };
         // First and last node (both even) of the pairs that meet the support [c − half, c + half].
         let first = |c: f64| 2 * ((c - half) * s as f64 / 2.0).floor() as i64;
         let last = |c: f64| 2 * ((c + half) * s as f64 / 2.0).ceil() as i64;
-        let centre = |i: usize| (i as f64 + 0.5) * spacing;
+        let centre = |i: usize| (i as f64 + 0.5) * spacing + seed.origin();
         let len = (0..n)
             .map(|i| (last(centre(i)) - first(centre(i)) + 1) as usize)
             .max()
@@ -91,7 +105,11 @@ impl AxisWeights {
                 // Pair nodes relative to the centre: v0, v1 = v0 + step, v2 = v0 + 2 step.
                 let v0 = (a0 + 2 * m as i64) as f64 * step - c;
                 let (v1, v2) = (v0 + step, v0 + 2.0 * step);
-                let [m0, m1, m2] = gauss_moments(v0.max(-half), v2.min(half), sigma);
+                let (l, r) = (v0.max(-half), v2.min(half));
+                let [m0, m1, m2] = match seed {
+                    SeedKernel::Cell | SeedKernel::Auto => uniform_moments(l, r),
+                    SeedKernel::Gaussian => gauss_moments(l, r, sigma),
+                };
                 // ∫ (v − p)(v − q) N = m2 − (p + q) m1 + p q m0.
                 let quad = |p: f64, q: f64| m2 - (p + q) * m1 + p * q * m0;
                 let h2 = step * step;
@@ -99,8 +117,9 @@ impl AxisWeights {
                 wi[2 * m + 1] -= quad(v0, v2) / h2;
                 wi[2 * m + 2] += quad(v0, v1) / (2.0 * h2);
             }
-            // The basis polynomials sum to 1, so the sum is the truncated kernel's mass
-            // 1 − 2Φ(−t) up to rounding; dividing by it gives the truncated kernel's moments.
+            // The basis polynomials sum to 1, so the sum is the kernel's mass (1 − 2Φ(−t) for the
+            // truncated Gaussian, the cell's width) up to rounding; dividing by it gives the
+            // (truncated) kernel's moments.
             let z: f64 = wi.iter().sum();
             if z > 0.0 {
                 wi.iter_mut().for_each(|v| *v /= z);
@@ -123,21 +142,24 @@ impl AxisWeights {
 }
 
 /// All lobes' moments, row major over the `nx × ny` lobe grid, by the separable filter (see the
-/// module doc): kernel σ = `sigma` texels per axis, truncated at ±`t` σ, `supersampling` as in
-/// [`nodes_per_texel`]. `progress` gets the fraction of lobe rows done.
+/// module doc): the `seed` kernel (the cell, or a Gaussian of σ = 0.4247 × spacing per axis
+/// truncated at ±`t` σ), `supersampling` as in [`nodes_per_texel`]. `progress` gets the fraction
+/// of lobe rows done.
 pub(super) fn all_moments(
     map: &NormalMap,
     grid: [usize; 2],
     spacing: [f64; 2],
-    sigma: [f64; 2],
+    seed: SeedKernel,
     t: f64,
     supersampling: u32,
     progress: Option<&(dyn Fn(f32) + Sync)>,
 ) -> Vec<[f32; 5]> {
     let [nx, ny] = grid;
+    let sigma = spacing.map(super::params::kernel_sigma);
     let ax = AxisWeights::new(
         nx,
         spacing[0],
+        seed,
         sigma[0],
         t,
         nodes_per_texel(supersampling, spacing[0]),
@@ -145,6 +167,7 @@ pub(super) fn all_moments(
     let ay = AxisWeights::new(
         ny,
         spacing[1],
+        seed,
         sigma[1],
         t,
         nodes_per_texel(supersampling, spacing[1]),
@@ -302,9 +325,9 @@ mod tests {
         // σ² (1 − 2 t φ(t) / (1 − 2 Φ(−t))); all to f64 rounding (~1e-15 per term, ≤ 40 terms,
         // centres up to 10 texels).
         for (h, t) in [(1.0, 3.0), (1.3, 3.0), (0.5, 2.0), (4.0, 5.0)] {
-            let sigma = super::super::build::kernel_sigma(h);
+            let sigma = super::super::params::kernel_sigma(h);
             let s = nodes_per_texel(4, h);
-            let a = AxisWeights::new(7, h, sigma, t, s);
+            let a = AxisWeights::new(7, h, SeedKernel::Gaussian, sigma, t, s);
             let var = sigma
                 * sigma
                 * (1.0 - 2.0 * t * gauss::std_pdf(t) / (1.0 - 2.0 * gauss::std_cdf(-t)));
@@ -340,7 +363,16 @@ mod tests {
                 (c * c + sigma * sigma) * cdf - sigma * (c + u) * pdf,
             ]
         };
-        let (lo, hi) = (c - t * sigma, c + t * sigma);
+        triangle_moments_with(anti, c - t * sigma, c + t * sigma)
+    }
+
+    /// [E[T], E[T²]] of the triangle wave under the uniform density on [lo, hi] (a cell).
+    fn triangle_moments_cell(lo: f64, hi: f64) -> [f64; 2] {
+        triangle_moments_with(|u: f64| [u, 0.5 * u * u, u * u * u / 3.0], lo, hi)
+    }
+
+    /// [E[T], E[T²]] over [lo, hi] of a kernel whose antiderivatives of 1, u, u² are `anti`.
+    fn triangle_moments_with(anti: impl Fn(f64) -> [f64; 3], lo: f64, hi: f64) -> [f64; 2] {
         let (mut e1, mut e2, mut z) = (0.0, 0.0, 0.0);
         let mut k = (lo - 0.5).floor() as i64;
         while (k as f64) + 0.5 < hi {
@@ -378,15 +410,28 @@ mod tests {
             .collect();
         let map = NormalMap::from_slopes(n, n, slopes).unwrap();
         let t = 3.0;
-        // Lobe spacings 1 (the default), 1.5 (centres between nodes) and 0.5 (finer grid).
-        for grid in [[12usize, 12], [8, 8], [24, 12]] {
+        // Lobe spacings 1 (the default), 1.5 (centres between nodes) and 0.5 (finer grid), both
+        // seed kernels (the cell's edges are even nodes at these spacings, so it is exact too).
+        for (seed, grid) in [SeedKernel::Gaussian, SeedKernel::Cell]
+            .into_iter()
+            .flat_map(|k| [[12usize, 12], [8, 8], [24, 12]].map(|g| (k, g)))
+        {
             let spacing = grid.map(|g| n as f64 / g as f64);
-            let sigma = spacing.map(super::super::build::kernel_sigma);
-            let m = all_moments(&map, grid, spacing, sigma, t, 4, None);
+            let sigma = spacing.map(super::super::params::kernel_sigma);
+            let m = all_moments(&map, grid, spacing, seed, t, 4, None);
+            let axis = |i: usize, h: f64, sigma: f64| {
+                let c = (i as f64 + 0.5) * h + seed.origin();
+                match seed {
+                    SeedKernel::Gaussian => triangle_moments(c, sigma, t),
+                    SeedKernel::Cell | SeedKernel::Auto => {
+                        triangle_moments_cell(c - 0.5 * h, c + 0.5 * h)
+                    }
+                }
+            };
             for j in 0..grid[1] {
                 for i in 0..grid[0] {
-                    let tx = triangle_moments((i as f64 + 0.5) * spacing[0], sigma[0], t);
-                    let ty = triangle_moments((j as f64 + 0.5) * spacing[1], sigma[1], t);
+                    let tx = axis(i, spacing[0], sigma[0]);
+                    let ty = axis(j, spacing[1], sigma[1]);
                     let (a, b) = (a as f64, b as f64);
                     let want = [
                         a * tx[0],
@@ -399,7 +444,7 @@ mod tests {
                     for c in 0..5 {
                         assert!(
                             (got[c] as f64 - want[c]).abs() < 1e-6,
-                            "grid {grid:?} lobe ({i}, {j}) moment {c}: {} vs {}",
+                            "{seed:?} grid {grid:?} lobe ({i}, {j}) moment {c}: {} vs {}",
                             got[c],
                             want[c]
                         );
@@ -453,7 +498,8 @@ mod tests {
         stride: usize,
         supersampling: &[u32],
     ) -> Vec<(&'static str, Vec<(f64, f64)>)> {
-        use super::super::build::{kernel_sigma, lobe_moments, qmc_offsets};
+        use super::super::build::{lobe_moments, qmc_offsets};
+        use super::super::params::kernel_sigma;
         let t = 3.0;
         let sigma = kernel_sigma(1.0);
         let fine = qmc_offsets(65536, [sigma; 2], t);
@@ -472,7 +518,8 @@ mod tests {
                     .collect();
                 let mut e = vec![errors(&qmc, &reference, &ks)];
                 for &s in supersampling {
-                    let filt = all_moments(&map, [n, n], [1.0; 2], [sigma; 2], t, s, None);
+                    let filt =
+                        all_moments(&map, [n, n], [1.0; 2], SeedKernel::Gaussian, t, s, None);
                     e.push(errors(&filt, &reference, &ks));
                 }
                 (name, e)

@@ -10,12 +10,11 @@
 //! Generic over the storage ([`LobeStore`], [`LevelView`]): compiled once per storage.
 
 use super::blocks::SIDE;
-use super::build::kernel_sigma;
 use super::calibrate;
 use super::lanes::LANES;
 use super::levels::resolution_index;
 use super::lobe_set::{Few, LobeSet};
-use super::params::PatchOptions;
+use super::params::{PatchOptions, SeedKernel};
 use super::storage::{LevelView, LobeStore};
 use super::sub_texel;
 use crate::glint::Footprint;
@@ -183,19 +182,35 @@ struct Effective {
     inv: [f64; 3],
 }
 
-/// The footprint's Gaussian k_P in level-0 lobe units: centre and covariance [xx, xy, yy].
+/// The footprint's Gaussian k_P in level-0 lobe units (lobe i centred at i + ½): centre and
+/// covariance [xx, xy, yy]; with the seed kernel's variances in the same units.
 pub(super) struct FootprintLobes {
     pub c: [f64; 2],
     pub cov: [f64; 3],
+    /// Per-axis variance of the seed kernel as the position weights use it
+    /// ([`SeedKernel::weight_variance`]).
+    pub seed_weight_var: f64,
+    /// The seed kernel and its truncation, for the sub-texel lobe.
+    seed: (SeedKernel, f32),
 }
 
 impl FootprintLobes {
-    /// The footprint on a map of `width × height` texels whose lobes are `spacing` texels apart.
-    pub fn new(footprint: &Footprint, width: usize, height: usize, spacing: [f64; 2]) -> Self {
-        let (c, s) = footprint.gaussian_texels(width, height);
+    /// The footprint on a map of `map` = (width, height) texels whose lobes are `spacing` texels
+    /// apart, seeded by `seed` (truncated at ±`kernel_sigmas` σ if Gaussian).
+    pub fn new(
+        footprint: &Footprint,
+        map: (usize, usize),
+        spacing: [f64; 2],
+        seed: SeedKernel,
+        kernel_sigmas: f32,
+    ) -> Self {
+        let (c, s) = footprint.gaussian_texels(map.0, map.1);
         let [hx, hy] = spacing;
+        let o = seed.origin();
         FootprintLobes {
-            c: [c.x as f64 / hx, c.y as f64 / hy],
+            seed_weight_var: seed.weight_variance(),
+            seed: (seed, kernel_sigmas),
+            c: [(c.x as f64 - o) / hx, (c.y as f64 - o) / hy],
             cov: [
                 s.x_axis.x as f64 / (hx * hx),
                 s.x_axis.y as f64 / (hx * hy),
@@ -210,6 +225,11 @@ impl FootprintLobes {
         12.0 * (sxx * syy - sxy * sxy).max(0.0).sqrt()
     }
 
+    /// The seed kernel and its truncation (what the sub-texel lobe reads).
+    pub fn seed(&self) -> (SeedKernel, f32) {
+        self.seed
+    }
+
     /// The smaller eigenvalue of Σ_P (lobe units²).
     fn min_variance(&self) -> f64 {
         let [a, b, d] = self.cov;
@@ -221,13 +241,15 @@ impl FootprintLobes {
 
 impl Effective {
     /// The effective Gaussian of the nodes of level l, in that level's units (a node spans 2^l
-    /// lobes): centre c / 2^l and covariance (Σ_P + (σ_k² + (4^l − 1)/12) I) / 4^l. The added
-    /// (4^l − 1)/12 is the variance of the 2^l lobe positions a node spans along each axis, so a
-    /// node's weight is the moment-matched Gaussian of the sum of its lobes' weights (exact at
-    /// l = 0, where the formula is the level-0 effective Gaussian k_i ∗ k_P).
+    /// lobes): centre c / 2^l and covariance (Σ_P + (σ_k² + (4^l − 1)/12) I) / 4^l, σ_k² the seed
+    /// kernel's weight variance (the Gaussian's, or the cell's 1/12, so that a cell node's is the
+    /// 4^l/12 of its 2^l-lobe cell). The added (4^l − 1)/12 is the variance of the 2^l lobe positions
+    /// a node spans along each axis, so a node's weight is the moment-matched Gaussian of the sum of
+    /// its lobes' weights (exact at l = 0, where the formula is the level-0 effective Gaussian
+    /// k_i ∗ k_P).
     fn at_level(fp: &FootprintLobes, l: usize) -> Effective {
         let n2 = (1u64 << (2 * l)) as f64;
-        let k2 = kernel_sigma(1.0).powi(2) + (n2 - 1.0) / 12.0;
+        let k2 = fp.seed_weight_var + (n2 - 1.0) / 12.0;
         let scale = 1.0 / (1u64 << l) as f64;
         let c = [fp.c[0] * scale, fp.c[1] * scale];
         let [sxx, sxy, syy] = fp.cov;
@@ -489,20 +511,20 @@ pub(super) enum SetKind {
 /// `options.lod_tolerance`, moved coarser by the cost cap, see [`level_range`]; past the cap the
 /// filtered mixture, or the filtered lobe without one) and the gather there, its buffers lent by
 /// `slots`.
-/// `weight_sigmas`, `kernel_sigmas` and `sigma_min` are the mixture's parameters,
+/// `weight_sigmas` and `sigma_min` are the mixture's parameters,
 /// `filtered_error` the filtered mixture's measured error per level (calibrate.rs).
 pub(super) fn footprint_patch<'a, S: LobeStore>(
     store: &'a S,
     fp: &FootprintLobes,
     options: &PatchOptions,
-    [weight_sigmas, kernel_sigmas, sigma_min]: [f32; 3],
+    [weight_sigmas, sigma_min]: [f32; 2],
     filtered_error: &[f32],
     slots: Option<Home<'a, SlotBuffers>>,
     sets: Option<Home<'a, LobeSet>>,
 ) -> Footprinted<'a, S::Level<'a>> {
     let area = fp.area();
     if area < options.sub_texel_area as f64 {
-        let lobe = sub_texel::limit_lobe(store, fp.c, fp.cov, sigma_min, kernel_sigmas);
+        let lobe = sub_texel::limit_lobe(store, fp.c, fp.cov, fp.seed(), sigma_min);
         return Footprinted {
             level: store.level(0),
             filtered: lobe,

@@ -3,7 +3,8 @@
 //! bounding-box hierarchy that keeps D_P evaluations local.
 //!
 //! - [`BeckmannMixture::build`] integrates the five slope moments of the *interpolated* normal map
-//!   under each seed kernel k_i (eq. 5-6) and keeps the lobes in one of two storages
+//!   under each seed kernel k_i (eq. 5-6; by default the cell between four texel centres, one
+//!   bilinear patch per lobe, rather than the paper's Gaussian: [`SeedKernel`]) and keeps the lobes in one of two storages
 //!   ([`LobeStorage`]). Full storage holds the moments (5 `f32` per lobe), an implicit quadtree of
 //!   slope boxes (§5), a mip chain of the moments (§4.2.2), and the lobes again as
 //!   structure-of-arrays blocks of 4 × 4 with their P22 and masking coefficients precomputed in
@@ -80,7 +81,7 @@ pub use params::{
     DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL, DEFAULT_SPACING, DEFAULT_SUB_TEXEL_AREA,
     DEFAULT_SUPERSAMPLING, DEFAULT_WEIGHT_SIGMAS, LOD_RESOLUTIONS, LobeStorage, MAX_SUPERSAMPLING,
     MAX_TRUNCATION_SIGMAS, MIN_COMPACT_SIGMA, MIN_SPACING, MaskingMode, MixtureMemory,
-    MixtureParams, MomentMethod, PatchOptions,
+    MixtureParams, MomentMethod, PatchOptions, SeedKernel,
 };
 pub use patch::MixturePatch;
 

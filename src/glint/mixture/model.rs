@@ -120,6 +120,11 @@ impl BeckmannMixture {
         progress: Option<&(dyn Fn(f32) + Sync)>,
     ) -> Result<Self> {
         params.validate()?;
+        // The mixture holds (and files store) the kernel it was built with, never `Auto`.
+        let params = MixtureParams {
+            seed: params.seed.resolve(params.spacing),
+            ..params
+        };
         let (width, height) = (map.width(), map.height());
         let (grid, spacing) = lobe_grid(width, height, &params)?;
         let lobes = match params.moments {
@@ -128,7 +133,7 @@ impl BeckmannMixture {
                 map,
                 grid,
                 spacing,
-                spacing.map(build::kernel_sigma),
+                params.seed,
                 params.kernel_sigmas as f64,
                 supersampling,
                 progress,
@@ -235,7 +240,8 @@ impl BeckmannMixture {
         self.params.storage
     }
 
-    /// The parameters the mixture was built with.
+    /// The parameters the mixture was built with, its seed kernel resolved
+    /// ([`SeedKernel::resolve`](super::SeedKernel::resolve): the cell or the Gaussian, never `Auto`).
     pub fn params(&self) -> &MixtureParams {
         &self.params
     }

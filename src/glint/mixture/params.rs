@@ -11,7 +11,8 @@ use crate::error::{Error, Result, positive};
 /// more (`nodes_per_texel` in src/glint/mixture/build_filter.rs).
 pub const DEFAULT_SUPERSAMPLING: u32 = 4;
 
-/// Default seed spacing h = 1 texel: one lobe per texel, at the texel centres (\[Chermain2019\] §5.1.1).
+/// Default seed spacing h = 1 texel: one lobe per texel (\[Chermain2019\] §5.1.1); under the default
+/// seed kernel (the cell at this spacing) each lobe is one bilinear patch, between four texel centres.
 pub const DEFAULT_SPACING: f32 = 1.0;
 
 /// Default floor σ_ε = 0.01 of the lobes' slope standard deviation (\[Chermain2019\] §3.2).
@@ -151,6 +152,112 @@ impl Default for MomentMethod {
     }
 }
 
+/// The seed kernel k_i whose slopes each lobe moment-matches (\[Chermain2019\] eq. 5-6): where the
+/// lobes sit and which part of the interpolated surface each carries.
+///
+/// Measured on the orb (docs/results.md, "Bias floor decomposition": denoised relative RMSE against
+/// the exact P-BRDF under a point light, σ_ε = 0.01, five maps at 1, 9 and 34 texels per pixel): at
+/// spacing 1 the cell lowers the summed error of the fifteen cells by 12 % (at 34 texels per pixel
+/// from 0.20-0.46 to 0.12-0.29, at 2,186 from 0.02-0.16 to 0.01-0.10); at spacings 0.5 and 0.25 the
+/// Gaussian is the better one (summed error 18 % and 45 % lower), since its overlapping lobes sum to a
+/// smoother P-NDF on smooth maps. [`SeedKernel::Auto`] picks accordingly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum SeedKernel {
+    /// The cell at spacings of one texel or more, the Gaussian below (the better of the two at each
+    /// spacing measured, above). A build resolves it ([`SeedKernel::resolve`]): a built or loaded
+    /// mixture's [`params`](super::BeckmannMixture::params) name the kernel it uses, never `Auto`.
+    #[default]
+    Auto,
+    /// A box of one lobe cell (h × h texels) whose corners lie on texel centres: lobe i sits at
+    /// (i + ½) h + ½ texels, so at spacing 1 each lobe is the moment match of exactly one bilinear
+    /// patch of the interpolated map (the square between four texel centres). The cells partition
+    /// the surface, and no lobe straddles the kinks the bilinear interpolation has at the texel
+    /// centres. Position weights: the box as the Gaussian of its variance (h²/12 per axis) convolved
+    /// with the footprint, exact in the limit of footprints wide against a cell (below two cells the
+    /// sub-texel lobe serves, [`PatchOptions::sub_texel_area`]).
+    Cell,
+    /// The paper's Gaussian (\[Chermain2019\] §5.1.1): σ_k = 0.4247 h per axis (half of its peak at
+    /// h/2), truncated at ±[`MixtureParams::kernel_sigmas`] σ_k, lobe i at (i + ½) h texels (the
+    /// texel centres at h = 1). Neighbouring lobes overlap, and at h = 1 each spans the kinks of the
+    /// bilinear interpolation at its texel centre.
+    Gaussian,
+}
+
+/// σ of the Gaussian seed kernel for a spacing `h`: half of the peak at h/2,
+/// exp(−(h/2)²/(2σ²)) = ½, so σ = h / (2 √(2 ln 2)) ≈ 0.4247 h.
+pub(super) fn kernel_sigma(h: f64) -> f64 {
+    h / (2.0 * (2.0 * std::f64::consts::LN_2).sqrt())
+}
+
+impl SeedKernel {
+    /// The kernel a build at `spacing` texels uses: `Auto` becomes the cell at spacings ≥ 1 (and
+    /// for a NaN spacing, which the build refuses anyway) and the Gaussian below; the others are
+    /// themselves.
+    pub fn resolve(self, spacing: f32) -> SeedKernel {
+        match self {
+            SeedKernel::Auto if spacing < 1.0 => SeedKernel::Gaussian,
+            SeedKernel::Auto => SeedKernel::Cell,
+            k => k,
+        }
+    }
+
+    /// Offset in texels of the lobe centres beyond (i + ½) h: ½ for the cell, 0 for the Gaussian
+    /// (lobe i sits at (i + ½) h + `origin()` texels along each axis). This and the variances below
+    /// describe resolved kernels; `Auto` answers as the cell, what it is at the default spacing.
+    pub fn origin(self) -> f64 {
+        match self {
+            SeedKernel::Cell | SeedKernel::Auto => 0.5,
+            SeedKernel::Gaussian => 0.0,
+        }
+    }
+
+    /// Per-axis variance of the kernel in lobe units² as the position weights use it: the cell's
+    /// 1/12, the Gaussian's untruncated σ_k² (W_i = N(u_i; c_P, Σ_P + σ_k² I) in lobe units).
+    pub fn weight_variance(self) -> f64 {
+        match self {
+            SeedKernel::Cell | SeedKernel::Auto => 1.0 / 12.0,
+            SeedKernel::Gaussian => kernel_sigma(1.0).powi(2),
+        }
+    }
+
+    /// Per-axis variance in lobe units² of the kernel the moments integrate: the cell's 1/12, the
+    /// Gaussian truncated at ±`kernel_sigmas` σ_k, σ_k² (1 − 2 t φ(t) / (1 − 2 Φ(−t))).
+    pub fn moment_variance(self, kernel_sigmas: f32) -> f64 {
+        match self {
+            SeedKernel::Cell | SeedKernel::Auto => 1.0 / 12.0,
+            SeedKernel::Gaussian => {
+                use crate::ndf::gauss;
+                let t = kernel_sigmas as f64;
+                let s2 = kernel_sigma(1.0).powi(2);
+                let mass = 1.0 - 2.0 * gauss::std_cdf(-t);
+                if mass > 0.0 {
+                    s2 * (1.0 - 2.0 * t * gauss::std_pdf(t) / mass)
+                } else {
+                    s2
+                }
+            }
+        }
+    }
+
+    /// The kernel's code in files (docs/format.md): 0 the Gaussian, 1 the cell (files hold resolved
+    /// kernels; `Auto` writes as the cell, what it is at the default spacing).
+    pub(super) fn code(self) -> u32 {
+        match self {
+            SeedKernel::Gaussian => 0,
+            SeedKernel::Cell | SeedKernel::Auto => 1,
+        }
+    }
+
+    /// The kernel of a file's code, `None` for an unknown one.
+    pub(super) fn from_code(code: u32) -> Option<SeedKernel> {
+        match code {
+            0 => Some(SeedKernel::Gaussian),
+            1 => Some(SeedKernel::Cell),
+            _ => None,
+        }
+    }
+}
+
 /// Largest accepted [`MomentMethod::Filter`] supersampling: 64 nodes per texel per axis (the
 /// node rows a band holds grow with it; the quadrature error is already ~1e-3 of 4's).
 pub const MAX_SUPERSAMPLING: u32 = 64;
@@ -270,7 +377,12 @@ pub struct MixtureParams {
     /// Quasi-Monte Carlo nodes per lobe for the moments, used (and required ≥ 1) when `moments` is
     /// [`MomentMethod::Qmc`]; ignored under [`MomentMethod::Filter`], where any value is accepted.
     pub samples: usize,
-    /// Truncation of k_i for the moment integral, in σ (in (0, [`MAX_TRUNCATION_SIGMAS`]]).
+    /// The seed kernel k_i ([`SeedKernel::Auto`] by default: the cell at spacings ≥ 1, the Gaussian
+    /// below). Resolved by the build and stored in files.
+    pub seed: SeedKernel,
+    /// Truncation of the Gaussian seed kernel for the moment integral, in σ (in (0,
+    /// [`MAX_TRUNCATION_SIGMAS`]]; checked whatever the kernel, read under
+    /// [`SeedKernel::Gaussian`] only).
     pub kernel_sigmas: f32,
     /// Truncation of the position weights, in σ (in (0, [`MAX_TRUNCATION_SIGMAS`]]).
     pub weight_sigmas: f32,
@@ -290,6 +402,7 @@ impl Default for MixtureParams {
             spacing: DEFAULT_SPACING,
             sigma_min: DEFAULT_SIGMA_MIN,
             samples: DEFAULT_SAMPLES,
+            seed: SeedKernel::default(),
             kernel_sigmas: DEFAULT_KERNEL_SIGMAS,
             weight_sigmas: DEFAULT_WEIGHT_SIGMAS,
             slope_tail: DEFAULT_SLOPE_TAIL,

@@ -142,9 +142,15 @@ impl<'a> MixturePatch<'a> {
         let slots = scratch.map(|s| s.home::<SlotBuffers>());
         let sets = scratch.map(|s| s.home::<LobeSet>());
         let (width, height) = mixture.map_size();
-        let fp = FootprintLobes::new(footprint, width, height, mixture.spacing_f64());
         let p = mixture.params();
-        let params = [p.weight_sigmas, p.kernel_sigmas, p.sigma_min];
+        let fp = FootprintLobes::new(
+            footprint,
+            (width, height),
+            mixture.spacing_f64(),
+            p.seed,
+            p.kernel_sigmas,
+        );
+        let params = [p.weight_sigmas, p.sigma_min];
         // The filtered mixture's measured errors, only where the options read them.
         let errors: &[f32] = if fp.area() >= options.filtered_area as f64
             && options.filtered_tolerance != f32::INFINITY

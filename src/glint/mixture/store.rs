@@ -1,7 +1,7 @@
 //! Saving and loading a built [`BeckmannMixture`] (format: docs/format.md, kinds 2 and 5).
 //!
-//! Full storage (kind 2) stores the map size, the build parameters (no per-query options: those are
-//! passed with each query), the lobes' moments (20 bytes per lobe) and the merge-error bounds of the
+//! Full storage (kind 2) stores the map size, the build parameters (with the seed kernel since format
+//! version 5; no per-query options: those are passed with each query), the lobes' moments (20 bytes per lobe) and the merge-error bounds of the
 //! levels of detail (N_RES `f32` per node of every level l ≥ 1: 4 bytes per lobe; files of format
 //! version 2 do not hold them, and get them recomputed). The
 //! lobe blocks, the slope boxes' hierarchy, the moment mip chain and the levels' merged lobes are
@@ -16,7 +16,7 @@ use super::blocks::SIDE;
 use super::compact::{self, CompactBlock, CompactStorage};
 use super::levels::{N_RES, level_grids};
 use super::model::{BeckmannMixture, Storage, box_sigmas, lobe_grid};
-use super::params::{LobeStorage, MixtureParams};
+use super::params::{LobeStorage, MixtureParams, SeedKernel};
 use crate::Result;
 use crate::glint::MAX_SLOPE;
 use crate::glint::io::format::{self, Decoder, Kind, Stored};
@@ -52,6 +52,7 @@ impl BeckmannMixture {
             e.put(p.kernel_sigmas)?;
             e.put(p.weight_sigmas)?;
             e.put(p.slope_tail)?;
+            e.put(p.seed.code())?;
             match self.lobe_storage() {
                 Storage::Full(s) => {
                     e.array(s.moments().iter().copied())?;
@@ -124,10 +125,19 @@ impl BeckmannMixture {
             let _masking: u32 = d.get("masking")?;
             let _lod_lobes: f32 = d.get("lod_lobes")?;
         }
+        // Versions before 5 knew only the Gaussian seed kernel.
+        let seed = if d.version() >= 5 {
+            let code: u32 = d.get("seed")?;
+            SeedKernel::from_code(code)
+                .ok_or_else(|| format::invalid(format!("unknown seed kernel code {code}")))?
+        } else {
+            SeedKernel::Gaussian
+        };
         let params = MixtureParams {
             spacing,
             sigma_min,
             samples,
+            seed,
             kernel_sigmas,
             weight_sigmas,
             slope_tail,

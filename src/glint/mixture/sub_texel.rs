@@ -2,9 +2,9 @@
 //! kernels, where the mixture's lobes are too wide.
 //!
 //! **Why.** Each level-0 lobe G_i is the moment match of the map's slopes under its seed kernel k_i
-//! (σ_k = 0.42 lobe spacings, \[Chermain2019\] §5.1.1, truncated at ±`kernel_sigmas` σ_k: σ_k² below
-//! is that truncated kernel's variance), so it carries the slope variation of a whole
-//! texel. The P-NDF the mixture approximates, D_P(m) = ∫ k_P(x) N(ñ(m); s(x), σ_ε² I) dx (s the
+//! ([`SeedKernel`](super::SeedKernel): the cell, of per-axis variance σ_k² = 1/12 lobe spacings², or
+//! the paper's Gaussian, σ_k = 0.42 lobe spacings truncated at ±`kernel_sigmas` σ_k, σ_k² below
+//! that truncated kernel's variance), so it carries the slope variation of a whole texel. The P-NDF the mixture approximates, D_P(m) = ∫ k_P(x) N(ñ(m); s(x), σ_ε² I) dx (s the
 //! interpolated slope field, σ_ε the material's intrinsic roughness), tends instead to the single
 //! slope s(c) at the footprint's centre, spread by σ_ε, as the footprint k_P = N(c, Σ_P) shrinks.
 //!
@@ -20,7 +20,7 @@
 //!
 //! with Σ_k the lobes' covariances from their raw moments (unfloored: a flat lobe adds nothing, so a
 //! flat map gives σ_ε exactly) and ∇²μ_k the lattice Laplacian of the lobe means: the means are the
-//! slope field smoothed by the seed kernel, s ∗ N(0, σ_k² I), and s ≈ s̃ − ½ σ_k² ∇²s̃ undoes that
+//! slope field smoothed by the seed kernel, s ∗ k_i, and s ≈ s̃ − ½ σ_k² ∇²s̃ undoes that
 //! smoothing to first order (it lowered the TV to the convolved truth at 0.25-1 texel on three of
 //! the four procedural maps, docs/results.md). The lobe reads twenty stored lobes. An anisotropic footprint enters through its area (√det Σ_P): the
 //! map's Jacobian is not stored, only J Jᵀ, so the lobe is scaled isotropically. The lobe is served
@@ -29,33 +29,22 @@
 //! Where it wins: docs/results.md, "Sub-texel footprints"; the switch is
 //! [`PatchOptions::sub_texel_area`](super::PatchOptions::sub_texel_area).
 
-use super::build::kernel_sigma;
+use super::SeedKernel;
 use super::storage::LobeStore;
-use crate::ndf::{SlopeGaussian, gauss};
-
-/// The per-axis variance, in lobe units², of the seed kernel N(0, σ_k²) truncated at ±`t` σ_k
-/// (the kernel the lobe moments integrate): σ_k² (1 − 2 t φ(t) / (1 − 2 Φ(−t))).
-fn seed_variance(t: f32) -> f64 {
-    let t = t as f64;
-    let s2 = kernel_sigma(1.0).powi(2);
-    let mass = 1.0 - 2.0 * gauss::std_cdf(-t);
-    if mass > 0.0 {
-        s2 * (1.0 - 2.0 * t * gauss::std_pdf(t) / mass)
-    } else {
-        s2
-    }
-}
+use crate::ndf::SlopeGaussian;
 
 /// The raw moments `[E x̃, E ỹ, E x̃², E ỹ², E x̃ỹ]` of the sub-texel limit lobe (module docs) of a
-/// footprint centred at `c` with covariance `cov` = [xx, xy, yy] (both in level-0 lobe units), for a
-/// material of intrinsic roughness `sigma_min` and seed kernels truncated at ±`kernel_sigmas` σ_k.
+/// footprint centred at `c` with covariance `cov` = [xx, xy, yy] (both in level-0 lobe units), for
+/// lobes seeded by `seed` (resolved; truncated at ±`kernel_sigmas` σ if Gaussian) and a material of
+/// intrinsic roughness `sigma_min`.
 pub(super) fn limit_moments<S: LobeStore>(
     store: &S,
     c: [f64; 2],
     cov: [f64; 3],
+    (seed, kernel_sigmas): (SeedKernel, f32),
     sigma_min: f32,
-    kernel_sigmas: f32,
 ) -> [f32; 5] {
+    let sk2 = seed.moment_variance(kernel_sigmas);
     let c = if c[0].is_finite() && c[1].is_finite() {
         c
     } else {
@@ -75,9 +64,9 @@ pub(super) fn limit_moments<S: LobeStore>(
     let mut spread = [0.0f64; 3];
     // The stored moments of lobe (x, y), wrapping as the lattice does.
     let at = |x: f64, y: f64| store.lobe_moments(x as i64, y as i64).map(f64::from);
-    // The lobe means are the slope field smoothed by the seed kernel, s̃ = s ∗ N(0, σ_k² I); one
-    // step of deconvolution, s ≈ s̃ − ½ σ_k² ∇² s̃, with the lattice Laplacian of the means.
-    let sk2 = seed_variance(kernel_sigmas);
+    // The lobe means are the slope field smoothed by the seed kernel, s̃ = s ∗ k (k of variance
+    // σ_k² per axis); one step of deconvolution, s ≈ s̃ − ½ σ_k² ∇² s̃ (the second-order term of
+    // any even kernel), with the lattice Laplacian of the means.
     let h = 0.5 * sk2;
     for (x, y, w) in corners {
         let m = at(x, y);
@@ -119,9 +108,9 @@ pub(super) fn limit_lobe<S: LobeStore>(
     store: &S,
     c: [f64; 2],
     cov: [f64; 3],
+    seed: (SeedKernel, f32),
     sigma_min: f32,
-    kernel_sigmas: f32,
 ) -> SlopeGaussian {
-    let m = limit_moments(store, c, cov, sigma_min, kernel_sigmas);
+    let m = limit_moments(store, c, cov, seed, sigma_min);
     SlopeGaussian::from_moments(m, sigma_min)
 }
