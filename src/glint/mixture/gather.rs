@@ -183,14 +183,12 @@ struct Effective {
 }
 
 /// The footprint's Gaussian k_P in level-0 lobe units (lobe i centred at i + ½): centre and
-/// covariance [xx, xy, yy]; with the seed kernel's variances in the same units.
+/// covariance [xx, xy, yy]; with the seed kernel the lobes were built with.
 pub(super) struct FootprintLobes {
     pub c: [f64; 2],
     pub cov: [f64; 3],
-    /// Per-axis variance of the seed kernel as the position weights use it
-    /// ([`SeedKernel::weight_variance`]).
-    pub seed_weight_var: f64,
-    /// The seed kernel and its truncation, for the sub-texel lobe.
+    /// The seed kernel and its truncation (the position weights read its variance, the sub-texel
+    /// lobe both).
     seed: (SeedKernel, f32),
 }
 
@@ -208,7 +206,6 @@ impl FootprintLobes {
         let [hx, hy] = spacing;
         let o = seed.origin();
         FootprintLobes {
-            seed_weight_var: seed.weight_variance(),
             seed: (seed, kernel_sigmas),
             c: [(c.x as f64 - o) / hx, (c.y as f64 - o) / hy],
             cov: [
@@ -249,7 +246,7 @@ impl Effective {
     /// k_i ∗ k_P).
     fn at_level(fp: &FootprintLobes, l: usize) -> Effective {
         let n2 = (1u64 << (2 * l)) as f64;
-        let k2 = fp.seed_weight_var + (n2 - 1.0) / 12.0;
+        let k2 = fp.seed.0.weight_variance() + (n2 - 1.0) / 12.0;
         let scale = 1.0 / (1u64 << l) as f64;
         let c = [fp.c[0] * scale, fp.c[1] * scale];
         let [sxx, sxy, syy] = fp.cov;

@@ -4,7 +4,8 @@
 //! **Why.** Each level-0 lobe G_i is the moment match of the map's slopes under its seed kernel k_i
 //! ([`SeedKernel`](super::SeedKernel): the cell, of per-axis variance σ_k² = 1/12 lobe spacings², or
 //! the paper's Gaussian, σ_k = 0.42 lobe spacings truncated at ±`kernel_sigmas` σ_k, σ_k² below
-//! that truncated kernel's variance), so it carries the slope variation of a whole texel. The P-NDF the mixture approximates, D_P(m) = ∫ k_P(x) N(ñ(m); s(x), σ_ε² I) dx (s the
+//! that truncated kernel's variance), so it carries the slope variation of a whole texel. The
+//! P-NDF the mixture approximates, D_P(m) = ∫ k_P(x) N(ñ(m); s(x), σ_ε² I) dx (s the
 //! interpolated slope field, σ_ε the material's intrinsic roughness), tends instead to the single
 //! slope s(c) at the footprint's centre, spread by σ_ε, as the footprint k_P = N(c, Σ_P) shrinks.
 //!
