@@ -366,6 +366,7 @@ fn query_cap_is_an_explicit_level_of_detail() {
         &fp,
         &brdf::glint::position_normal::PatchOptions {
             max_query_texels: PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS,
+            ..Default::default()
         },
         None,
     );
@@ -378,6 +379,7 @@ fn query_cap_is_an_explicit_level_of_detail() {
         &fp,
         &brdf::glint::position_normal::PatchOptions {
             max_query_texels: 12.0,
+            ..Default::default()
         },
         None,
     );
@@ -392,6 +394,7 @@ fn query_cap_is_an_explicit_level_of_detail() {
         &fp,
         &brdf::glint::position_normal::PatchOptions {
             max_query_texels: f32::INFINITY,
+            ..Default::default()
         },
         None,
     );
@@ -402,6 +405,7 @@ fn query_cap_is_an_explicit_level_of_detail() {
             &fp,
             &brdf::glint::position_normal::PatchOptions {
                 max_query_texels: cap,
+                ..Default::default()
             },
             None,
         );

@@ -139,7 +139,17 @@ fn lod_table() {
         for area in [1.0f32, 16.0, 256.0, 4096.0, 16384.0, 65536.0] {
             let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
             let reference = binned_pndf(map, &fp, Kernel::Gaussian, &bins, 4_000_000, 17);
-            let capped = pn.patch(&fp).query_scale() < 1.0;
+            let capped = pn
+                .patch_with(
+                    &fp,
+                    &brdf::glint::position_normal::PatchOptions {
+                        filtered_area: f32::INFINITY,
+                        ..Default::default()
+                    },
+                    None,
+                )
+                .query_scale()
+                < 1.0;
             let caps: &[f32] = if capped {
                 &[128.0, f32::INFINITY]
             } else {
@@ -150,6 +160,8 @@ fn lod_table() {
                     &fp,
                     &brdf::glint::position_normal::PatchOptions {
                         max_query_texels: cap,
+                        filtered_area: f32::INFINITY,
+                        ..Default::default()
                     },
                     None,
                 );
@@ -175,6 +187,8 @@ fn lod_table() {
                         std::hint::black_box(&fp),
                         &brdf::glint::position_normal::PatchOptions {
                             max_query_texels: cap,
+                            filtered_area: f32::INFINITY,
+                            ..Default::default()
                         },
                         None,
                     );

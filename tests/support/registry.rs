@@ -71,7 +71,17 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
     let mut capped = GlintOptions::default();
     capped.position_normal = position_normal::PatchOptions {
         max_query_texels: 8.0,
+        filtered_area: f32::INFINITY,
+        ..position_normal::PatchOptions::default()
     };
+    let mut pn_filtered = GlintOptions::default();
+    pn_filtered.position_normal = position_normal::PatchOptions {
+        filtered_area: 0.0,
+        filtered_tolerance: f32::INFINITY,
+        ..position_normal::PatchOptions::default()
+    };
+    let position_normal =
+        GlintModel::from(PositionNormalMap::build(map, PositionNormalParams::default()).unwrap());
     let examples = vec![
         example(
             "mixture, exact masking",
@@ -97,10 +107,13 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
         example("bin map, smoothed", bin_map, smoothed),
         example(
             "position-normal, footprint cap 8 texels",
-            PositionNormalMap::build(map, PositionNormalParams::default())
-                .unwrap()
-                .into(),
+            position_normal.clone(),
             capped,
+        ),
+        example(
+            "position-normal, filtered mixture at every footprint",
+            position_normal,
+            pn_filtered,
         ),
     ];
     for name in GlintModel::NAMES {

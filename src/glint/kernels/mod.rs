@@ -1,8 +1,19 @@
 //! Kernels shared by the glint models' builds and patches (crate-private).
 //!
 //! - cdf.rs: inverting a cumulative table, the first step of every glint sampler.
+//! - filtered_error.rs: the filtered mixture's measured distance to a model's full P-NDF, per
+//!   level (what the models' `filtered_tolerance` is compared with).
+//! - gmm.rs: the filtered mixture, a mip chain of few-lobe Gaussian mixtures over a lobe grid.
+//! - lobe_set.rs: a small weighted set of slope Gaussians, the few-lobe patches' P-NDF.
+//! - mip.rs: trilinear addressing of mip chains over a lobe grid.
+//! - view_memo.rs: a patch's V(wo) kept for the queries of one shading point (lock-free).
 //! - slope_tree.rs: the implicit quadtree of slope boxes over a regular grid of elements (the
 //!   mixture's lobes, the position-normal elements).
 
 pub(crate) mod cdf;
+pub(crate) mod filtered_error;
+pub(crate) mod gmm;
+pub(crate) mod lobe_set;
+pub(crate) mod mip;
 pub(crate) mod slope_tree;
+pub(crate) mod view_memo;

@@ -10,23 +10,20 @@
 use super::params::kernel_sigma;
 use super::{MixtureParams, SeedKernel};
 use crate::glint::NormalMap;
+use crate::glint::kernels::filtered_error::r2;
 use crate::ndf::gauss;
 use glam::Vec2;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// The plastic number g (g³ = g + 1), generator of the R2 sequence.
-pub(super) const PLASTIC: f64 = 1.324_717_957_244_746;
-
 /// The N quadrature offsets (texel units) of a Gaussian kernel of per-axis standard deviations
 /// `sigma`, truncated at ±`t` σ per axis.
 pub(super) fn qmc_offsets(n: usize, sigma: [f64; 2], t: f64) -> Vec<Vec2> {
-    let a = [1.0 / PLASTIC, 1.0 / (PLASTIC * PLASTIC)];
     let p_lo = gauss::std_cdf(-t);
     let span = 1.0 - 2.0 * p_lo;
     (0..n)
         .map(|k| {
-            let r = a.map(|ai| (0.5 + k as f64 * ai).fract());
+            let r = r2(k);
             let z = r.map(|ri| gauss::inv_std_cdf(p_lo + ri * span));
             Vec2::new((z[0] * sigma[0]) as f32, (z[1] * sigma[1]) as f32)
         })
@@ -36,10 +33,9 @@ pub(super) fn qmc_offsets(n: usize, sigma: [f64; 2], t: f64) -> Vec<Vec2> {
 /// The N quadrature offsets (texel units) of the uniform density over a cell of `spacing` texels
 /// per axis: the R2 points of [`qmc_offsets`], mapped linearly onto [−h/2, h/2).
 pub(super) fn cell_offsets(n: usize, spacing: [f64; 2]) -> Vec<Vec2> {
-    let a = [1.0 / PLASTIC, 1.0 / (PLASTIC * PLASTIC)];
     (0..n)
         .map(|k| {
-            let r = a.map(|ai| (0.5 + k as f64 * ai).fract() - 0.5);
+            let r = r2(k).map(|v| v - 0.5);
             Vec2::new((r[0] * spacing[0]) as f32, (r[1] * spacing[1]) as f32)
         })
         .collect()

@@ -37,9 +37,9 @@
 //! compact_encode.rs.
 
 use super::blocks::{J_SCALE, LANES, LobeBlock, SIDE};
-use super::lobe_set::LobeSet;
 use super::params::MixtureMemory;
 use super::storage::{LevelView, LobeStore};
+use crate::glint::kernels::lobe_set::LobeSet;
 use crate::glint::kernels::slope_tree::{SlopeTree, level_sizes};
 use crate::ndf::SlopeGaussian;
 use glam::Vec2;

@@ -9,12 +9,12 @@
 //! and built mixtures answer bit-identically.
 
 use super::blocks::{LobeBlocks, SIDE};
-use super::gmm::GmmPyramid;
 use super::hierarchy::{LobePyramid, lobe_box};
 use super::levels::{LobeLevel, N_RES, build_levels};
-use super::lobe_set::LobeSet;
 use super::params::MixtureMemory;
 use super::storage::{LevelView, LobeStore};
+use crate::glint::kernels::gmm::GmmPyramid;
+use crate::glint::kernels::lobe_set::LobeSet;
 use crate::glint::kernels::slope_tree::{SlopeTree, level_sizes, parent_row};
 use crate::ndf::{DEFAULT_SIGMA_MIN, SIGMA_MIN_FLOOR, SlopeGaussian};
 use rayon::prelude::*;
@@ -54,7 +54,12 @@ impl FullStorage {
         // Blocks and tree in one streaming pass (no whole-grid temporaries), then the mip chain.
         let (blocks, tree) = derive_blocks_and_tree(nx, ny, &moments, sigma_min, box_k);
         let pyramid = LobePyramid::build(nx, ny, &moments);
-        let gmm = GmmPyramid::build(nx, ny, &moments, sigma_min);
+        let gmm = GmmPyramid::build(
+            nx,
+            ny,
+            |k| SlopeGaussian::from_moments(moments[k], sigma_min),
+            sigma_min,
+        );
         let pad = SlopeGaussian::from_moments([0.0; 5], sigma_min);
         let merged = build_levels(nx, ny, &moments, sigma_min, box_k, &pad, errors);
         let mut levels = Vec::with_capacity(1 + merged.len());
@@ -116,7 +121,14 @@ impl LobeStore for FullStorage {
     }
 
     fn filtered_mixture(&self, p: [f64; 2], lod: f64, set: &mut LobeSet) -> bool {
-        self.gmm.lookup(self.moments(), p, lod, set);
+        let lobes = self.moments();
+        let sigma_min = self.sigma_min;
+        self.gmm.lookup(
+            |k| SlopeGaussian::from_moments(lobes[k], sigma_min),
+            p,
+            lod,
+            set,
+        );
         true
     }
 

@@ -10,14 +10,14 @@
 //! Generic over the storage ([`LobeStore`], [`LevelView`]): compiled once per storage.
 
 use super::blocks::SIDE;
-use super::calibrate;
 use super::lanes::LANES;
 use super::levels::resolution_index;
-use super::lobe_set::{Few, LobeSet};
 use super::params::{PatchOptions, SeedKernel};
 use super::storage::{LevelView, LobeStore};
 use super::sub_texel;
 use crate::glint::Footprint;
+use crate::glint::kernels::filtered_error;
+use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::scratch::{Home, Lent};
 use crate::ndf::SlopeGaussian;
 use glam::Vec2;
@@ -485,7 +485,7 @@ pub(super) struct Footprinted<'a, L> {
     pub gathered: Option<Gathered<'a>>,
     /// What serves the patch when `gathered` is `None`: the filtered lobe, the sub-texel limit
     /// lobe (sub_texel.rs) or the filtered mixture (gmm.rs), with its error (the filtered
-    /// mixture's measured TV to the full mixture, calibrate.rs; 1 for the single lobes, which have
+    /// mixture's measured TV to the full mixture, kernels/filtered_error.rs; 1 for the single lobes, which have
     /// none).
     pub set: Option<(Few<'a>, SetKind, f32)>,
 }
@@ -509,7 +509,7 @@ pub(super) enum SetKind {
 /// filtered mixture, or the filtered lobe without one) and the gather there, its buffers lent by
 /// `slots`.
 /// `weight_sigmas` and `sigma_min` are the mixture's parameters,
-/// `filtered_error` the filtered mixture's measured error per level (calibrate.rs).
+/// `filtered_error` the filtered mixture's measured error per level (kernels/filtered_error.rs).
 pub(super) fn footprint_patch<'a, S: LobeStore>(
     store: &'a S,
     fp: &FootprintLobes,
@@ -533,7 +533,7 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
     let filtered = SlopeGaussian::from_moments(store.filtered_moments(fp.c, lod), sigma_min);
     // The filtered mixture where the storage has one (with its measured error at this level),
     // else the filtered lobe.
-    let error = calibrate::error_at(filtered_error, lod);
+    let error = filtered_error::error_at(filtered_error, lod);
     let few = || {
         let mut set = Lent::new(sets);
         if store.filtered_mixture(fp.c, lod, &mut set) && set.len() > 0 {

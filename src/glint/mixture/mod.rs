@@ -51,18 +51,15 @@
 mod blocks;
 mod build;
 mod build_filter;
-mod calibrate;
 mod compact;
 mod compact_encode;
 #[cfg(test)]
 mod dispatch_tests;
 mod full;
 mod gather;
-mod gmm;
 mod hierarchy;
 mod lanes;
 mod levels;
-mod lobe_set;
 mod model;
 mod params;
 mod passes;
@@ -71,9 +68,8 @@ mod simd;
 mod storage;
 mod store;
 mod sub_texel;
-mod view_memo;
 
-pub use gmm::GMM_LOBES;
+pub use crate::glint::kernels::gmm::GMM_LOBES;
 pub use model::BeckmannMixture;
 pub use params::{
     DEFAULT_FILTERED_AREA, DEFAULT_FILTERED_TOLERANCE, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES,
@@ -85,18 +81,19 @@ pub use params::{
 };
 pub use patch::MixturePatch;
 
+use crate::glint::kernels::filtered_error;
 use crate::glint::{Footprint, GlintNdf, GlintScratch};
 
 impl BeckmannMixture {
     /// The filtered mixture's measured TV to the full mixture per level of its mip chain (index l:
     /// footprints of 4^l lobe cells; 1 below the first measured level), empty under compact
     /// storage: what [`PatchOptions::filtered_tolerance`] is compared with. Measured on first use
-    /// (~0.1-0.3 s, deterministic) and kept. See src/glint/mixture/calibrate.rs.
+    /// (~0.1-0.3 s, deterministic) and kept. See src/glint/kernels/filtered_error.rs.
     pub fn filtered_mixture_errors(&self) -> &[f32] {
         self.filtered_error_cell().get_or_init(|| {
             let (nx, ny) = self.grid();
-            let (full, filtered) = calibrate::compared_options();
-            calibrate::filtered_mixture_errors(
+            let (full, filtered) = compared_options();
+            filtered_error::errors_per_level(
                 self.filtered_mixture_levels(),
                 (nx * ny) as f64,
                 self.spacing_f64(),
@@ -105,11 +102,29 @@ impl BeckmannMixture {
                     let exact = MixturePatch::new(self, fp, full, None);
                     let few = MixturePatch::new(self, fp, filtered, None);
                     few.is_filtered_mixture()
-                        .then(|| calibrate::tv(&exact, &few))
+                        .then(|| filtered_error::tv(&exact, &few))
                 },
             )
         })
     }
+}
+
+/// The options of the two patches compared: the full mixture, and the filtered mixture at any
+/// footprint (neither reads the measured errors).
+fn compared_options() -> (PatchOptions, PatchOptions) {
+    let full = PatchOptions {
+        lod_lobes: f32::INFINITY,
+        lod_tolerance: 0.0,
+        sub_texel_area: 0.0,
+        filtered_area: f32::INFINITY,
+        ..PatchOptions::default()
+    };
+    let filtered = PatchOptions {
+        filtered_area: 0.0,
+        filtered_tolerance: f32::INFINITY,
+        ..full
+    };
+    (full, filtered)
 }
 
 impl GlintNdf for BeckmannMixture {

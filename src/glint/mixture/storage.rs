@@ -10,8 +10,8 @@
 //! Both traits are crate-private and implemented only by the two storages (sealed).
 
 use super::blocks::LobeBlock;
-use super::lobe_set::LobeSet;
 use super::params::MixtureMemory;
+use crate::glint::kernels::lobe_set::LobeSet;
 use crate::glint::kernels::slope_tree::SlopeTree;
 use crate::ndf::SlopeGaussian;
 

@@ -17,6 +17,8 @@
 
 mod brdf;
 mod build;
+mod filtered;
+mod geometry;
 mod patch;
 mod store;
 
@@ -24,9 +26,11 @@ pub use brdf::{DEFAULT_MASKING_ALPHA, PositionNormalBrdf};
 pub use patch::{EXACT_MASKING_ELEMENTS, PositionNormalPatch};
 
 use crate::error::{Error, Result, positive};
+use crate::glint::kernels::gmm::GmmPyramid;
 use crate::glint::kernels::slope_tree::SlopeTree;
 use crate::glint::{Footprint, GlintNdf, GlintScratch, NormalMap};
 use glam::{Mat2, Vec2};
+use std::sync::OnceLock;
 
 /// Largest accepted truncation of the position weights, in standard deviations
 /// ([`PositionNormalParams::weight_sigmas`]): 10, which keeps the enumerated region bounded.
@@ -72,9 +76,21 @@ impl PositionNormalParams {
 
     /// Default cap on the footprint ([`PatchOptions::max_query_texels`]): its standard deviation
     /// along each principal axis is clamped so that `weight_sigmas` · σ ≤ 128 texels (the released
-    /// code's maximum query range, which bounds the per-patch work of a method that has no level of
-    /// detail).
+    /// code's maximum query range, which bounds the per-patch work of the element sum where the
+    /// filtered mixture does not serve).
     pub const DEFAULT_MAX_QUERY_TEXELS: f32 = 128.0;
+
+    /// Default footprint area, in elements, from which a patch may be the filtered mixture
+    /// ([`PatchOptions::filtered_area`]): 4096, the mixture's
+    /// ([`crate::glint::mixture::DEFAULT_FILTERED_AREA`]), where the element sum costs ~10⁴
+    /// element lobes per query (docs/results.md, "Cost and error of a shading point against
+    /// footprint").
+    pub const DEFAULT_FILTERED_AREA: f32 = 4096.0;
+
+    /// Default tolerance of the filtered mixture ([`PatchOptions::filtered_tolerance`]): the
+    /// largest measured TV to the exact element sum at which it serves, the mixture's
+    /// ([`crate::glint::mixture::DEFAULT_FILTERED_TOLERANCE`]).
+    pub const DEFAULT_FILTERED_TOLERANCE: f32 = 0.15;
 }
 
 impl Default for PositionNormalParams {
@@ -124,18 +140,31 @@ impl PositionNormalParams {
 /// its file stores none.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PatchOptions {
-    /// The level of detail: the footprint is shrunk about its centre until `weight_sigmas` ·
-    /// σ_footprint ≤ this many texels (`f32::INFINITY` keeps the exact footprint whatever its size;
-    /// values not > 0, NaN included, shrink the footprint to its centre). `Default` gives
+    /// The cost cap of the element sum: the footprint is shrunk about its centre until
+    /// `weight_sigmas` · σ_footprint ≤ this many texels (`f32::INFINITY` keeps the exact footprint
+    /// whatever its size; values not > 0, NaN included, shrink the footprint to its centre).
+    /// Applies where the filtered mixture does not serve. `Default` gives
     /// [`PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS`]. docs/position_normal.md gives the cost
     /// against accuracy.
     pub max_query_texels: f32,
+    /// Footprint area, in elements (box-equivalent area 12 √det Σ_P), at and above which the patch
+    /// may be the filtered mixture ([`PositionNormalParams::DEFAULT_FILTERED_AREA`];
+    /// `f32::INFINITY` or NaN never).
+    pub filtered_area: f32,
+    /// Largest measured TV between the filtered mixture and the exact element sum at the
+    /// footprint's level ([`PositionNormalParams::DEFAULT_FILTERED_TOLERANCE`]; measured per map on
+    /// first use, [`PositionNormalMap::filtered_mixture_errors`]) at which the filtered mixture
+    /// serves a footprint of at least `filtered_area`; above it the elements are summed (under
+    /// the cap `max_query_texels`). `f32::INFINITY` always serves it, NaN never.
+    pub filtered_tolerance: f32,
 }
 
 impl Default for PatchOptions {
     fn default() -> Self {
         PatchOptions {
             max_query_texels: PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS,
+            filtered_area: PositionNormalParams::DEFAULT_FILTERED_AREA,
+            filtered_tolerance: PositionNormalParams::DEFAULT_FILTERED_TOLERANCE,
         }
     }
 }
@@ -149,6 +178,9 @@ pub struct PositionNormalMemory {
     pub element_bytes: usize,
     /// The slope-box quadtree (levels ≥ 1, 16 bytes per node).
     pub hierarchy_bytes: usize,
+    /// The filtered mixture's chain (96 bytes per node of levels ≥ 1, ≤ 32 bytes per element),
+    /// 0 until a footprint first needs it.
+    pub filtered_bytes: usize,
 }
 
 /// The position-normal glint representation of a normal map (\[Yan2016\]).
@@ -178,6 +210,10 @@ pub struct PositionNormalMap {
     elements: Vec<[f32; 6]>,
     tree: SlopeTree,
     params: PositionNormalParams,
+    /// The filtered mixture's chain (filtered.rs), built on the first footprint that needs it.
+    filtered: OnceLock<GmmPyramid>,
+    /// Its measured error per level, measured on first use.
+    filtered_error: OnceLock<Vec<f32>>,
 }
 
 /// The element grid (width, height) × sampling rate, at most 2³¹ elements.
@@ -261,6 +297,8 @@ impl PositionNormalMap {
             elements,
             tree,
             params,
+            filtered: OnceLock::new(),
+            filtered_error: OnceLock::new(),
         }
     }
 
@@ -313,6 +351,7 @@ impl PositionNormalMap {
             elements: self.elements.len(),
             element_bytes: self.elements.len() * 24,
             hierarchy_bytes: self.tree.bytes(),
+            filtered_bytes: self.filtered.get().map_or(0, GmmPyramid::bytes),
         }
     }
 }
@@ -321,14 +360,15 @@ impl GlintNdf for PositionNormalMap {
     type Patch<'a> = PositionNormalPatch<'a>;
     type Options = PatchOptions;
 
-    /// The position-normal P-NDF of a footprint ([`PositionNormalPatch`]) under the query cap of
-    /// `options`.
+    /// The position-normal P-NDF of a footprint ([`PositionNormalPatch`]) at the level of detail
+    /// of `options`: the filtered mixture where it serves, else the element sum under the query
+    /// cap.
     fn patch_with<'a>(
         &'a self,
         footprint: &Footprint,
         options: &PatchOptions,
         scratch: Option<&'a GlintScratch>,
     ) -> PositionNormalPatch<'a> {
-        PositionNormalPatch::new(self, footprint, options.max_query_texels, scratch)
+        PositionNormalPatch::new(self, footprint, options, scratch)
     }
 }

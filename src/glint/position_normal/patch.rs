@@ -1,194 +1,27 @@
 //! The patch of a footprint: the closed-form position-normal P-NDF of \[Yan2016\] §5, evaluated
 //! through the slope-box quadtree, exact (or moment-bounded) masking terms, and exact samplers.
 //!
-//! Per-footprint work (done once when the patch is built): the footprint in element units
-//! (clamped to the query cap), the effective position Gaussian Σ_eff = Σ_P + σ_h² I, the conditional
-//! position covariance Σ_u = (Σ_P⁻¹ + σ_h⁻² I)⁻¹ = σ_h² I − σ_h⁴ Σ_eff⁻¹, the rectangle of elements
-//! that can be within `weight_sigmas` of the footprint, their total weight and the P-NDF's first and
-//! second slope moments. The per-element lobes used by the samplers are built on first use.
+//! Per-footprint work (done once when the patch is built): the level of detail (the filtered
+//! mixture, filtered.rs, where the options serve it: then nothing else), else the footprint's
+//! geometry (geometry.rs), the rectangle of elements that can be within `weight_sigmas` of the
+//! footprint, their total weight and the P-NDF's first and second slope moments. The per-element
+//! lobes used by the samplers are built on first use; the exact V(wo) of the last view is kept.
 
 use super::build::slope_box;
-use super::{PositionNormalMap, SIGMA_H_PER_SPACING};
+use super::filtered::footprint_in_elements;
+use super::geometry::{Geometry, gaussian, segments};
+use super::{PatchOptions, PositionNormalMap, SIGMA_H_PER_SPACING};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
 use crate::glint::kernels::cdf::{invert_cdf, pick_streaming};
+use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::kernels::slope_tree::contains;
-use crate::glint::scratch::Loan;
+use crate::glint::kernels::view_memo::ViewMemo;
+use crate::glint::scratch::{Lent, Loan};
 use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
-
-const TWO_PI: f64 = std::f64::consts::TAU;
-
-/// Per-footprint constants, positions in element units (element i has its centre at i + ½).
-#[derive(Clone, Copy, Debug)]
-struct Geometry {
-    /// Footprint centre.
-    c: [f64; 2],
-    /// Σ_eff⁻¹ = (Σ_P + σ_h² I)⁻¹ as (xx, xy, yy).
-    inv_eff: [f64; 3],
-    /// K = h σ_h² Σ_eff⁻¹: maps c − u_i (element units) to μ_u − u_i in texels.
-    k: [f64; 3],
-    /// Σ_u in texels²: h² (σ_h² I − σ_h⁴ Σ_eff⁻¹).
-    sigma_u: [f64; 3],
-    /// σ_r².
-    var_r: f64,
-    /// k_w².
-    kw2: f64,
-    /// Half-widths of the rectangle of candidate elements, k_w √Σ_eff,kk.
-    half: [f64; 2],
-    /// Footprint σ after the query cap over σ before, along the major axis (1 if the cap did not bite).
-    query_scale: f64,
-}
-
-/// Symmetric 2 × 2 eigen decomposition: eigenvalues (λ1 ≥ λ2) and the unit eigenvector of λ1.
-fn eigen(c: [f64; 3]) -> ([f64; 2], [f64; 2]) {
-    let [a, b, d] = c;
-    let half_tr = 0.5 * (a + d);
-    let r = (0.25 * (a - d) * (a - d) + b * b).sqrt();
-    let (l1, l2) = (half_tr + r, half_tr - r);
-    let e = if b.abs() > 1e-300 {
-        let (x, y) = (l1 - d, b);
-        let n = (x * x + y * y).sqrt();
-        [x / n, y / n]
-    } else if a >= d {
-        [1.0, 0.0]
-    } else {
-        [0.0, 1.0]
-    };
-    ([l1, l2], e)
-}
-
-/// The covariance with eigenvalues clamped to at most `max_var` (same eigenvectors).
-fn clamp_covariance(c: [f64; 3], max_var: f64) -> [f64; 3] {
-    let ([l1, l2], e) = eigen(c);
-    if l1 <= max_var {
-        return c;
-    }
-    let (l1, l2) = (l1.min(max_var), l2.clamp(0.0, max_var));
-    let f = [-e[1], e[0]];
-    [
-        l1 * e[0] * e[0] + l2 * f[0] * f[0],
-        l1 * e[0] * e[1] + l2 * f[0] * f[1],
-        l1 * e[1] * e[1] + l2 * f[1] * f[1],
-    ]
-}
-
-impl Geometry {
-    /// `max_query_texels` not > 0 (NaN included) acts as 0: the footprint shrinks to its centre.
-    fn new(map: &PositionNormalMap, footprint: &Footprint, max_query_texels: f32) -> Geometry {
-        let p = &map.params;
-        let (c, s) = footprint.gaussian_texels(map.width, map.height);
-        let cov = [s.x_axis.x as f64, s.y_axis.x as f64, s.y_axis.y as f64];
-        let kw = p.weight_sigmas as f64;
-        let cap = if max_query_texels > 0.0 {
-            max_query_texels as f64 / kw
-        } else {
-            0.0
-        };
-        let major = eigen(cov).0[0];
-        let cov = clamp_covariance(cov, cap * cap);
-        let query_scale = if major > 0.0 {
-            (eigen(cov).0[0] / major).sqrt().min(1.0)
-        } else {
-            1.0
-        };
-        let h = map.spacing;
-        let (h2, sh) = (h * h, SIGMA_H_PER_SPACING);
-        let sh2 = sh * sh;
-        let (a, b, d) = (cov[0] / h2 + sh2, cov[1] / h2, cov[2] / h2 + sh2);
-        let det = a * d - b * b;
-        // det ≥ σ_h⁴ > 0: Σ_P is positive semi-definite and σ_h² I is added.
-        let inv = [d / det, -b / det, a / det];
-        Geometry {
-            c: [c.x as f64 / h, c.y as f64 / h],
-            inv_eff: inv,
-            k: [h * sh2 * inv[0], h * sh2 * inv[1], h * sh2 * inv[2]],
-            sigma_u: [
-                h2 * (sh2 - sh2 * sh2 * inv[0]).max(0.0),
-                -h2 * sh2 * sh2 * inv[1],
-                h2 * (sh2 - sh2 * sh2 * inv[2]).max(0.0),
-            ],
-            var_r: (p.sigma_r as f64).powi(2),
-            kw2: kw * kw,
-            half: [kw * a.sqrt(), kw * d.sqrt()],
-            query_scale,
-        }
-    }
-
-    /// The unwrapped element index range [lo, hi] of one axis.
-    fn range(&self, axis: usize) -> [i64; 2] {
-        let (c, half) = (self.c[axis], self.half[axis]);
-        let lo = (c - 0.5 - half).ceil();
-        let hi = (c - 0.5 + half).floor();
-        if hi >= lo {
-            [lo as i64, hi as i64]
-        } else {
-            let n = (c - 0.5).round() as i64;
-            [n, n]
-        }
-    }
-
-    /// The position weight of unwrapped element (i, j): exp(−½ dᵀ Σ_eff⁻¹ d), d = c − u_i, or
-    /// `None` outside the truncation ellipse. Also returns d.
-    #[inline]
-    fn weight(&self, i: i64, j: i64) -> Option<(f64, [f64; 2])> {
-        let d = [self.c[0] - (i as f64 + 0.5), self.c[1] - (j as f64 + 0.5)];
-        let q = self.inv_eff[0] * d[0] * d[0]
-            + 2.0 * self.inv_eff[1] * d[0] * d[1]
-            + self.inv_eff[2] * d[1] * d[1];
-        (q <= self.kw2).then(|| ((-0.5 * q).exp(), d))
-    }
-
-    /// The element's slope Gaussian under the footprint: mean ñ_i + J K d and covariance
-    /// J Σ_u Jᵀ + σ_r² I (as (xx, xy, yy)).
-    #[inline]
-    fn lobe(&self, e: &[f32; 6], d: [f64; 2]) -> ([f64; 2], [f64; 3]) {
-        let [sx, sy, jxu, jxv, jyu, jyv] = e.map(f64::from);
-        let du = [
-            self.k[0] * d[0] + self.k[1] * d[1],
-            self.k[1] * d[0] + self.k[2] * d[1],
-        ];
-        let mean = [
-            sx + jxu * du[0] + jxv * du[1],
-            sy + jyu * du[0] + jyv * du[1],
-        ];
-        let [u0, u1, u2] = self.sigma_u;
-        // Rows of J Σ_u.
-        let (ax, ay) = (jxu * u0 + jxv * u1, jxu * u1 + jxv * u2);
-        let (bx, by) = (jyu * u0 + jyv * u1, jyu * u1 + jyv * u2);
-        let cov = [
-            ax * jxu + ay * jxv + self.var_r,
-            ax * jyu + ay * jyv,
-            bx * jyu + by * jyv + self.var_r,
-        ];
-        (mean, cov)
-    }
-}
-
-/// The 2D Gaussian density N(s; mean, cov) in `f64` (0 for a degenerate covariance).
-#[inline]
-fn gaussian(s: [f64; 2], mean: [f64; 2], cov: [f64; 3]) -> f64 {
-    let det = cov[0] * cov[2] - cov[1] * cov[1];
-    if det.is_nan() || det <= 0.0 {
-        return 0.0;
-    }
-    let (dx, dy) = (s[0] - mean[0], s[1] - mean[1]);
-    let q = (cov[2] * dx * dx - 2.0 * cov[1] * dx * dy + cov[0] * dy * dy) / det;
-    (-0.5 * q).exp() / (TWO_PI * det.sqrt())
-}
-
-/// Segments of one axis: wrapped index ranges [lo, hi] (inclusive) with the offset that unwraps them.
-fn segments(range: [i64; 2], n: usize) -> impl Iterator<Item = (usize, usize, i64)> {
-    let n = n as i64;
-    let [lo, hi] = range;
-    (lo.div_euclid(n)..=hi.div_euclid(n)).map(move |k| {
-        let a = (lo - k * n).max(0);
-        let b = (hi - k * n).min(n - 1);
-        (a as usize, b as usize, k * n)
-    })
-}
 
 /// The per-element lobes of a patch, for the samplers and the untruncated densities; also the
 /// position-normal part of [`GlintScratch`] (only its capacity is kept between patches).
@@ -227,6 +60,12 @@ pub(crate) struct Slots {
 ///   element ∝ W_i V_i(wo) then its visible normal, exactly `pdf_visible`. Both densities sum every
 ///   kept element (no slope truncation), O(elements in the footprint).
 ///
+/// **Level of detail.** A footprint of at least `filtered_area` elements whose level meets
+/// `filtered_tolerance` ([`PatchOptions`](super::PatchOptions)) is served by the filtered mixture
+/// instead (src/glint/position_normal/filtered.rs): at most 32 slope Gaussians, every term exact
+/// over them (src/glint/kernels/lobe_set.rs), O(1) per query; [`PositionNormalPatch::is_filtered_mixture`]
+/// tells which.
+///
 /// # Reference
 /// \[Yan2016\] §5 (P-NDF of a Gaussian footprint, truncation, hierarchy).
 #[derive(Clone, Debug)]
@@ -244,6 +83,11 @@ pub struct PositionNormalPatch<'a> {
     /// Built on the first call that needs every element (masking, samplers, densities), in buffers
     /// lent by the caller's scratch if any.
     slots: Loan<'a, Slots>,
+    /// The filtered mixture when it serves the footprint ([`Few::None`] for the element sum).
+    few: Few<'a>,
+    /// The exact V(wo) of the last view asked for (`view_visible_area`, `pdf_visible`,
+    /// `sample_visible`): one pass per wo instead of one per query.
+    view: ViewMemo,
 }
 
 /// Largest patch (number of elements kept) whose masking terms use the exact V(w) = Σ W_i V_i(w);
@@ -252,21 +96,62 @@ pub struct PositionNormalPatch<'a> {
 pub const EXACT_MASKING_ELEMENTS: usize = 4096;
 
 impl<'a> PositionNormalPatch<'a> {
-    /// The P-NDF of `footprint` (see the type's docs) under the query cap `max_query_texels`
-    /// ([`PatchOptions::max_query_texels`](super::PatchOptions)), with its per-element buffers lent
-    /// by `scratch` if any. Total: any footprint works; cost O(elements within `weight_sigmas` of
-    /// the capped footprint). No allocation (the samplers' buffers are built on first use).
+    /// The P-NDF of `footprint` (see the type's docs) at the level of detail of `options`, with
+    /// its buffers lent by `scratch` if any. Total: any footprint works; cost O(1) where the
+    /// filtered mixture serves, else O(elements within `weight_sigmas` of the capped footprint). No
+    /// allocation with a warmed scratch (the samplers' buffers are built on first use).
     pub(super) fn new(
         map: &'a PositionNormalMap,
         footprint: &Footprint,
-        max_query_texels: f32,
+        options: &PatchOptions,
         scratch: Option<&'a GlintScratch>,
     ) -> PositionNormalPatch<'a> {
+        let (c, area) = footprint_in_elements(map, footprint);
+        if area >= options.filtered_area as f64 {
+            let mut set: Lent<'a, LobeSet> = Lent::new(scratch.map(|s| s.home()));
+            if map.filtered_mixture(c, area, options, &mut set) {
+                return Self::filtered(map, footprint, set);
+            }
+        }
         Self::build(
             map,
-            Geometry::new(map, footprint, max_query_texels),
+            Geometry::new(map, footprint, options.max_query_texels),
             scratch,
         )
+    }
+
+    /// The patch served by the filtered mixture `set`: its moments from the lobes, no elements.
+    fn filtered(map: &'a PositionNormalMap, footprint: &Footprint, set: Lent<'a, LobeSet>) -> Self {
+        let mut acc = [0.0f64; 5];
+        for (w, g) in set.iter() {
+            let (m, c) = (g.mean(), g.covariance());
+            let (w, mx, my) = (w as f64, m.x as f64, m.y as f64);
+            acc[0] += w * mx;
+            acc[1] += w * my;
+            acc[2] += w * (c.x_axis.x as f64 + mx * mx);
+            acc[3] += w * (c.y_axis.y as f64 + my * my);
+            acc[4] += w * (c.x_axis.y as f64 + mx * my);
+        }
+        let moments = acc.map(|v| v as f32);
+        PositionNormalPatch {
+            map,
+            geo: Geometry::new(map, footprint, f32::INFINITY),
+            rect: [[0, -1], [0, -1]],
+            inv_total: 0.0,
+            count: 0,
+            mean_slope: Vec2::new(moments[0], moments[1]),
+            moments,
+            moments_lobe: SlopeGaussian::from_moments(moments, map.params.sigma_r),
+            slots: Loan::new(None),
+            few: Few::Set(set),
+            view: ViewMemo::default(),
+        }
+    }
+
+    /// Whether the filtered mixture serves the patch (module docs of
+    /// src/glint/position_normal/filtered.rs); else the elements are summed.
+    pub fn is_filtered_mixture(&self) -> bool {
+        !matches!(self.few, Few::None)
     }
 
     fn build(
@@ -301,6 +186,8 @@ impl<'a> PositionNormalPatch<'a> {
             moments,
             moments_lobe,
             slots: Loan::new(scratch.map(|s| s.home())),
+            few: Few::None,
+            view: ViewMemo::default(),
         }
     }
 
@@ -331,7 +218,8 @@ impl<'a> PositionNormalPatch<'a> {
         self.geo.query_scale as f32
     }
 
-    /// Number of elements kept in the footprint (inside the weight ellipse).
+    /// Number of elements kept in the footprint (inside the weight ellipse); 0 where the filtered
+    /// mixture serves.
     pub fn element_count(&self) -> usize {
         self.count
     }
@@ -352,10 +240,16 @@ impl<'a> PositionNormalPatch<'a> {
         &self.moments_lobe
     }
 
-    /// The normalised weights W_i and slope Gaussians N(μ_i, C_i) of the kept elements.
+    /// The normalised weights W_i and slope Gaussians N(μ_i, C_i) of the kept elements, or the
+    /// filtered mixture's lobes where it serves.
     pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
-        let s = self.slots();
-        s.weights.iter().zip(&s.lobes).map(|(&w, &l)| (w as f32, l))
+        let few = self.few.lobes();
+        let slots = (!self.is_filtered_mixture()).then(|| self.slots());
+        few.into_iter().chain(
+            slots
+                .into_iter()
+                .flat_map(|s| s.weights.iter().zip(&s.lobes).map(|(&w, &l)| (w as f32, l))),
+        )
     }
 
     fn slots(&self) -> &Slots {
@@ -386,6 +280,9 @@ impl<'a> PositionNormalPatch<'a> {
     /// # Reference
     /// \[Yan2016\] §5.
     pub fn d_with_stats(&self, m: Vec3) -> (f32, usize) {
+        if let Few::Set(set) = &self.few {
+            return (set.d(m), set.len());
+        }
         let Some(s) = normal_to_slope(m) else {
             return (0.0, 0);
         };
@@ -430,6 +327,9 @@ impl<'a> PositionNormalPatch<'a> {
 
     /// Σ W_i D_i(m) over every kept element, in `f64`.
     fn untruncated_d(&self, m: Vec3) -> f64 {
+        if self.is_filtered_mixture() {
+            return self.few.d(m) as f64;
+        }
         let s = self.slots();
         s.weights
             .iter()
@@ -438,14 +338,27 @@ impl<'a> PositionNormalPatch<'a> {
             .sum()
     }
 
-    /// Σ W_i V_i(w) over every kept element (the exact visible area of the P-NDF), in `f64`.
+    /// Σ W_i V_i(w) over every kept element (the exact visible area of the P-NDF), in `f64`; over
+    /// the filtered mixture's lobes where it serves.
     pub fn visible_area_exact(&self, w: Vec3) -> f32 {
         finite_or_zero(self.exact_visible_area(w))
+    }
+
+    /// The exact V(wo) at the view, through the view memo (the same value as
+    /// [`Self::exact_visible_area`]).
+    fn view_exact_visible_area(&self, wo: Vec3) -> f64 {
+        if !(wo.z > 0.0 && wo.is_finite()) {
+            return 0.0;
+        }
+        self.view.get_or(wo, || self.exact_visible_area(wo))
     }
 
     fn exact_visible_area(&self, w: Vec3) -> f64 {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
+        }
+        if self.is_filtered_mixture() {
+            return self.few.visible_area(w) as f64;
         }
         let s = self.slots();
         s.weights
@@ -487,11 +400,17 @@ impl Ndf for PositionNormalPatch<'_> {
     /// Λ = V/A − 1 with V from [`Ndf::visible_area`] (exact, or Scarf's bound for large patches) and A
     /// from the P-NDF's mean slope; 0 for invalid w, `f32::MAX` where A(w) = 0 < w_z.
     fn lambda(&self, w: Vec3) -> f32 {
+        if self.is_filtered_mixture() {
+            return self.few.lambda(w);
+        }
         crate::ndf::lambda_from_areas(self, w)
     }
 
     /// A(w) of the moments lobe: max(cos θ − w_xy·μ_P, 0) with μ_P the P-NDF's mean slope.
     fn projected_area(&self, w: Vec3) -> f32 {
+        if self.is_filtered_mixture() {
+            return self.few.projected_area(w);
+        }
         self.moments_lobe.projected_area(w)
     }
 
@@ -509,8 +428,21 @@ impl Ndf for PositionNormalPatch<'_> {
         }
     }
 
+    /// [`Ndf::visible_area`]`(wo)`, the exact V kept in the patch's view memo for the queries that
+    /// follow at the same wo.
+    fn view_visible_area(&self, wo: Vec3) -> f32 {
+        if self.count <= EXACT_MASKING_ELEMENTS {
+            finite_or_zero(self.view_exact_visible_area(wo))
+        } else {
+            self.moments_lobe.visible_area_bound(wo)
+        }
+    }
+
     /// m ~ D_P(m) cos θ_m (untruncated): element ∝ W_i with u.x (rescaled), then its slope Gaussian.
     fn sample_normal(&self, u: Vec2) -> Vec3 {
+        if self.is_filtered_mixture() {
+            return self.few.sample_normal(u);
+        }
         let s = self.slots();
         if s.lobes.is_empty() {
             return self.moments_lobe.sample_normal(u);
@@ -526,6 +458,9 @@ impl Ndf for PositionNormalPatch<'_> {
     /// pdf 0, where D_P is 0 too, and `MicrofacetBrdf::sample` returns `None` for it. Inside the
     /// support the value differs from `d(m) cos θ_m` by at most the truncated tails. O(elements).
     fn pdf_normal(&self, m: Vec3) -> f32 {
+        if self.is_filtered_mixture() {
+            return self.few.pdf_normal(m);
+        }
         if !(m.z > 0.0 && m.is_finite() && self.d(m) > 0.0) {
             return 0.0;
         }
@@ -537,8 +472,11 @@ impl Ndf for PositionNormalPatch<'_> {
     /// m ~ Σ W_i ⟨wo, m⟩⁺ D_i(m) / Σ W_i V_i(wo): element ∝ W_i V_i(wo), then its visible normal.
     /// Invalid wo: [`Ndf::sample_normal`].
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        if self.is_filtered_mixture() {
+            return self.few.sample_visible(wo, u);
+        }
         let s = self.slots();
-        let total = self.exact_visible_area(wo);
+        let total = self.view_exact_visible_area(wo);
         if !(total > 0.0 && total.is_finite()) {
             return self.sample_normal(u);
         }
@@ -577,44 +515,11 @@ impl PositionNormalPatch<'_> {
         if d() <= 0.0 {
             return 0.0;
         }
-        let v = self.exact_visible_area(wo);
+        let v = self.view_exact_visible_area(wo);
         if v.is_nan() || v <= 0.0 {
             return 0.0;
         }
         let p = (c as f64 * self.untruncated_d(m) / v) as f32;
         if p.is_finite() { p } else { 0.0 }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn segments_cover_the_range_once() {
-        for &(lo, hi, n) in &[
-            (-3i64, 4i64, 4usize),
-            (0, 3, 4),
-            (5, 5, 4),
-            (-9, 9, 3),
-            (2, 2, 1),
-        ] {
-            let mut seen = Vec::new();
-            for (a, b, off) in segments([lo, hi], n) {
-                assert!(a <= b && b < n);
-                for w in a..=b {
-                    seen.push(w as i64 + off);
-                }
-            }
-            assert_eq!(seen, (lo..=hi).collect::<Vec<_>>(), "{lo} {hi} {n}");
-        }
-    }
-
-    #[test]
-    fn clamp_keeps_small_and_shrinks_large() {
-        let c = [4.0, 1.0, 2.0];
-        assert_eq!(clamp_covariance(c, 10.0), c);
-        let ([l1, l2], _) = eigen(clamp_covariance([100.0, 0.0, 1.0], 9.0));
-        assert!((l1 - 9.0).abs() < 1e-12 && (l2 - 1.0).abs() < 1e-12);
     }
 }

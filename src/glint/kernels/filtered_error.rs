@@ -1,25 +1,23 @@
-//! The filtered mixture's error, measured at build time: for each level l of its mip chain, the
-//! mean total variation between the filtered mixture (gmm.rs) and the full mixture over
-//! footprints of 4^l lobe cells (the footprints whose lookup reads level l), so that a patch
+//! The filtered mixture's error, measured once per model: for each level l of its mip chain
+//! (gmm.rs), the mean total variation between the filtered mixture and the model's full P-NDF
+//! over footprints of 4^l lobe cells (the footprints whose lookup reads level l), so that a patch
 //! serves the filtered mixture only where it stays within the caller's tolerance of the full one
-//! ([`PatchOptions::filtered_tolerance`](super::PatchOptions::filtered_tolerance)).
+//! (the `filtered_tolerance` of the mixture's and the position-normal map's patch options).
 //!
 //! **Estimator.** TV(p, q) = ½ ∫ |p − q| = E_r[|p − q| / (p + q)] with r = ½ (p + q), p and q the
 //! two patches' normal densities D(m) cos θ_m; [`SAMPLES`] normals, half drawn from each patch
 //! by its `sample_normal` on a fixed R2 sequence (deterministic), at [`CENTRES`] fixed footprint
 //! centres, averaged. The standard error of the mean is ≤ ½ / √(SAMPLES · CENTRES) ≈ 0.016.
 //!
-//! Measured on a mixture's first footprint that needs it (a renderer whose footprints stay small
+//! Measured on a model's first footprint that needs it (a renderer whose footprints stay small
 //! never pays for it).
 //!
 //! **Which levels.** Measured for footprints of 4^l lobe cells with 4^l in [[`FIRST_AREA`],
-//! [`LAST_AREA`]]; the full mixture's `d` costs ~0.1 ms at the last one, which bounds the build's
-//! extra time (~0.1-0.3 s per map). Coarser levels take the value measured at [`LAST_AREA`] (the
+//! [`LAST_AREA`]]; the full mixture's `d` costs ~0.1 ms at the last one, which bounds the
+//! measurement's time (~0.1-0.3 s per map). Coarser levels take the value measured at [`LAST_AREA`] (the
 //! filtered mixture's distance falls as footprints grow and their P-NDFs smooth out: measured in
 //! docs/results.md), finer ones are not served by the filtered mixture (error 1).
 
-use super::build::PLASTIC;
-use super::params::PatchOptions;
 use crate::glint::Footprint;
 use crate::ndf::Ndf;
 use glam::{Vec2, Vec3};
@@ -29,21 +27,27 @@ const SAMPLES: usize = 256;
 /// Footprint centres per level.
 const CENTRES: usize = 4;
 /// Smallest footprint (lobe cells) at which the error is measured.
-pub(super) const FIRST_AREA: f64 = 64.0;
+pub(crate) const FIRST_AREA: f64 = 64.0;
 /// Largest footprint (lobe cells) at which the error is measured.
 const LAST_AREA: f64 = 4096.0;
 
+/// The plastic number g (g³ = g + 1), generator of the R2 sequence.
+pub(crate) const PLASTIC: f64 = 1.324_717_957_244_746;
+
 /// Point k of the R2 sequence (Roberts 2018, the additive recurrence with the plastic number):
 /// a low-discrepancy point in [0, 1)².
-fn r2(k: usize) -> Vec2 {
+pub(crate) fn r2(k: usize) -> [f64; 2] {
     let a = [1.0 / PLASTIC, 1.0 / (PLASTIC * PLASTIC)];
-    let x = (0.5 + k as f64 * a[0]).fract();
-    let y = (0.5 + k as f64 * a[1]).fract();
+    a.map(|ai| (0.5 + k as f64 * ai).fract())
+}
+
+fn r2_f32(k: usize) -> Vec2 {
+    let [x, y] = r2(k);
     Vec2::new(x as f32, y as f32)
 }
 
 /// TV between the normal densities D cos θ of two patches, by the estimator of the module docs.
-pub(super) fn tv(p: &impl Ndf, q: &impl Ndf) -> f64 {
+pub(crate) fn tv(p: &impl Ndf, q: &impl Ndf) -> f64 {
     let density = |n: &dyn Fn(Vec3) -> f32, m: Vec3| -> f64 {
         if m.z > 0.0 && m.is_finite() {
             (n(m) * m.z) as f64
@@ -53,7 +57,7 @@ pub(super) fn tv(p: &impl Ndf, q: &impl Ndf) -> f64 {
     };
     let mut sum = 0.0;
     for k in 0..SAMPLES {
-        let u = r2(k);
+        let u = r2_f32(k);
         let m = if k % 2 == 0 {
             p.sample_normal(u)
         } else {
@@ -67,30 +71,12 @@ pub(super) fn tv(p: &impl Ndf, q: &impl Ndf) -> f64 {
     sum / SAMPLES as f64
 }
 
-/// The options of the two patches compared: the full mixture, and the filtered mixture at any
-/// footprint (neither reads the measured errors).
-pub(super) fn compared_options() -> (PatchOptions, PatchOptions) {
-    let full = PatchOptions {
-        lod_lobes: f32::INFINITY,
-        lod_tolerance: 0.0,
-        sub_texel_area: 0.0,
-        filtered_area: f32::INFINITY,
-        ..PatchOptions::default()
-    };
-    let filtered = PatchOptions {
-        filtered_area: 0.0,
-        filtered_tolerance: f32::INFINITY,
-        ..full
-    };
-    (full, filtered)
-}
-
 /// Per level l of a mip chain of `levels` levels (index l, level 0 included) over a lobe grid of
 /// `grid_area` lobes spaced `spacing` texels on a `map` = (width, height) map, the measured mean TV
-/// between the filtered mixture and the full mixture at footprints of 4^l lobe cells (module docs);
-/// `tv_at(footprint)` measures one footprint (`None` when the filtered mixture does not serve it).
-/// Empty when `levels` is 0.
-pub(super) fn filtered_mixture_errors(
+/// between the filtered mixture and the model's full P-NDF at footprints of 4^l lobe cells (module
+/// docs); `tv_at(footprint)` measures one footprint (`None` when the filtered mixture does not
+/// serve it). Empty when `levels` is 0.
+pub(crate) fn errors_per_level(
     levels: usize,
     grid_area: f64,
     spacing: [f64; 2],
@@ -109,7 +95,7 @@ pub(super) fn filtered_mixture_errors(
             }
             let mut sum = 0.0;
             for c in 0..CENTRES {
-                let uv = r2(1000 + c);
+                let uv = r2_f32(1000 + c);
                 let fp = Footprint::isotropic_texels(uv, (area * hx * hy) as f32, w, h);
                 sum += tv_at(&fp)?;
             }
@@ -133,7 +119,7 @@ pub(super) fn filtered_mixture_errors(
 
 /// The filtered mixture's measured error at level of detail `lod`: the larger of the two levels
 /// a trilinear lookup reads (1 where not measured, NaN `lod` → level 0).
-pub(super) fn error_at(errors: &[f32], lod: f64) -> f32 {
+pub(crate) fn error_at(errors: &[f32], lod: f64) -> f32 {
     if errors.is_empty() {
         return 1.0;
     }

@@ -1,7 +1,7 @@
-//! A small weighted set of slope Gaussians evaluated by brute force: what a mixture patch serves
-//! when its level of detail is one lobe (the filtered lobe, the sub-texel limit lobe) or the
-//! filtered mixture of a large footprint (src/glint/mixture/gmm.rs), with the terms of
-//! \[Chermain2019\] eq. 9-17 over its lobes:
+//! A small weighted set of slope Gaussians evaluated by brute force: what a glint patch serves
+//! when its level of detail is one lobe (the mixture's filtered lobe and sub-texel limit lobe) or
+//! the filtered mixture of a large footprint (gmm.rs, for the mixture and position-normal), with
+//! the terms of \[Chermain2019\] eq. 9-17 over its lobes:
 //!
 //! - D(m) = Σ w_i D_i(m);
 //! - A(w) = max(cos θ − w_xy·μ, 0), μ = Σ w_i μ_i (the signed areas summed, as the mixture's);
@@ -20,7 +20,7 @@ use glam::{Vec2, Vec3};
 
 /// A weighted set of slope Gaussians (module docs).
 #[derive(Clone, Debug, Default)]
-pub(super) struct LobeSet {
+pub(crate) struct LobeSet {
     n: usize,
     w: Vec<f32>,
     g: Vec<SlopeGaussian>,
@@ -28,7 +28,7 @@ pub(super) struct LobeSet {
 
 /// What a few-lobe patch holds: one lobe inline, or a set lent by the caller's scratch.
 #[derive(Clone, Debug)]
-pub(super) enum Few<'a> {
+pub(crate) enum Few<'a> {
     /// No lobes (a gathered patch).
     None,
     /// One lobe of weight 1.

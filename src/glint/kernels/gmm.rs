@@ -3,8 +3,9 @@
 //! keep the P-NDF's shape (the single filtered lobe of \[Chermain2019\] §4.2.2 keeps only its mean
 //! and covariance).
 //!
-//! **Build.** Level 0 is the lobes themselves (one component each, as D evaluates them: floored
-//! covariance, clamped correlation; not stored). A node of level l + 1 takes the components of its
+//! **Build.** Level 0 is the model's own lobes on a regular grid (one component each, as the
+//! model evaluates them: the mixture's lobes with their floored covariance and clamped correlation,
+//! the position-normal elements' slope marginals; not stored). A node of level l + 1 takes the components of its
 //! (up to) 2 × 2 children, each child's weights divided by the number of children, and reduces them
 //! to [`GMM_LOBES`] by greedy pairwise merging: the pair whose moment-matched merge has the smallest
 //! upper bound of the KL divergence it adds,
@@ -16,14 +17,14 @@
 //!
 //! **Lookup.** As the moment mip chain: trilinear at level log₂ √(footprint area in lobes) and the
 //! footprint's centre, a convex combination of up to 8 nodes, each weight multiplying its node's
-//! component weights (src/glint/mixture/lobe_set.rs holds the result and evaluates it).
+//! component weights (lobe_set.rs holds the result and evaluates it).
 //!
 //! Cost: ~20 ns of build per lobe (one reduction of ≤ 4 [`GMM_LOBES`] components per node), 96
 //! bytes per node of the levels ≥ 1 (≤ 32 bytes per lobe), and O(1) per query.
 
-use super::hierarchy::{bilinear_nodes, trilinear_levels};
 use super::lobe_set::LobeSet;
-use crate::glint::kernels::slope_tree::level_sizes;
+use super::mip::{bilinear_nodes, trilinear_levels};
+use super::slope_tree::level_sizes;
 use crate::ndf::SlopeGaussian;
 
 /// Components per node of the filtered mixture.
@@ -132,18 +133,23 @@ fn reduce(comps: &mut Vec<Comp>, k: usize) {
 
 /// The filtered-mixture mip chain (module docs): levels l ≥ 1, [`GMM_LOBES`] components per node.
 #[derive(Clone, Debug)]
-pub(super) struct GmmPyramid {
+pub(crate) struct GmmPyramid {
     sizes: Vec<[usize; 2]>,
     /// `levels[l - 1]`: level l's nodes, row major, each [`GMM_LOBES`] components (weight 0 pads).
     levels: Vec<Vec<[Stored; GMM_LOBES]>>,
-    /// Level 0: the lobes' raw moments (as the store holds them) and the floor σ_min.
+    /// The floor σ_min of every stored component's standard deviations.
     sigma_min: f32,
 }
 
 impl GmmPyramid {
-    /// Builds the chain over an `nx × ny` lobe grid of raw moments `lobes` (row major), each lobe
-    /// floored at `sigma_min` as D evaluates it.
-    pub fn build(nx: usize, ny: usize, lobes: &[[f32; 5]], sigma_min: f32) -> GmmPyramid {
+    /// Builds the chain over an `nx × ny` lobe grid whose lobe k (row major) is `lobe0(k)`; the
+    /// stored components are read back with their standard deviations floored at `sigma_min`.
+    pub fn build(
+        nx: usize,
+        ny: usize,
+        lobe0: impl Fn(usize) -> SlopeGaussian + Sync,
+        sigma_min: f32,
+    ) -> GmmPyramid {
         use rayon::prelude::*;
         let sizes = level_sizes(nx, ny);
         let mut levels: Vec<Vec<[Stored; GMM_LOBES]>> = Vec::new();
@@ -160,9 +166,7 @@ impl GmmPyramid {
                         let k = cy * pw + cx;
                         match prev {
                             Some(p) => comps.extend(p[k].iter().map(Comp::from_stored)),
-                            None => comps.push(Comp::of_lobe(&SlopeGaussian::from_moments(
-                                lobes[k], sigma_min,
-                            ))),
+                            None => comps.push(Comp::of_lobe(&lobe0(k))),
                         }
                     }
                 }
@@ -205,11 +209,17 @@ impl GmmPyramid {
             .sum()
     }
 
-    /// The filtered mixture of a footprint centred at `p` (level-0 lobe units) at level of detail
-    /// `lod` (clamped to [0, top], NaN → 0), into `set`: trilinear over the nodes, as the moment
-    /// mip chain (src/glint/mixture/hierarchy.rs), `lobes` the level-0 raw moments; at most 8
-    /// nodes × [`GMM_LOBES`] lobes.
-    pub fn lookup(&self, lobes: &[[f32; 5]], p: [f64; 2], lod: f64, set: &mut LobeSet) {
+    /// The filtered mixture of a footprint centred at `p` (level-0 lobe units, lobe i centred at
+    /// i + ½) at level of detail `lod` (clamped to [0, top], NaN → 0), into `set`: trilinear over
+    /// the nodes (mip.rs), `lobe0(k)` the level-0 lobes as at the build; at most 8 nodes ×
+    /// [`GMM_LOBES`] lobes.
+    pub fn lookup(
+        &self,
+        lobe0: impl Fn(usize) -> SlopeGaussian,
+        p: [f64; 2],
+        lod: f64,
+        set: &mut LobeSet,
+    ) {
         let (p, l0, t) = trilinear_levels(self.sizes.len(), p, lod);
         set.clear();
         let mut add_level = |l: usize, wl: f64| {
@@ -222,10 +232,7 @@ impl GmmPyramid {
                     continue;
                 }
                 if l == 0 {
-                    set.push(
-                        wn as f32,
-                        SlopeGaussian::from_moments(lobes[k], self.sigma_min),
-                    );
+                    set.push(wn as f32, lobe0(k));
                 } else {
                     for c in &self.levels[l - 1][k] {
                         if c[0] > 0.0 {

@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicU32, AtomicU64, Ordering, fence};
 /// One memoised f64 keyed by the bits of a direction (0 in the sequence: empty; odd: a store in
 /// progress).
 #[derive(Debug, Default)]
-pub(super) struct ViewMemo {
+pub(crate) struct ViewMemo {
     seq: AtomicU32,
     key: [AtomicU32; 3],
     value: AtomicU64,
@@ -35,7 +35,7 @@ fn key_of(w: Vec3) -> [u32; 3] {
 impl ViewMemo {
     /// The value kept for `w` if it is the last one stored, else `compute()`, stored for `w`.
     #[inline]
-    pub(super) fn get_or(&self, w: Vec3, compute: impl FnOnce() -> f64) -> f64 {
+    pub(crate) fn get_or(&self, w: Vec3, compute: impl FnOnce() -> f64) -> f64 {
         let key = key_of(w);
         if let Some(v) = self.get(key) {
             return v;
