@@ -21,10 +21,12 @@ fn view(theta_deg: f32) -> Vec3 {
     Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
 }
 
-/// Options with the exact-masking limit `limit` (texels), no smoothing.
+/// Options with the exact-masking limit `limit` (texels), no smoothing, no moment masking below
+/// the limit.
 fn options(limit: f32) -> PatchOptions {
     PatchOptions {
         exact_masking_texels: limit,
+        moment_masking_tolerance: 0.0,
         ..PatchOptions::default()
     }
 }
@@ -60,6 +62,45 @@ fn the_limit_chooses_the_masking_form() {
         };
         assert!(with(0.5 * m), "limit {limit}");
         assert!(!with(2.0 * m), "limit {limit}");
+    }
+}
+
+/// The measured G1 errors are in [0, 1], 1 below 256 texels; the tolerance chooses the moment
+/// lobe's masking below the limit exactly where its level's error is within it (0 and NaN never,
+/// ∞ from `MIN_MOMENT_MASKING_TEXELS`); the default serves it on the scratched map.
+#[test]
+fn the_tolerance_chooses_the_masking_form() {
+    for (name, map) in procedural_maps(256) {
+        let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
+        let errors = bm.moment_masking_errors().to_vec();
+        println!("{name}: {errors:?}");
+        assert!(errors.iter().all(|e| (0.0..=1.0).contains(e)), "{name}");
+        assert_eq!(errors[3], 1.0, "{name}");
+        let fp = Footprint::isotropic_texels(Vec2::new(0.41, 0.29), 1024.0, 256, 256);
+        let with = |tol: f32| {
+            let o = PatchOptions {
+                moment_masking_tolerance: tol,
+                ..PatchOptions::default()
+            };
+            bm.patch_with(&fp, &o, None).has_exact_masking()
+        };
+        let e5 = errors[5];
+        assert!(!with(e5), "{name}");
+        assert!(with(0.99 * e5), "{name}");
+        assert!(with(0.0) && with(f32::NAN), "{name}");
+        assert!(!with(f32::INFINITY), "{name}");
+        let small = Footprint::isotropic_texels(Vec2::new(0.41, 0.29), 100.0, 256, 256);
+        let inf = PatchOptions {
+            moment_masking_tolerance: f32::INFINITY,
+            ..PatchOptions::default()
+        };
+        assert!(
+            bm.patch_with(&small, &inf, None).has_exact_masking(),
+            "{name}"
+        );
+        if name == "scratched" {
+            assert!(!bm.patch(&fp).has_exact_masking(), "{name}: {errors:?}");
+        }
     }
 }
 

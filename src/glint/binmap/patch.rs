@@ -6,10 +6,10 @@
 //! # Reference
 //! \[Atanasov2020\] §2 (D_A^H), §2.2 (evaluation through 𝓑⁻¹).
 
-use super::BinMap;
 use super::clip::Parallelogram;
 use super::forest::QueryStats;
 use super::masking::{Buf, ExactMasking, PatchBin};
+use super::{BinMap, PatchOptions};
 use crate::glint::scratch::Lent;
 use crate::glint::{Footprint, GlintScratch, HemisphereBins, MIN_WIDTH_TEXELS};
 use crate::ndf::SlopeGaussian;
@@ -132,7 +132,7 @@ impl<'a> BinMapPatch<'a> {
         map: &'a BinMap,
         footprint: &Footprint,
         alpha: Option<f32>,
-        exact_masking_texels: f32,
+        options: &PatchOptions,
         scratch: Option<&'a GlintScratch>,
     ) -> Self {
         let mut bufs = Bufs::new(scratch);
@@ -174,7 +174,7 @@ impl<'a> BinMapPatch<'a> {
             bins,
             lobes,
         } = bufs;
-        let exact = (area_texels <= exact_masking_texels as f64).then(|| {
+        let exact = map.exact_masking_for(area_texels, options).then(|| {
             ExactMasking::new(map, &para, images.as_slice(), sigma, &mut acc, bins, lobes)
         });
         BinMapPatch {

@@ -218,6 +218,7 @@ impl BinMap {
             center_slope,
             facets,
             moments: MomentPyramid::from_parts(first, levels),
+            moment_masking_error: std::sync::OnceLock::new(),
         })
     }
 }

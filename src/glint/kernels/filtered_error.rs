@@ -1,10 +1,11 @@
-//! The filtered mixture's error, measured once per model: for each level l of its mip chain
-//! (gmm.rs), the mean total variation between the filtered mixture and the model's full P-NDF
-//! over footprints of 4^l lobe cells (the footprints whose lookup reads level l), so that a patch
-//! serves the filtered mixture only where it stays within the caller's tolerance of the full one
-//! (the `filtered_tolerance` of the mixture's and the position-normal map's patch options).
+//! The error of an O(1) level-of-detail form against the exact one, measured once per model: for
+//! each level l of a mip chain, the mean error over footprints of 4^l lobe cells (the footprints
+//! whose lookup reads level l), so that a patch serves the O(1) form only where it stays within the
+//! caller's tolerance. The filtered mixture (gmm.rs) of the mixture and the position-normal map is
+//! measured by the total variation to the full P-NDF ([`tv`]; their options' `filtered_tolerance`),
+//! the bin map's moment-lobe masking by its G1 error (src/glint/binmap/masking_choice.rs).
 //!
-//! **Estimator.** TV(p, q) = ½ ∫ |p − q| = E_r[|p − q| / (p + q)] with r = ½ (p + q), p and q the
+//! **TV estimator.** TV(p, q) = ½ ∫ |p − q| = E_r[|p − q| / (p + q)] with r = ½ (p + q), p and q the
 //! two patches' normal densities D(m) cos θ_m; [`SAMPLES`] normals, half drawn from each patch
 //! by its `sample_normal` on a fixed R2 sequence (deterministic), at [`CENTRES`] fixed footprint
 //! centres, averaged. The standard error of the mean is ≤ ½ / √(SAMPLES · CENTRES) ≈ 0.016.
@@ -72,10 +73,9 @@ pub(crate) fn tv(p: &impl Ndf, q: &impl Ndf) -> f64 {
 }
 
 /// Per level l of a mip chain of `levels` levels (index l, level 0 included) over a lobe grid of
-/// `grid_area` lobes spaced `spacing` texels on a `map` = (width, height) map, the measured mean TV
-/// between the filtered mixture and the model's full P-NDF at footprints of 4^l lobe cells (module
-/// docs); `tv_at(footprint)` measures one footprint (`None` when the filtered mixture does not
-/// serve it). Empty when `levels` is 0.
+/// `grid_area` lobes spaced `spacing` texels on a `map` = (width, height) map, the measured mean
+/// error of the O(1) form at footprints of 4^l lobe cells (module docs); `tv_at(footprint)` measures
+/// one footprint (`None` when the O(1) form does not serve it). Empty when `levels` is 0.
 pub(crate) fn errors_per_level(
     levels: usize,
     grid_area: f64,
