@@ -89,7 +89,9 @@ impl BinMap {
             return false;
         }
         let tolerance = options.moment_masking_tolerance;
-        if area <= MIN_MOMENT_MASKING_TEXELS as f64 || !(tolerance > 0.0) {
+        // NaN and non-positive tolerances never serve the lobe.
+        let positive = tolerance > 0.0;
+        if area <= MIN_MOMENT_MASKING_TEXELS as f64 || !positive {
             return true;
         }
         // The 256-texel level for 128-256 texels (module docs).
