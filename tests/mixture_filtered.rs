@@ -1,4 +1,4 @@
-//! The mixture's filtered mixture (src/glint/mixture/gmm.rs, calibrate.rs): when the default
+//! The mixture's filtered mixture (src/glint/kernels/gmm.rs, filtered_error.rs): when the default
 //! options serve it, both samplers against their pdfs, the white furnace in the renderer's
 //! measure, its measured error, and its distance to the σ_ε-convolved truth against the single
 //! filtered lobe's.

@@ -23,6 +23,8 @@ struct Input {
     smoothing_alpha: f32,
     /// The masking level of detail: any value (NaN, negative, huge) must give a total patch.
     exact_masking_texels: f32,
+    /// The tolerance on the moment lobe's measured masking error: any value must give a total patch.
+    moment_masking_tolerance: f32,
     footprint: FootprintInput,
     probe: Probe,
 }
@@ -52,6 +54,7 @@ fuzz_target!(|input: Input| {
         &brdf::glint::binmap::PatchOptions {
             smoothing_alpha: input.smoothing_alpha,
             exact_masking_texels: input.exact_masking_texels,
+            moment_masking_tolerance: input.moment_masking_tolerance,
         },
         None,
     );

@@ -1,5 +1,6 @@
 //! Position-normal Gaussians (Yan 2016): build on an arbitrary small map with arbitrary parameters,
-//! patch through an arbitrary footprint with an arbitrary footprint cap, query and sample the patch, the published BRDF and ours.
+//! patch through an arbitrary footprint with an arbitrary footprint cap and filtered-mixture
+//! switch, query and sample the patch, the published BRDF and ours.
 #![no_main]
 
 use arbitrary::Arbitrary;
@@ -17,6 +18,8 @@ struct Input {
     weight_sigmas: f32,
     slope_sigmas: f32,
     max_query_texels: f32,
+    filtered_area: f32,
+    filtered_tolerance: f32,
     footprint: FootprintInput,
     probe: Probe,
 }
@@ -35,6 +38,8 @@ fuzz_target!(|input: Input| {
     // Per-query options are not validated: every cap must give a total patch.
     let options = PatchOptions {
         max_query_texels: input.max_query_texels,
+        filtered_area: input.filtered_area,
+        filtered_tolerance: input.filtered_tolerance,
     };
     let patch = model.patch_with(&input.footprint.build(), &options, None);
     check_ndf(&patch, &input.probe);

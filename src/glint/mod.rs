@@ -230,4 +230,10 @@ pub trait GlintNdf {
     fn patch_in<'a>(&'a self, footprint: &Footprint, scratch: &'a GlintScratch) -> Self::Patch<'a> {
         self.patch_with(footprint, &Self::Options::default(), Some(scratch))
     }
+
+    /// Builds and measures now what the model otherwise builds on the first footprint that needs
+    /// it (the measured errors its level of detail is chosen by, the filtered chains), so that no
+    /// frame pays for it: a renderer calls it once after loading. Deterministic; never needed for
+    /// correctness. The default does nothing (a model with nothing deferred).
+    fn prepare(&self) {}
 }

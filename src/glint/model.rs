@@ -148,6 +148,12 @@ macro_rules! glint_models {
                     )+
                 }
             }
+
+            fn prepare(&self) {
+                match self {
+                    $( GlintModel::$variant(m) => m.prepare(), )+
+                }
+            }
         }
 
         /// Forwards one `Ndf` method to the variant's patch.

@@ -584,6 +584,11 @@ impl GlintNdf for BinMap {
             .then(|| alpha.clamp(crate::ndf::MIN_ALPHA, crate::ndf::MAX_ALPHA));
         BinMapPatch::new(self, footprint, alpha, options, scratch)
     }
+
+    /// Measures the moment-lobe masking's errors ([`BinMap::moment_masking_errors`]).
+    fn prepare(&self) {
+        self.moment_masking_errors();
+    }
 }
 
 #[cfg(test)]

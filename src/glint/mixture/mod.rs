@@ -20,7 +20,7 @@
 //!   sub-texel limit lobe (the interpolated slope at the footprint's centre, spread by the slope
 //!   variation the footprint covers and σ_ε: sub_texel.rs); from [`DEFAULT_FILTERED_AREA`] texels
 //!   the filtered mixture ([`GMM_LOBES`] lobes per node of a mip chain, O(1) per query: gmm.rs)
-//!   wherever its TV to the full mixture, measured per mixture (calibrate.rs), is within
+//!   wherever its TV to the full mixture, measured per mixture (src/glint/kernels/filtered_error.rs), is within
 //!   [`PatchOptions::filtered_tolerance`]; otherwise the lobes gathered over the footprint, on the
 //!   coarsest level of merged lobes whose error bound meets [`PatchOptions::lod_tolerance`] and the
 //!   cost cap [`PatchOptions::lod_lobes`].
@@ -41,7 +41,7 @@
 //!    (the sub-texel limit lobe), `full.rs` and `compact.rs` (its two implementations),
 //!    `compact_encode.rs` (the compact encoder);
 //! 6. `model.rs` ([`BeckmannMixture`]: build and accessors), `store.rs` (save and load);
-//! 7. `calibrate.rs` (the filtered mixture's measured error), `gather.rs` (per-footprint work:
+//! 7. `gather.rs` (per-footprint work:
 //!    level choice, weights), `passes.rs` (the per-query loops over blocks, generic over the
 //!    storage), `patch.rs` ([`MixturePatch`]);
 //! 8. this file: the re-exports, `impl GlintNdf` and the filtered mixture's measured errors
@@ -140,5 +140,11 @@ impl GlintNdf for BeckmannMixture {
         scratch: Option<&'a GlintScratch>,
     ) -> MixturePatch<'a> {
         MixturePatch::new(self, footprint, *options, scratch)
+    }
+
+    /// Measures the filtered mixture's errors ([`BeckmannMixture::filtered_mixture_errors`]; ~0.1-0.3
+    /// s, nothing under compact storage).
+    fn prepare(&self) {
+        self.filtered_mixture_errors();
     }
 }

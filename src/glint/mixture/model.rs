@@ -66,7 +66,7 @@ pub struct BeckmannMixture {
     /// Half-width of the slope boxes in lobe standard deviations, k = √(−2 ln tail).
     box_k: f32,
     /// The filtered mixture's measured TV to the full mixture per level of its mip chain
-    /// (calibrate.rs), measured on first use; empty without a filtered mixture (compact storage).
+    /// (src/glint/kernels/filtered_error.rs), measured on first use; empty without a filtered mixture (compact storage).
     filtered_error: std::sync::OnceLock<Vec<f32>>,
 }
 

@@ -90,7 +90,7 @@ pub const DEFAULT_LOD_TOLERANCE: f32 = 0.01;
 pub const DEFAULT_SUB_TEXEL_AREA: f32 = 2.0;
 
 /// Default footprint area, in lobe cells (texels at the default spacing), at and above which a
-/// patch is the filtered mixture (src/glint/mixture/gmm.rs): [`GMM_LOBES`](super::GMM_LOBES) lobes
+/// patch is the filtered mixture (src/glint/kernels/gmm.rs): [`GMM_LOBES`](super::GMM_LOBES) lobes
 /// per node of a mip chain, read trilinearly, O(1) per query whatever the footprint (full storage;
 /// compact storage serves the filtered lobe there).
 ///
@@ -100,7 +100,7 @@ pub const DEFAULT_SUB_TEXEL_AREA: f32 = 2.0;
 pub const DEFAULT_FILTERED_AREA: f32 = 4096.0;
 
 /// Default tolerance of the filtered mixture: the largest TV to the full mixture, measured per
-/// mixture and level at build time (src/glint/mixture/calibrate.rs), at which it serves a large
+/// mixture and level at build time (src/glint/kernels/filtered_error.rs), at which it serves a large
 /// footprint. See docs/results.md, "Cost and error of a shading point against footprint".
 pub const DEFAULT_FILTERED_TOLERANCE: f32 = 0.15;
 
@@ -333,7 +333,7 @@ pub struct PatchOptions {
     pub filtered_area: f32,
     /// Largest measured TV between the filtered mixture and the full mixture at the footprint's
     /// level ([`DEFAULT_FILTERED_TOLERANCE`]; measured per mixture on first use,
-    /// src/glint/mixture/calibrate.rs) at which the filtered mixture serves a footprint of at
+    /// src/glint/kernels/filtered_error.rs) at which the filtered mixture serves a footprint of at
     /// least `filtered_area`; above it the footprint is gathered (the level of detail and the
     /// cost cap `lod_lobes` decide). `f32::INFINITY` always serves it.
     pub filtered_tolerance: f32,

@@ -77,7 +77,7 @@ impl PatchLevel<'_> {
 /// - Few-lobe forms (one slope Gaussian or a few, evaluated by brute force, O(1) per query):
 ///   below [`PatchOptions::sub_texel_area`] the sub-texel limit lobe
 ///   (src/glint/mixture/sub_texel.rs); from [`PatchOptions::filtered_area`] the filtered mixture
-///   (src/glint/mixture/gmm.rs) where its measured TV to the full mixture
+///   (src/glint/kernels/gmm.rs) where its measured TV to the full mixture
 ///   ([`BeckmannMixture::filtered_mixture_errors`]) is within
 ///   [`PatchOptions::filtered_tolerance`], and beyond the cost cap; compact storage serves the
 ///   single filtered lobe there. Their masking is exact (V = Σ w_i V_i, V(wo) kept per view).
@@ -197,7 +197,7 @@ impl<'a> MixturePatch<'a> {
     }
 
     /// Whether the patch is the filtered mixture: [`super::GMM_LOBES`] lobes per node of a mip
-    /// chain read trilinearly (src/glint/mixture/gmm.rs), for footprints of at least
+    /// chain read trilinearly (src/glint/kernels/gmm.rs), for footprints of at least
     /// [`PatchOptions::filtered_area`] (or beyond the cost cap), full storage.
     pub fn is_filtered_mixture(&self) -> bool {
         self.few_kind == Some(SetKind::FilteredMixture)

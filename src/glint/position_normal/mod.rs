@@ -371,4 +371,10 @@ impl GlintNdf for PositionNormalMap {
     ) -> PositionNormalPatch<'a> {
         PositionNormalPatch::new(self, footprint, options, scratch)
     }
+
+    /// Builds the filtered mixture's chain and measures its errors
+    /// ([`PositionNormalMap::filtered_mixture_errors`]).
+    fn prepare(&self) {
+        self.filtered_mixture_errors();
+    }
 }
