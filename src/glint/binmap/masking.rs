@@ -7,8 +7,10 @@
 //! \[Chermain2019\] eq. 13-17 (exact Smith terms of a sum of lobes), over the bins of
 //! \[Atanasov2020\] §2.
 
+use super::BinMap;
 use super::clip::{Overlap, Parallelogram};
-use super::{BinFacet, BinMap};
+use super::facets::BinFacet;
+
 use crate::glint::HemisphereBins;
 use crate::glint::scratch::Lent;
 use crate::math::finite_or_zero;

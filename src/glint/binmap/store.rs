@@ -152,7 +152,7 @@ impl BinMap {
         // fingerprint is taken chunk by chunk as 𝓑 is read.
         let (mut tables, mut forest) = (None, None);
         let read = rayon::in_place_scope(|outer| {
-            outer.spawn(|_| tables = Some(super::bin_tables(&bins, &offsets)));
+            outer.spawn(|_| tables = Some(super::facets::bin_tables(&bins, &offsets)));
             let inverse = flat(d.array::<u32, 1>("inverse", texels)?);
             let rest = rayon::in_place_scope(|inner| {
                 if offsets_ok.is_ok() {
