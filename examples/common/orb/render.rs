@@ -382,6 +382,9 @@ pub fn build_methods(opts: &OrbOptions, map: &NormalMap) -> Res<Vec<OrbMethod>> 
     };
     let mixture: Arc<GlintModel> =
         Arc::new(BeckmannMixture::build_with_progress(map, params, Some(&progress))?.into());
+    // What each model measures for its level of detail is part of its build time, so that no
+    // render pays it.
+    mixture.prepare();
     build_bar.finish();
     let mixture_build = t.elapsed().as_secs_f64();
     let variant = |masking, lod_lobes| {
@@ -401,6 +404,7 @@ pub fn build_methods(opts: &OrbOptions, map: &NormalMap) -> Res<Vec<OrbMethod>> 
         ..BinMapParams::default()
     };
     let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, binmap_params)?.into());
+    binmap.prepare();
     let binmap_build = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let pn = |sigma_r| {
@@ -411,7 +415,10 @@ pub fn build_methods(opts: &OrbOptions, map: &NormalMap) -> Res<Vec<OrbMethod>> 
                 ..PositionNormalParams::default()
             },
         )
-        .map(|m| Configured::new(Arc::new(m.into())))
+        .map(|m| {
+            m.prepare();
+            Configured::new(Arc::new(m.into()))
+        })
     };
     let position_normal = pn(sigma)?;
     let position_normal_build = t.elapsed().as_secs_f64();

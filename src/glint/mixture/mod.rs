@@ -19,11 +19,11 @@
 //!   renderer never has to set, [`PatchOptions`]): below [`DEFAULT_SUB_TEXEL_AREA`] texels the
 //!   sub-texel limit lobe (the interpolated slope at the footprint's centre, spread by the slope
 //!   variation the footprint covers and σ_ε: sub_texel.rs); from [`DEFAULT_FILTERED_AREA`] texels
-//!   the filtered mixture ([`GMM_LOBES`] lobes per node of a mip chain, O(1) per query: gmm.rs)
-//!   wherever its TV to the full mixture, measured per mixture (src/glint/kernels/filtered_error.rs), is within
-//!   [`PatchOptions::filtered_tolerance`]; otherwise the lobes gathered over the footprint, on the
-//!   coarsest level of merged lobes whose error bound meets [`PatchOptions::lod_tolerance`] and the
-//!   cost cap [`PatchOptions::lod_lobes`].
+//!   the filtered mixture ([`GMM_LOBES`] lobes per node of a mip chain, O(1) per query:
+//!   src/glint/kernels/gmm.rs) wherever its TV to the full mixture, measured per mixture
+//!   (src/glint/kernels/filtered_error.rs), is within [`PatchOptions::filtered_tolerance`];
+//!   otherwise the lobes gathered over the footprint, on the coarsest level of merged lobes whose
+//!   error bound meets [`PatchOptions::lod_tolerance`] and the cost cap [`PatchOptions::lod_lobes`].
 //!
 //! The model, the hierarchy layout, the deviations from the paper and the defaults with their
 //! measurements are in docs/mixture.md.
@@ -34,16 +34,16 @@
 //! 2. `build.rs` (QMC moments), `build_filter.rs` (the separable filter's moments);
 //! 3. `lanes.rs` (lane arithmetic: `exp2`, the ramp term), `blocks.rs` (the 4 × 4 lobe blocks, their
 //!    lane kernels and the walk to them), `simd.rs` (the baseline and AVX2 copies of the block loops);
-//! 4. `hierarchy.rs` (slope boxes, moment mip chain), `lobe_set.rs` (a few weighted lobes evaluated
-//!    by brute force), `gmm.rs` (the filtered mixture's mip chain), `levels.rs` (merged levels of
-//!    detail and their error bounds);
+//! 4. `hierarchy.rs` (slope boxes, moment mip chain), `levels.rs` (merged levels of detail and
+//!    their error bounds); the filtered mixture's kernels (a few weighted lobes evaluated by brute
+//!    force, its mip chain, its measured error, the view memo) are shared with the position-normal
+//!    map in src/glint/kernels/;
 //! 5. `storage.rs` (the crate-private storage interface `LobeStore` / `LevelView`), `sub_texel.rs`
 //!    (the sub-texel limit lobe), `full.rs` and `compact.rs` (its two implementations),
 //!    `compact_encode.rs` (the compact encoder);
 //! 6. `model.rs` ([`BeckmannMixture`]: build and accessors), `store.rs` (save and load);
-//! 7. `gather.rs` (per-footprint work:
-//!    level choice, weights), `passes.rs` (the per-query loops over blocks, generic over the
-//!    storage), `patch.rs` ([`MixturePatch`]);
+//! 7. `gather.rs` (per-footprint work: level choice, weights), `passes.rs` (the per-query loops over
+//!    blocks, generic over the storage), `patch.rs` ([`MixturePatch`]);
 //! 8. this file: the re-exports, `impl GlintNdf` and the filtered mixture's measured errors
 //!    ([`BeckmannMixture::filtered_mixture_errors`], which builds patches); and the unit
 //!    test of the runtime dispatch (`dispatch_tests.rs`).
