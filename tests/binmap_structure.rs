@@ -273,3 +273,51 @@ fn rotated_footprint_masses_match_point_sampling() {
         }
     }
 }
+
+/// A patch with exact masking terms reads mass_j from the footprint's listed bins: equal to the
+/// bin's forest query (the same overlaps summed in another order) for every bin, on footprints from
+/// sub-texel to larger than the map, crossing the map's borders, at s = 1 and 2; and the listed
+/// masses sum to 1.
+#[test]
+fn listed_bin_masses_equal_the_forest_queries() {
+    use brdf::glint::binmap::PatchOptions;
+    let map = noise(48, 40, 0.5, 9);
+    let (w, h) = (48usize, 40usize);
+    let exact = PatchOptions {
+        exact_masking_texels: f32::INFINITY,
+        moment_masking_tolerance: 0.0,
+        ..PatchOptions::default()
+    };
+    for sub in [1, 2] {
+        let p = BinMapParams {
+            subdivisions: sub,
+            ..params(9, 4, BinLookup::Dense)
+        };
+        let bm = BinMap::build(&map, p).unwrap();
+        for (c, area, aspect, angle) in [
+            (Vec2::new(0.5, 0.5), 0.3, 1.0, 0.0),
+            (Vec2::new(0.31, 0.72), 2.5, 2.0, 0.9),
+            (Vec2::new(0.97, 0.03), 40.0, 8.0, 2.1),
+            (Vec2::new(0.2, 0.4), 3000.0, 1.5, 0.4),
+        ] {
+            let fp = Footprint::anisotropic_texels(c, area, aspect, angle, w, h);
+            let patch = bm.patch_with(&fp, &exact, None);
+            let sub_area = patch.area_texels() * (sub * sub) as f64;
+            let mut total = 0.0;
+            for bin in 0..bm.bins().len() {
+                let listed = patch.bin_mass(bin);
+                let forest = patch.bin_overlap_with_stats(bin).0 / sub_area;
+                total += listed;
+                // f64 rounding of up to ~10⁴ overlaps summed in two orders: 1e-12.
+                assert!(
+                    (listed - forest).abs() < 1e-12,
+                    "s={sub} {c} area {area} bin {bin}: {listed} vs {forest}"
+                );
+            }
+            assert!(
+                (total - 1.0).abs() < 1e-9,
+                "s={sub} {c} area {area}: Σ {total}"
+            );
+        }
+    }
+}

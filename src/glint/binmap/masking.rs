@@ -98,6 +98,8 @@ fn sort_by_bin(acc: &mut Vec<(u32, f64)>, bins: usize) -> &[(u32, f64)] {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct PatchBin {
     pub(super) bin: u32,
+    /// mass_j = Σ_k I_{H_j}(t_k) |A ∩ T_k| / |A|, the same sum as the forest's query of bin j.
+    pub(super) mass: f64,
     /// s_j = mass_j / c̄_j: the bin's D times |H|.
     pub(super) scale: f32,
     /// The bin's tabulated facet (mean direction, centre, radius; unscaled).
@@ -200,6 +202,7 @@ impl<'a> ExactMasking<'a> {
             };
             bins_out.push(PatchBin {
                 bin: bin as u32,
+                mass: mass * inv_area,
                 scale: scale as f32,
                 facet: f,
                 corners: [c00, corner(1.0, 0.0), c01, corner(1.0, 1.0)],
@@ -212,6 +215,21 @@ impl<'a> ExactMasking<'a> {
             a: Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32),
             heavy_scale: REFINE_SHARE * total,
         }
+    }
+
+    /// mass_j of `bin` from the footprint's listed bins (0 for a bin the footprint does not touch),
+    /// or `None` when the patch lists no bins (smoothed): a binary search instead of the bin's forest
+    /// query, which sums the same overlaps in another order (equal to f64 rounding).
+    #[inline]
+    pub(super) fn bin_mass(&self, bin: usize) -> Option<f64> {
+        let bins = self.bins.as_slice();
+        if bins.is_empty() {
+            return None;
+        }
+        let found = u32::try_from(bin)
+            .ok()
+            .and_then(|b| bins.binary_search_by_key(&b, |p| p.bin).ok());
+        Some(found.map_or(0.0, |k| bins[k].mass))
     }
 
     /// V(w) = Σ_j s_j (1/|H|) ∫_{H_j} ⟨w, m⟩⁺ dω, exact for the bins that face w entirely and bounded
@@ -360,6 +378,7 @@ mod tests {
                 let facet = BinFacet::new(&bins, bin);
                 let b = PatchBin {
                     bin: bin as u32,
+                    mass: 1.0,
                     scale: 1.0,
                     facet,
                     corners: [Vec3::Z; 4],

@@ -314,8 +314,12 @@ impl<'a> BinMapPatch<'a> {
     }
 
     /// mass_j = Σ_k I_{H_j}(t_k) |A ∩ T_k| / |A| = ∫_{H_j} D cos θ dω for the unsmoothed patch
-    /// (\[Atanasov2020\] §2, times |H|). Σ_j mass_j = 1.
+    /// (\[Atanasov2020\] §2, times |H|). Σ_j mass_j = 1. Read from the footprint's listed bins when
+    /// the patch has exact masking terms (they hold the same sums), otherwise one forest query.
     pub fn bin_mass(&self, bin: usize) -> f64 {
+        if let Some(mass) = self.exact.as_ref().and_then(|e| e.bin_mass(bin)) {
+            return mass;
+        }
         self.bin_overlap_with_stats(bin).0 / self.para.area()
     }
 
