@@ -1,6 +1,7 @@
 //! The bin-map P-NDF of one footprint: the patch and its construction (periodic images, masking
-//! lobe, exact masking terms for small footprints), bin masses through the forest,
-//! D = mass / (|H| c̄) and the smoothed variant. The exact masking terms are in `masking`, the
+//! lobe, exact masking terms for small footprints), bin masses (from the footprint's listed bins
+//! when it has exact masking terms, through the forest otherwise), D = mass / (|H| c̄) and the
+//! smoothed variant. The exact masking terms are in `masking`, the
 //! samplers and the [`Ndf`](crate::ndf::Ndf) implementation in `sampling`.
 //!
 //! # Reference
