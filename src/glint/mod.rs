@@ -30,7 +30,7 @@
 //! |---|---|---|
 //! | below ~10 | naive normal mapping, a few samples per pixel (the mixture on scratched and flakes) | every glint model once its build counts (the mixture at `spacing` 0.25 reaches 0.01-0.14, at 8-12× the render time and 16× the build) |
 //! | ~10 to ~2 000 | the mixture (2.5-26× sooner than naive to its error: 0.03-0.43 at 9-34 texels per pixel, 0.009-0.10 at ~2 000), position-normal to 0.1 on flakes, the bin map to 0.2 where its moment-lobe masking serves (scratched, brushed) | any model for errors below 0.1 at ~34 texels per pixel (the mixture's floor there is one Gaussian per bilinear patch) |
-//! | beyond ~10⁵ (distant surfaces) | the mixture's filtered mixture to 0.1-0.2 (13-344× sooner than naive), the bin map smoothed at σ_ε to 0.05 and below (0.000-0.064) | position-normal for errors below 0.1 (its filtered mixture: as fast, 0.10-0.19); glints on flakes (nothing reaches 0.1) |
+//! | beyond ~10⁵ (distant surfaces) | the mixture's filtered mixture to 0.1-0.2 (13-345× sooner than naive), the bin map smoothed at σ_ε to 0.05 and below (0.000-0.064) | position-normal for errors below 0.1 (its filtered mixture: as fast, 0.10-0.19); glints on flakes (nothing reaches 0.1) |
 //!
 //! Cost of one renderer shading point at each footprint (every model at its defaults, against an
 //! analytic GGX one): docs/results.md, "Cost and error of a shading point against footprint". Each
