@@ -10,7 +10,6 @@
 use super::BinMap;
 use super::clip::{Overlap, Parallelogram};
 use super::facets::BinFacet;
-
 use crate::glint::HemisphereBins;
 use crate::glint::scratch::Lent;
 use crate::math::finite_or_zero;

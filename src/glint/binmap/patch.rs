@@ -1,8 +1,8 @@
 //! The bin-map P-NDF of one footprint: the patch and its construction (periodic images, masking
 //! lobe, exact masking terms for small footprints), bin masses (from the footprint's listed bins
 //! when it has exact masking terms, through the forest otherwise), D = mass / (|H| c̄) and the
-//! smoothed variant. The exact masking terms are in `masking`, the
-//! samplers and the [`Ndf`](crate::ndf::Ndf) implementation in `sampling`.
+//! smoothed variant. The exact masking terms are in `masking`, the samplers and the
+//! [`Ndf`](crate::ndf::Ndf) implementation in `sampling`.
 //!
 //! # Reference
 //! \[Atanasov2020\] §2 (D_A^H), §2.2 (evaluation through 𝓑⁻¹).
