@@ -277,7 +277,7 @@ fn rotated_footprint_masses_match_point_sampling() {
 /// A patch with exact masking terms reads mass_j from the footprint's listed bins: equal to the
 /// bin's forest query (the same overlaps summed in another order) for every bin, on footprints from
 /// sub-texel to larger than the map, crossing the map's borders, at s = 1 and 2; and the listed
-/// masses sum to 1.
+/// masses sum to 1. A patch without them returns the forest query itself, also when it is kept.
 #[test]
 fn listed_bin_masses_equal_the_forest_queries() {
     use brdf::glint::binmap::PatchOptions;
@@ -318,6 +318,26 @@ fn listed_bin_masses_equal_the_forest_queries() {
                 (total - 1.0).abs() < 1e-9,
                 "s={sub} {c} area {area}: Σ {total}"
             );
+            // Without exact terms (the moment lobe's masking, from 128 texels) every bin's mass is
+            // its forest query, the same when asked again (kept) and after another bin.
+            if area < 128.0 {
+                continue;
+            }
+            let lobe = PatchOptions {
+                exact_masking_texels: 0.0,
+                ..exact
+            };
+            let patch = bm.patch_with(&fp, &lobe, None);
+            for bin in 0..bm.bins().len() {
+                let forest = patch.bin_overlap_with_stats(bin).0 / sub_area;
+                let first = patch.bin_mass(bin);
+                let again = patch.bin_mass(bin);
+                let other = patch.bin_mass((bin + 1) % bm.bins().len());
+                assert!(
+                    (first - forest).abs() < 1e-12 && again == first && other >= 0.0,
+                    "s={sub} {c} area {area} bin {bin}: {first}, {again} vs {forest}"
+                );
+            }
         }
     }
 }

@@ -11,6 +11,7 @@ use super::clip::Parallelogram;
 use super::forest::QueryStats;
 use super::masking::{Buf, ExactMasking, PatchBin};
 use super::{BinMap, PatchOptions};
+use crate::glint::kernels::view_memo::ViewMemo;
 use crate::glint::scratch::Lent;
 use crate::glint::{Footprint, GlintScratch, HemisphereBins, MIN_WIDTH_TEXELS};
 use crate::ndf::SlopeGaussian;
@@ -101,6 +102,9 @@ pub struct BinMapPatch<'a> {
     pub(super) exact: Option<ExactMasking<'a>>,
     /// Smoothing lobes' slope σ, if any.
     pub(super) sigma: Option<f64>,
+    /// The last bin mass a forest query gave (keyed by the bin): D and the sampler's pdf at one
+    /// direction, as `sample` and `eval_pdf` ask them, query the forest once.
+    mass_memo: ViewMemo,
 }
 
 /// The buffers of one patch under construction: the footprint's periodic images and, for
@@ -185,6 +189,7 @@ impl<'a> BinMapPatch<'a> {
             lobe,
             exact,
             sigma,
+            mass_memo: ViewMemo::default(),
         }
     }
 
@@ -279,7 +284,7 @@ impl<'a> BinMapPatch<'a> {
         let (n, nr) = (bins.n(), grid.n());
         let mut out = vec![0.0f64; grid.len()];
         for bin in 0..bins.len() {
-            let mass = self.bin_mass(bin);
+            let mass = self.listed_or_forest_mass(bin);
             if mass <= 0.0 {
                 continue;
             }
@@ -316,11 +321,30 @@ impl<'a> BinMapPatch<'a> {
 
     /// mass_j = Σ_k I_{H_j}(t_k) |A ∩ T_k| / |A| = ∫_{H_j} D cos θ dω for the unsmoothed patch
     /// (\[Atanasov2020\] §2, times |H|). Σ_j mass_j = 1. Read from the footprint's listed bins when
-    /// the patch has exact masking terms (they hold the same sums), otherwise one forest query.
+    /// the patch has exact masking terms (they hold the same sums), otherwise one forest query, kept
+    /// for the next call with the same bin (D and the sampler's pdf at one direction, as `sample`
+    /// and `eval_pdf` ask them).
     pub fn bin_mass(&self, bin: usize) -> f64 {
         if let Some(mass) = self.exact.as_ref().and_then(|e| e.bin_mass(bin)) {
             return mass;
         }
+        let Ok(key) = u32::try_from(bin) else {
+            return 0.0;
+        };
+        self.mass_memo
+            .get_or_key([key, 0, 0], || self.forest_mass(bin))
+    }
+
+    /// mass_j from the listed bins or one forest query, not kept: for loops over many bins.
+    fn listed_or_forest_mass(&self, bin: usize) -> f64 {
+        match self.exact.as_ref().and_then(|e| e.bin_mass(bin)) {
+            Some(mass) => mass,
+            None => self.forest_mass(bin),
+        }
+    }
+
+    /// mass_j by the bin's forest query.
+    fn forest_mass(&self, bin: usize) -> f64 {
         self.bin_overlap_with_stats(bin).0 / self.para.area()
     }
 
@@ -385,7 +409,7 @@ impl<'a> BinMapPatch<'a> {
             let (dx, dy) = (sx - c.x as f64, sy - c.y as f64);
             let q = dx * dx + dy * dy;
             if q <= r * r {
-                let mass = self.bin_mass(bin);
+                let mass = self.listed_or_forest_mass(bin);
                 if mass > 0.0 {
                     sum += mass * norm * (-q * inv2s2).exp();
                 }

@@ -2,6 +2,9 @@
 //! that the queries a renderer makes at one shading point and one wo (`eval` and `pdf` at a few
 //! wi, `sample`) pay the pass over the patch's lobes once instead of once per query.
 //!
+//! The same memo keyed by any three `u32` ([`ViewMemo::get_or_key`]) keeps another per-patch
+//! value that consecutive queries share (the bin map's last bin mass).
+//!
 //! Patches are shared between threads (the truth integrators run them under rayon), so the memo is
 //! `Send + Sync` without a lock: a sequence lock over atomics. A reader that races a writer sees a
 //! changed sequence number and computes V itself; a writer that finds another writer at work skips
@@ -36,7 +39,12 @@ impl ViewMemo {
     /// The value kept for `w` if it is the last one stored, else `compute()`, stored for `w`.
     #[inline]
     pub(crate) fn get_or(&self, w: Vec3, compute: impl FnOnce() -> f64) -> f64 {
-        let key = key_of(w);
+        self.get_or_key(key_of(w), compute)
+    }
+
+    /// The value kept for `key` if it is the last one stored, else `compute()`, stored for `key`.
+    #[inline]
+    pub(crate) fn get_or_key(&self, key: [u32; 3], compute: impl FnOnce() -> f64) -> f64 {
         if let Some(v) = self.get(key) {
             return v;
         }
