@@ -19,7 +19,7 @@
 //! Run: `cargo bench --bench mixture -- --warm-up-time 0.5 --measurement-time 2 --sample-size 10`
 //! (the queries only: append `'^mixture_(patch|d|lambda_exact|sample_visible|eval_pdf)/'`; one map:
 //! e.g. `/bumpy/`; build times at 2048²:
-//! `cargo test --release --test mixture_measure -- --ignored build_2048 --nocapture`).
+//! `cargo test --release --test it -- --ignored mixture::build_2048 --nocapture`).
 
 use brdf::fresnel::NoFresnel;
 use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams, PatchOptions};

@@ -2,6 +2,7 @@
 //! `MicrofacetBrdf` over every glint model allocate nothing. A counting global allocator (this test
 //! binary's own) counts the allocations made on the test's thread.
 
+#[path = "it/support/mod.rs"]
 mod support;
 
 use brdf::bxdf::{Bxdf, MicrofacetBrdf};
@@ -79,7 +80,7 @@ fn shade(
 #[test]
 fn shading_allocates_nothing_after_warm_up() {
     let map = brdf::glint::flakes(64, 64, Default::default(), 3).unwrap();
-    // Every registered model, each storage, masking mode and smoothing (tests/support/registry.rs).
+    // Every registered model, each storage, masking mode and smoothing (tests/it/support/registry.rs).
     let examples = support::registry::examples(&map);
     let footprints: Vec<Footprint> = [0.3f32, 4.0, 50.0, 700.0, 3000.0]
         .iter()

@@ -3,12 +3,15 @@
 //!
 //! `cargo test --features serde --test serde` (CI runs it).
 
+#[path = "it/support/mod.rs"]
 mod support;
 
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::MixtureParams;
 use brdf::glint::position_normal::PositionNormalParams;
-use brdf::glint::{BeckmannMixture, BinMap, Footprint, GlintNdf, NormalMap, PositionNormalMap};
+use brdf::glint::{
+    BeckmannMixture, BinMap, Footprint, GlintModel, GlintNdf, NormalMap, PositionNormalMap,
+};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 
@@ -91,4 +94,19 @@ fn damaged_bytes_are_errors() {
     assert!(postcard::from_bytes::<NormalMap>(&bytes[..bytes.len() - 9]).is_err());
     // A normal map's bytes are not a bin map.
     assert!(postcard::from_bytes::<BinMap>(&bytes).is_err());
+}
+
+#[test]
+fn every_registered_model_round_trips_through_serde() {
+    let map = brdf::glint::scratched(32, 32, Default::default(), 11).unwrap();
+    for ex in support::registry::examples(&map) {
+        let bytes = postcard::to_allocvec(&ex.model).unwrap();
+        let back: GlintModel = postcard::from_bytes(&bytes).unwrap();
+        assert_eq!(
+            support::registry::fingerprint(&back, &ex.options),
+            support::registry::fingerprint(&ex.model, &ex.options),
+            "{}",
+            ex.label
+        );
+    }
 }

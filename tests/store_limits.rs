@@ -32,8 +32,8 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static A: Counting = Counting;
 
-/// The documented checksum (docs/format.md), shared with tests/store_*.rs.
-#[path = "support/format.rs"]
+/// The documented checksum (docs/format.md), shared with tests/it/store_*.rs.
+#[path = "it/support/format.rs"]
 mod format;
 use format::reseal;
 

@@ -84,7 +84,7 @@ fn furnace_against_alpha(out: &Path, n: usize) -> Res<Artifact> {
              and EnergyCompensated, GGX and Beckmann, against α at θo = 0°, 60°, 85°: the \
              single-scattering loss and its compensation to 1. The compensated curves' wiggles at \
              θo = 85° and α < 0.1 are Monte Carlo noise of the cosine-sampled compensation lobe, \
-             not bias (the quadrature furnace is 1 within 0.5 %, tests/energy_compensation.rs) \
+             not bias (the quadrature furnace is 1 within 0.5 %, tests/it/energy_compensation.rs) \
              (energy example)."
         ),
     ))

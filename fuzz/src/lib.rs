@@ -1,5 +1,5 @@
 //! Shared pieces of the fuzz targets: arbitrary inputs built from raw bytes, and the totality checks
-//! of `tests/support/totality.rs` (finite, ≥ 0 where it is a density or a value, a sample only with a
+//! of `tests/it/support/totality.rs` (finite, ≥ 0 where it is a density or a value, a sample only with a
 //! positive pdf, never a panic).
 //!
 //! A failed check panics with the offending input, which libFuzzer records as a crash artefact.
@@ -10,7 +10,7 @@ use brdf::ndf::Ndf;
 use brdf::{Bxdf, Vec2, Vec3};
 
 /// The checks themselves, shared with the property tests of the crate.
-#[path = "../../tests/support/totality.rs"]
+#[path = "../../tests/it/support/totality.rs"]
 pub mod totality;
 
 /// A normal map of 1 to 12 texels per side from raw slopes (repeated to fill it; any f32, so NaN,

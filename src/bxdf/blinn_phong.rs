@@ -18,7 +18,7 @@ use std::f32::consts::{FRAC_1_PI, PI, TAU};
 ///
 /// At normal incidence (wo = n, so θ_h = θ_i/2) the lobe's albedo is
 /// ∫ cos^γ(θ_i/2) cos θ_i dω_i = 8π (γ + 2^(−γ/2)) / ((γ+2)(γ+4)) (substitute x = cos(θ_i/2)), and
-/// it decreases toward grazing `wo` (checked by quadrature in `tests/bxdf_phong.rs`).
+/// it decreases toward grazing `wo` (checked by quadrature in `tests/it/bxdf_phong.rs`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum BlinnPhongNormalization {
     /// N = (γ+8)/(8π), the popular approximation (\[AkenineMoller2008\], §7.6). **Gains energy** near

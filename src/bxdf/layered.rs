@@ -14,7 +14,7 @@
 //! fixed set of [`TRANSMISSION_SAMPLES`] points, a rank-1 lattice that is both a Latin hypercube and
 //! stratified on the 2 × 2 grid: deterministic, exact for a constant F (F = 1 gives R̂ = 1, no base,
 //! the glint's own albedo), and for a Fresnel term that varies across the visible normals it carries
-//! a quadrature error (bounded in tests/layered.rs against a converged estimate, and by the measured
+//! a quadrature error (bounded in tests/it/layered.rs against a converged estimate, and by the measured
 //! furnace). Each point costs one `sample_visible`, which for a glint patch is a pass over its lobes,
 //! so the set is as small as keeps the accuracy: a glint patch's visible normals are a mixture of
 //! narrow lobes, chosen by the first coordinate, and the four distinct first coordinates pick the

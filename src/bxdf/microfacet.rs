@@ -46,7 +46,7 @@
 //! F · G2/G1(wo) ≤ F up to a few ulps and up to the ratio of the normaliser of the NDF's
 //! `pdf_visible` to the `visible_area` its masking uses (1 for the analytic NDFs, ≤ 1 for patches
 //! whose masking uses an upper bound of V), for every view down to cos θo = 10⁻³⁰ and every u in
-//! [0, 1)² (tests/hostile_sampling.rs; measured ≤ 1 + 10⁻⁶ for the analytic NDFs and the mixture,
+//! [0, 1)² (tests/it/hostile_sampling.rs; measured ≤ 1 + 10⁻⁶ for the analytic NDFs and the mixture,
 //! ≤ 1 + 6·10⁻⁶ for the position-normal and smoothed bin-map patches; the unsmoothed bin map's
 //! visible sampler, which draws ⟨wo, m⟩ bilinearly in each bin, reaches 1.71 F in bins that wo's
 //! horizon cuts).

@@ -157,7 +157,7 @@ impl PhongNormalization {
 /// k_d = ρ_d (1 − F(cos θ_o)), so that the energy taken by the specular lobe is removed from the diffuse
 /// one. cos θ_r = wi · reflect(wo, n).
 ///
-/// Properties (tested in `tests/bxdf_phong.rs` and `tests/bxdf_reciprocity.rs`):
+/// Properties (tested in `tests/it/bxdf_phong.rs` and `tests/it/bxdf_reciprocity.rs`):
 /// - reciprocal iff N is constant and Fresnel is off ([`Phong::is_reciprocal`]);
 /// - energy conserving for every normalisation but [`PhongNormalization::Unnormalized`] when
 ///   ρ_d + ρ_s ≤ 1 (enforced); with an energy-normalised N the specular albedo is exactly k_s for

@@ -33,7 +33,7 @@
 //! [`super::MicrofacetBrdf`] with GGX or Beckmann converges to this lobe as α → 0: ∫ f L cos θi dωi
 //! → F(cos θo) L(reflect(wo)) for a smooth environment L, with an error O(α²) for Beckmann and
 //! O(α² ln(1/α)) for GGX (the second moment of the slope distribution; GGX's is infinite and is
-//! cut by the hemisphere). tests/specular.rs measures it; docs/bxdf.md, "Delta lobes", has the
+//! cut by the hemisphere). tests/it/specular.rs measures it; docs/bxdf.md, "Delta lobes", has the
 //! figures.
 
 use super::{Bxdf, BxdfSample, LobeFlags};

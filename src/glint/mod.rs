@@ -50,7 +50,7 @@
 //!    `glint_models!` registry (`model.rs`: the [`GlintModel`] and [`GlintPatch`] variants, the
 //!    [`GlintOptions`] field, save/load dispatch), its `serde` line (`io/serde.rs`), and
 //!    `pub mod` plus the re-export of its model and patch types here.
-//! 3. The registry's completeness test (tests/glint_registry.rs) lists an example of every
+//! 3. The registry's completeness test (tests/it/glint_registry.rs) lists an example of every
 //!    registered model and fails until the new one is there: it saves and loads each through
 //!    [`GlintModel`], round-trips each through `serde`, and checks that a patch built in a warm
 //!    scratch allocates nothing.

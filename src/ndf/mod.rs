@@ -37,7 +37,7 @@ pub use slope_gaussian::*;
 /// samplers, a valid upper-hemisphere normal), never NaN, never a panic.
 ///
 /// **The density contract** (every NDF and glint patch of the crate, but for now the mixture's
-/// patch, whose densities sum its lobes without the slope truncation of its D; tests/pdf_contract.rs):
+/// patch, whose densities sum its lobes without the slope truncation of its D; tests/it/pdf_contract.rs):
 /// `pdf_normal(m)` and `pdf_visible(wo, m)` are 0 wherever `d(m)` is 0, and `pdf_visible` is 0 for
 /// every invalid `wo` (at or below the horizon, −0.0, zero, non-finite) even though
 /// `sample_visible` still returns a normal there. A sampler may draw normals where its density is 0

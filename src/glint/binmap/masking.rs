@@ -279,8 +279,8 @@ impl<'a> ExactMasking<'a> {
 ///    sub-cell (a few k of them).
 ///
 /// An upper bound of V is a lower bound of G1 = A/V: the BRDF may lose a little energy at grazing
-/// angles but never creates any (the white furnaces in tests/robustness_energy.rs and
-/// tests/binmap_furnace.rs).
+/// angles but never creates any (the white furnaces in tests/it/robustness_energy.rs and
+/// tests/it/binmap_furnace.rs).
 #[inline]
 fn visible_part(bins: &HemisphereBins, b: &PatchBin, w: Vec3, refine: bool) -> f32 {
     let f = &b.facet;

@@ -11,7 +11,7 @@
 //! texels, 256-4096 measured, four fixed centres; src/glint/kernels/filtered_error.rs), on the
 //! map's first footprint that asks (~10-50 ms for a 1024² map) and kept. Footprints of 128-256
 //! texels read the 256-texel level: the error varies little between levels (on the 256² procedural
-//! maps it moves by at most 0.005 between 256 and 4096 texels, tests/binmap_masking_lod.rs), and
+//! maps it moves by at most 0.005 between 256 and 4096 texels, tests/it/binmap_masking_lod.rs), and
 //! below 128 texels the moments are not the footprint's (the floor).
 
 use super::{BinMap, MIN_MOMENT_MASKING_TEXELS, PatchOptions};

@@ -51,7 +51,7 @@ pub const DEFAULT_EXACT_MASKING_TEXELS: f32 = 4096.0;
 /// level [`MASKING_FIRST_LEVEL`], read at radius ½√|A|) are not the footprint's, so Scarf's bound is
 /// not an upper bound on its visible area and the furnace exceeds 1 (measured up to 1.41 at 85° and
 /// 1.10 at 45° on 64-texel footprints); from 128 texels it stays within 1 % of 1 on the test maps,
-/// the excess the default limit also has above 4096 (tests/binmap_masking_lod.rs).
+/// the excess the default limit also has above 4096 (tests/it/binmap_masking_lod.rs).
 pub const MIN_MOMENT_MASKING_TEXELS: f32 = 128.0;
 
 /// Default [`PatchOptions::moment_masking_tolerance`]: 0.02, a 2 % mean error of G1 at 45° and

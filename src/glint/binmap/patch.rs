@@ -60,7 +60,7 @@ const SMOOTH_TAIL: f64 = 1e-6;
 /// moment mip chain at the footprint centre and radius ½√|A|, σ floored at `sigma_min`), whose
 /// first two slope moments approximate the footprint's (second moments raised by σ² for the
 /// smoothed variant). See docs/binmap.md and the white furnace in
-/// tests/binmap_furnace.rs. The lobe's V is replaced by Scarf's moment bound
+/// tests/it/binmap_furnace.rs. The lobe's V is replaced by Scarf's moment bound
 /// ([`BinMapPatch::moment_bound_visible_area`]) and A by its signed projected area, so Λ is
 /// conservative (a Gaussian's V can be below a spiky distribution's with the same moments).
 ///

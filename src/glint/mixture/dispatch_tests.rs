@@ -16,7 +16,7 @@ use crate::ndf::Ndf;
 use glam::{Vec2, Vec3};
 use rand::{RngExt, SeedableRng};
 
-/// The four procedural maps at `n`² with the gallery's parameters and seeds (as tests/support's
+/// The four procedural maps at `n`² with the gallery's parameters and seeds (as tests/it/support's
 /// `procedural_maps`).
 fn procedural_maps(n: usize) -> Vec<(&'static str, NormalMap)> {
     vec![

@@ -18,7 +18,7 @@
 //! half angles). The curvature term is first order and exact for a mirror at normal incidence; at
 //! incidence θ a real mirror spreads the beam by 2κw/cos θ in the plane of incidence and by
 //! 2κw cos θ across it, and the cone keeps one isotropic value, their geometric mean 2κw (the
-//! reflected beam's area is right, its shape is not): tests/ray_cone.rs checks both against exact
+//! reflected beam's area is right, its shape is not): tests/it/ray_cone.rs checks both against exact
 //! ray differentials on a sphere.
 //!
 //! **Roughness rule.** The papers widen the cone at a rough surface by a term that grows with the

@@ -52,7 +52,7 @@ use rand_pcg::Pcg64Mcg;
 /// (with A_u(wo) = ⟨wo,h⟩/h_z on the facet that reflects wo into wi), which is 1 when the footprint
 /// holds a single facet orientation (then A_P = V_P = A_u) and differs otherwise: the difference is
 /// the P-BRDF formulation's own modelling of the patch (masking and normalisation by A_P, V_P),
-/// which a per-position shading does not have. tests/reference.rs checks both limits.
+/// which a per-position shading does not have. tests/it/reference.rs checks both limits.
 ///
 /// Degenerate directions (below the horizon, non-finite, wo = −wi), a non-positive or non-finite
 /// σ_ε, or a footprint that sees nothing toward wo or wi give 0 for both.

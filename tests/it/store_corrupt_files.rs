@@ -1,0 +1,264 @@
+//! Damaged files give a clear `Err` (docs/format.md), never a panic or a huge allocation: every
+//! truncation, every flipped byte, header errors that name what is wrong, bad values in later chunks
+//! found after the checksum, and sizes beyond the file refused before allocating.
+
+use crate::support;
+
+use brdf::Error;
+use brdf::glint::binmap::BinMapParams;
+use brdf::glint::mixture::MixtureParams;
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, NormalMap, PositionNormalMap};
+use support::format::reseal;
+use support::store::{
+    as_version_2, at, load_mixture, map, mixture_as_version_3, mixture_as_version_4,
+    position_normal_as_version_3, saved, small_compact_file, small_mixture_file,
+};
+
+#[test]
+fn every_truncation_is_an_error() {
+    for (kind, file, load) in small_files() {
+        for cut in 0..file.len() {
+            let e = load(&file[..cut]).unwrap_err();
+            assert!(
+                matches!(e, Error::Truncated { .. }),
+                "{kind}: cut at {cut}: {e}"
+            );
+        }
+    }
+}
+
+/// A version-5 file of `kind` (of [`small_files`]) as format `version` (2, 3 or 4) wrote it: no
+/// seed kernel in the mixtures; in versions 2 and 3 the patch options that the mixtures and the
+/// position-normal map stored then (at their defaults), and for a full mixture of version 2 no merge
+/// errors.
+fn as_version(kind: &str, file: &[u8], version: u32) -> Vec<u8> {
+    let mut f = match (kind, version) {
+        ("mixture" | "compact mixture", 4) => return mixture_as_version_4(file),
+        ("mixture", 2) => return as_version_2(file),
+        ("mixture" | "compact mixture", _) => mixture_as_version_3(file, 0, 16384.0),
+        ("position-normal", 2 | 3) => position_normal_as_version_3(file, 128.0),
+        _ => file.to_vec(),
+    };
+    f[8..12].copy_from_slice(&version.to_le_bytes());
+    reseal(f)
+}
+
+/// A small file of every kind, with its loader.
+#[allow(clippy::type_complexity)]
+fn small_files() -> Vec<(&'static str, Vec<u8>, fn(&[u8]) -> brdf::Result<()>)> {
+    let m = map(6);
+    let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
+    let bm_params = BinMapParams {
+        bins_per_axis: 3,
+        leaf_size: 2,
+        ..BinMapParams::default()
+    };
+    let bm = BinMap::build(&m, bm_params).unwrap();
+    vec![
+        ("mixture", small_mixture_file(), |b| {
+            load_mixture(b).map(drop)
+        }),
+        ("compact mixture", small_compact_file(), |b| {
+            load_mixture(b).map(drop)
+        }),
+        ("normal map", saved(|w| m.save(w)), |b| {
+            NormalMap::load(&mut &b[..]).map(drop)
+        }),
+        ("position-normal", saved(|w| pn.save(w)), |b| {
+            PositionNormalMap::load(&mut &b[..]).map(drop)
+        }),
+        ("bin map", saved(|w| bm.save(w)), |b| {
+            BinMap::load(&mut &b[..]).map(drop)
+        }),
+    ]
+}
+
+#[test]
+fn every_flipped_byte_is_an_error() {
+    for (kind, file, load) in small_files() {
+        assert!(load(&file).is_ok(), "{kind}");
+        for k in 0..file.len() {
+            for mask in [0x01u8, 0x80, 0xFF] {
+                let mut f = file.clone();
+                f[k] ^= mask;
+                let e = load(&f).unwrap_err();
+                let expected = match k {
+                    0..8 => matches!(e, Error::BadMagic { .. }),
+                    // Of these masks only 0x01 on the low byte turns version 5 into one still read
+                    // (4): then the payload, read in the older layout, is refused or fails its
+                    // checksum (the header is checksummed).
+                    8 if mask == 0x01 => matches!(
+                        e,
+                        Error::InvalidFile { .. }
+                            | Error::ChecksumMismatch { .. }
+                            | Error::Truncated { .. }
+                    ),
+                    8..12 => matches!(e, Error::UnsupportedVersion { .. }),
+                    12..16 => matches!(e, Error::WrongModelKind { .. }),
+                    // The payload length: too long leaves bytes over or runs out; too short cuts a
+                    // field.
+                    16..24 => matches!(e, Error::InvalidFile { .. } | Error::Truncated { .. }),
+                    // Parameters and counts may be refused before the checksum is read (or, for a
+                    // count, run out of data); data are caught by the checksum.
+                    _ => matches!(
+                        e,
+                        Error::InvalidFile { .. }
+                            | Error::ChecksumMismatch { .. }
+                            | Error::Truncated { .. }
+                    ),
+                };
+                assert!(expected, "{kind}: byte {k} ^ {mask:#x}: {e}");
+            }
+        }
+    }
+}
+
+#[test]
+fn header_errors_name_what_is_wrong() {
+    let file = small_mixture_file();
+    let mut f = file.clone();
+    f[..8].copy_from_slice(b"NOTGLINT");
+    let e = load_mixture(&f).unwrap_err();
+    assert!(e.to_string().contains("BRDFGLNT"), "{e}");
+    let mut f = file.clone();
+    f[8..12].copy_from_slice(&6u32.to_le_bytes());
+    let e = load_mixture(&reseal(f)).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::UnsupportedVersion {
+                found: 6,
+                supported: 5
+            }
+        ),
+        "{e}"
+    );
+    // Format versions 2 to 4 are still read for every kind but the bin map (which gained 𝓑 in
+    // version 3, and is read from version 3 on; the full mixture gained its merge errors in version
+    // 3, recomputed when absent; versions 2 and 3 of the mixtures and the position-normal map store
+    // patch options, read and ignored; mixtures before version 5 are Gaussian-seeded); older
+    // versions are not.
+    for (kind, file, load) in small_files() {
+        for version in [2u32, 3, 4] {
+            let old = as_version(kind, &file, version);
+            let r = load(&old);
+            if kind == "bin map" && version == 2 {
+                assert!(
+                    matches!(
+                        r,
+                        Err(Error::UnsupportedVersion {
+                            found: 2,
+                            supported: 5
+                        })
+                    ),
+                    "{kind}: {r:?}"
+                );
+            } else {
+                assert!(r.is_ok(), "{kind} version {version}: {r:?}");
+            }
+        }
+        let mut f = file.clone();
+        f[8..12].copy_from_slice(&1u32.to_le_bytes());
+        assert!(
+            matches!(
+                load(&reseal(f)),
+                Err(Error::UnsupportedVersion { found: 1, .. })
+            ),
+            "{kind}"
+        );
+    }
+    // A mixture file handed to the other loaders.
+    let e = PositionNormalMap::load(&mut file.as_slice()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(e, Error::WrongModelKind { .. })
+            && msg.contains("BeckmannMixture")
+            && msg.contains("PositionNormalMap"),
+        "{msg}"
+    );
+    assert!(matches!(
+        NormalMap::load(&mut file.as_slice()),
+        Err(Error::WrongModelKind { .. })
+    ));
+    // A good file with trailing bytes after the checksum: read exactly, the rest left to the caller.
+    let mut f = file.clone();
+    f.extend_from_slice(b"next");
+    let mut r = f.as_slice();
+    assert!(BeckmannMixture::load(&mut r).is_ok());
+    assert_eq!(r, b"next");
+}
+
+/// Values are checked chunk by chunk while they are read (64 KiB chunks: 3276 lobes, 2730
+/// position-normal elements): a bad value far into a later chunk is found and named by its index in
+/// the whole array, and only after the checksum (a damaged file is a checksum error first).
+#[test]
+fn values_in_later_chunks_are_checked_after_the_checksum() {
+    let m = map(64);
+    let mixture = BeckmannMixture::build(&m, MixtureParams::default()).unwrap();
+    let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
+    type Load = fn(&[u8]) -> brdf::Result<()>;
+    /// Name in the error, file, offset of the array's first record, record bytes, record index,
+    /// component, bad value, loader.
+    type Case = (&'static str, Vec<u8>, usize, usize, usize, usize, f32, Load);
+    let count = 64 * 64;
+    let pn_file = saved(|w| pn.save(w));
+    // The position-normal elements end the payload; the lobes start it (the merge errors follow).
+    let pn_start = pn_file.len() - 8 - count * 24;
+    let cases: [Case; 2] = [
+        (
+            "lobes[4000][2]",
+            saved(|w| mixture.save(w)),
+            at::LOBES,
+            20,
+            4000,
+            2,
+            -1.0,
+            |f| load_mixture(f).map(|_| ()),
+        ),
+        (
+            "elements[3000][4]",
+            pn_file,
+            pn_start,
+            24,
+            3000,
+            4,
+            1e30,
+            |f| PositionNormalMap::load(&mut &f[..]).map(|_| ()),
+        ),
+    ];
+    for (needle, file, start, record, index, component, value, load) in cases {
+        let mut f = file.clone();
+        let at = start + index * record + 4 * component;
+        f[at..at + 4].copy_from_slice(&value.to_le_bytes());
+        let e = load(&f).unwrap_err();
+        assert!(matches!(e, Error::ChecksumMismatch { .. }), "{needle}: {e}");
+        let e = load(&reseal(f)).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidFile { .. }) && e.to_string().contains(needle),
+            "{needle}: {e}"
+        );
+        load(&file).unwrap();
+    }
+}
+
+#[test]
+fn sizes_beyond_the_file_are_refused_before_allocating() {
+    // A 40000² map (1.6·10⁹ lobes, 32 GB) declared in a file of a few hundred bytes: refused from the
+    // declared payload length before any allocation (the allocation-bound test is tests/store_limits.rs).
+    let mut f = small_mixture_file();
+    f[at::WIDTH..at::WIDTH + 8].copy_from_slice(&40000u64.to_le_bytes());
+    f[at::WIDTH + 8..at::WIDTH + 16].copy_from_slice(&40000u64.to_le_bytes());
+    f[at::LOBE_COUNT..at::LOBE_COUNT + 8].copy_from_slice(&1_600_000_000u64.to_le_bytes());
+    let e = load_mixture(&reseal(f.clone())).unwrap_err();
+    assert!(e.to_string().contains("declares only"), "{e}");
+    // The same with a payload length that claims it all: the data run out (Truncated).
+    f[16..24].copy_from_slice(&(60 + 32_000_000_000u64).to_le_bytes());
+    let e = load_mixture(&reseal(f)).unwrap_err();
+    assert!(matches!(e, Error::Truncated { what: "lobes" }), "{e}");
+    // A normal map of 2^31 × 2^31 texels: beyond the size limit.
+    let mut nm = saved(|w| map(2).save(w));
+    nm[24..32].copy_from_slice(&(1u64 << 31).to_le_bytes());
+    let e = NormalMap::load(&mut &reseal(nm)[..]).unwrap_err();
+    assert!(e.to_string().contains("width"), "{e}");
+}

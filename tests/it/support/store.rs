@@ -1,0 +1,136 @@
+//! Shared helpers of the store tests (tests/it/store_*.rs): small maps and saved files of every kind,
+//! query directions, and the offsets of the fields in a mixture file (docs/format.md).
+
+use super::format::reseal;
+use brdf::Vec3;
+use brdf::glint::mixture::{LobeStorage, MixtureParams, SeedKernel};
+use brdf::glint::{BeckmannMixture, NormalMap};
+
+/// White-noise slopes in [−0.6, 0.6]² (seed `n`): every lobe and element different.
+pub fn map(n: usize) -> NormalMap {
+    super::noise_map(n, n, 0.6, n as u64)
+}
+
+/// Directions for the queries: normal incidence, moderate, grazing, below the horizon.
+pub fn dirs() -> Vec<Vec3> {
+    let mut v = Vec::new();
+    for th in [0.0, 30.0, 60.0, 85.0, 89.9] {
+        for ph in [0.0, 75.0, 200.0] {
+            v.push(super::dir(th, ph));
+        }
+    }
+    v.push(Vec3::new(0.3, 0.1, -0.9).normalize());
+    v
+}
+
+/// The bytes `save` writes.
+pub fn saved(save: impl FnOnce(&mut Vec<u8>) -> brdf::Result<()>) -> Vec<u8> {
+    let mut v = Vec::new();
+    save(&mut v).unwrap();
+    v
+}
+
+/// A full mixture of the 6² map (8 QMC samples per lobe; the Gaussian seed kernel, which files of
+/// every format version hold, so that [`mixture_as_version_3`] and [`as_version_2`] apply), saved.
+pub fn small_mixture_file() -> Vec<u8> {
+    let params = MixtureParams {
+        samples: 8,
+        seed: SeedKernel::Gaussian,
+        ..MixtureParams::default()
+    };
+    let built = BeckmannMixture::build(&map(6), params).unwrap();
+    saved(|w| built.save(w))
+}
+
+/// A compact mixture of the 6² map (the Gaussian seed kernel, as [`small_mixture_file`]), saved.
+pub fn small_compact_file() -> Vec<u8> {
+    let params = MixtureParams {
+        storage: LobeStorage::Compact,
+        seed: SeedKernel::Gaussian,
+        ..MixtureParams::default()
+    };
+    let built = BeckmannMixture::build(&map(6), params).unwrap();
+    saved(|w| built.save(w))
+}
+
+/// Loads a mixture from bytes.
+pub fn load_mixture(bytes: &[u8]) -> brdf::Result<BeckmannMixture> {
+    BeckmannMixture::load(&mut &bytes[..])
+}
+
+/// `file` with `fields` inserted at byte `offset` of the file, the header's version set to `version`
+/// and its payload length grown, re-sealed.
+fn with_fields(file: &[u8], offset: usize, fields: &[u8], version: u32) -> Vec<u8> {
+    let mut f = file[..offset].to_vec();
+    f.extend_from_slice(fields);
+    f.extend_from_slice(&file[offset..]);
+    f[8..12].copy_from_slice(&version.to_le_bytes());
+    let payload = u64::from_le_bytes(f[16..24].try_into().unwrap()) + fields.len() as u64;
+    f[16..24].copy_from_slice(&payload.to_le_bytes());
+    reseal(f)
+}
+
+/// A mixture's file (full or compact, format version 5, Gaussian seed kernel) as version 4 wrote
+/// it: without the seed kernel's code after `slope_tail` (docs/format.md), re-sealed.
+pub fn mixture_as_version_4(file: &[u8]) -> Vec<u8> {
+    assert_eq!(
+        &file[at::SEED..at::SEED + 4],
+        &0u32.to_le_bytes(),
+        "only Gaussian-seeded mixtures have an older form"
+    );
+    let mut f = file[..at::SEED].to_vec();
+    f.extend_from_slice(&file[at::SEED + 4..]);
+    f[8..12].copy_from_slice(&4u32.to_le_bytes());
+    let payload = u64::from_le_bytes(f[16..24].try_into().unwrap()) - 4;
+    f[16..24].copy_from_slice(&payload.to_le_bytes());
+    reseal(f)
+}
+
+/// A mixture's file (full or compact, format version 5, Gaussian seed kernel) as version 3 wrote
+/// it: no seed kernel, and the patch options `masking` (`u32`) and `lod_lobes` (`f32`) stored after
+/// `slope_tail` (docs/format.md).
+pub fn mixture_as_version_3(file: &[u8], masking: u32, lod_lobes: f32) -> Vec<u8> {
+    let mut fields = masking.to_le_bytes().to_vec();
+    fields.extend_from_slice(&lod_lobes.to_le_bytes());
+    with_fields(&mixture_as_version_4(file), at::SEED, &fields, 3)
+}
+
+/// A position-normal map's file (format version 5) as version 3 wrote it: the footprint cap
+/// `max_query_texels` (`f32`) stored after `slope_sigmas` (docs/format.md).
+pub fn position_normal_as_version_3(file: &[u8], max_query_texels: f32) -> Vec<u8> {
+    // Header 24, width, height, sampling_rate (u64), sigma_r, weight_sigmas, slope_sigmas (f32).
+    with_fields(file, 24 + 24 + 12, &max_query_texels.to_le_bytes(), 3)
+}
+
+/// A full mixture's file (format version 5, Gaussian seed kernel) as version 2 wrote it: no seed
+/// kernel, the default patch options stored after `slope_tail` (masking 0, lod_lobes 16384), the
+/// payload cut after the lobes (no merge errors), the header's version and payload length set,
+/// re-sealed.
+pub fn as_version_2(file: &[u8]) -> Vec<u8> {
+    // Offsets in the version-4 layout: lobe count at 68, lobes at 76.
+    let file = mixture_as_version_4(file);
+    let (count, lobes_at) = (at::SEED, at::SEED + 8);
+    let lobes = u64::from_le_bytes(file[count..lobes_at].try_into().unwrap()) as usize;
+    let end = lobes_at + 20 * lobes;
+    let mut f = file[..end].to_vec();
+    f.extend_from_slice(&[0u8; 8]);
+    f[16..24].copy_from_slice(&((end - 24) as u64).to_le_bytes());
+    let f = reseal(f);
+    let mut fields = 0u32.to_le_bytes().to_vec();
+    fields.extend_from_slice(&16384.0f32.to_le_bytes());
+    with_fields(&f, at::SEED, &fields, 2)
+}
+
+/// Offsets in a mixture file of format version 5 (docs/format.md): header 24, width 24, height 32,
+/// spacing 40, sigma_min 44, samples 48, kernel_sigmas 56, weight_sigmas 60, slope_tail 64, seed
+/// kernel 68, lobe count 72, lobes 80.
+pub mod at {
+    pub const WIDTH: usize = 24;
+    pub const SPACING: usize = 40;
+    pub const SEED: usize = 68;
+    pub const LOBE_COUNT: usize = 72;
+    pub const LOBES: usize = 80;
+    /// After the 36 lobes of the 6² map: the level count, then level 1's error count and records.
+    pub const LEVELS: usize = LOBES + 36 * 20;
+    pub const ERRORS: usize = LEVELS + 16;
+}
