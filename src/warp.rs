@@ -440,9 +440,69 @@ pub fn pdf_hemisphere_equal_area(w: Vec3) -> f32 {
     pdf_uniform_hemisphere(w)
 }
 
+/// Mean of cos θ over the equal-area image ([`square_to_hemisphere_equal_area`]) of the rectangle
+/// [x0, x1] × [y0, y1] ⊂ [0, 1]², in `f64`, exact up to rounding: with (a, b) = 2u − 1 the map gives
+/// z = 1 − max(a², b²) (the concentric radius is max(|a|, |b|)), so the mean is 1 − the mean of
+/// max(a², b²) over the rectangle in (a, b). An empty rectangle gives 1 (the value at its corner).
+pub(crate) fn equal_area_mean_cos(x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
+    1.0 - mean_max_square(
+        2.0 * x0 - 1.0,
+        2.0 * x1 - 1.0,
+        2.0 * y0 - 1.0,
+        2.0 * y1 - 1.0,
+    )
+}
+
+/// Mean of max(a², b²) over the rectangle [a0, a1] × [b0, b1] (exact up to rounding).
+fn mean_max_square(a0: f64, a1: f64, b0: f64, b1: f64) -> f64 {
+    // g(a) = ∫_{b0}^{b1} max(a², b²) db in closed form: b² outside |b| < |a|, a² inside.
+    let g = |a: f64| {
+        let abs = a.abs();
+        let (lo, hi) = (b0.max(-abs), b1.min(abs));
+        let full = (b1.powi(3) - b0.powi(3)) / 3.0;
+        if hi > lo {
+            full - (hi.powi(3) - lo.powi(3)) / 3.0 + a * a * (hi - lo)
+        } else {
+            full
+        }
+    };
+    // g is a polynomial of degree ≤ 3 between its breakpoints a ∈ {0, ±b0, ±b1}: 3-point
+    // Gauss–Legendre (exact to degree 5) on each piece.
+    let mut cuts = vec![a0, a1];
+    for c in [0.0, b0, -b0, b1, -b1] {
+        if c > a0 && c < a1 {
+            cuts.push(c);
+        }
+    }
+    cuts.sort_by(|x, y| x.total_cmp(y));
+    const X: [f64; 3] = [-0.774_596_669_241_483_4, 0.0, 0.774_596_669_241_483_4];
+    const W: [f64; 3] = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
+    let mut total = 0.0;
+    for pair in cuts.windows(2) {
+        let (l, r) = (pair[0], pair[1]);
+        let (mid, half) = (0.5 * (l + r), 0.5 * (r - l));
+        total += half
+            * X.iter()
+                .zip(W)
+                .map(|(x, w)| w * g(mid + half * x))
+                .sum::<f64>();
+    }
+    total / ((a1 - a0) * (b1 - b0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn mean_max_square_closed_forms() {
+        // Whole square [−1, 1]²: the CDF of r = max(|a|, |b|) is r², so E[r²] = ∫ r² 2r dr = 1/2
+        // (and the hemisphere's mean cosine is 1 − 1/2).
+        assert!((mean_max_square(-1.0, 1.0, -1.0, 1.0) - 0.5).abs() < 1e-15);
+        // A cell where |a| > |b| everywhere: the mean of a².
+        let m = mean_max_square(0.5, 0.7, -0.1, 0.2);
+        assert!((m - (0.7f64.powi(3) - 0.5f64.powi(3)) / 3.0 / 0.2).abs() < 1e-14);
+    }
     use std::f64::consts::PI;
 
     /// Inputs of a round trip: an (n+1)² grid with the ends replaced by 0 and 1 − ε.

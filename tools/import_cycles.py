@@ -21,9 +21,11 @@ is resolved to the file that DEFINES it:
   - a submodule -> the submodule's file; anything else -> the target module's file.
   Names imported from other crates (std, glam, ...) make no edge.
 
-Ignored: edges from a file to itself or to one of its ancestor module files (a child using its
-parent's items), edges from a module file to its own descendants made by `pub use` re-exports
-(`mod` declarations make none), and test code: every item carrying `#[cfg(test)]` (the
+Kept too: edges from a child to an ancestor module file (a child using an item its parent defines):
+a parent that calls into its child while the child uses the parent's items is a cycle like any other,
+which is why a model folder keeps its types in files of their own and its mod.rs to declarations and
+re-exports. Ignored: edges from a file to itself, edges from a module file to its own descendants
+made by `pub use` re-exports (`mod` declarations make none), and test code: every item carrying `#[cfg(test)]` (the
 `mod tests { ... }` blocks, test-only helpers) and files whose module is `#[cfg(test)]`.
 
 Reports the strongly connected components with more than one file (Tarjan) with the edges
@@ -552,8 +554,6 @@ class Crate:
             skey, dkey = self.file_module[src], self.file_module[dst]
             if src == dst:
                 ignored["same file"] += 1
-            elif dkey == skey[: len(dkey)]:
-                ignored["to an ancestor"] += 1
             elif use.reexport and skey == dkey[: len(skey)]:
                 ignored["re-export of a descendant"] += 1
             else:
@@ -740,6 +740,7 @@ SELF_TEST_TREE = {
         mod b;
         mod d;
         pub mod p;
+        mod q;
         pub use p::{C, P as Renamed};
     """,
     # a.rs <-> b.rs: a `use` one way, an inline path in code the other way.
@@ -766,7 +767,7 @@ SELF_TEST_TREE = {
         };
         pub struct D(pub Cee, pub p::P, pub Renamed);
     """,
-    # p/mod.rs declares and re-exports its child, and the child uses its parent: not a cycle.
+    # p/mod.rs declares and re-exports its child, and the child uses its parent: an edge, no cycle.
     "p/mod.rs": """
         mod c;
         pub use c::C;
@@ -775,6 +776,20 @@ SELF_TEST_TREE = {
     "p/c.rs": """
         use super::P;
         pub struct C(pub P);
+    """,
+    # q/mod.rs calls into its child, which uses the parent's type: a child -> parent cycle.
+    "q/mod.rs": """
+        mod e;
+        pub struct Q;
+        pub fn make() -> Q {
+            e::build()
+        }
+    """,
+    "q/e.rs": """
+        use super::Q;
+        pub fn build() -> Q {
+            Q
+        }
     """,
 }
 
@@ -793,13 +808,17 @@ def self_test():
             ("b.rs", "a.rs"): [2, 4],  # crate::a::A in the signature and the body
             ("d.rs", "p/c.rs"): [2],  # C through p's `pub use c::C`
             ("d.rs", "p/mod.rs"): [2, 3, 5],  # p::{self}, Renamed (= p::P through lib.rs), p::P
+            ("p/c.rs", "p/mod.rs"): [1],  # use super::P: a child using its parent's item
+            ("q/mod.rs", "q/e.rs"): [4],  # e::build() in code
+            ("q/e.rs", "q/mod.rs"): [1],  # use super::Q
         }
         ok = True
         if edges != expected:
             print(f"self-test: edges {edges}\n      expected {expected}", file=sys.stderr)
             ok = False
-        if cycles != [["a.rs", "b.rs"]]:
-            print(f"self-test: cycles {cycles}, expected [['a.rs', 'b.rs']]", file=sys.stderr)
+        want_cycles = [["a.rs", "b.rs"], ["q/e.rs", "q/mod.rs"]]
+        if sorted(cycles) != want_cycles:
+            print(f"self-test: cycles {cycles}, expected {want_cycles}", file=sys.stderr)
             ok = False
         if crate.warnings:
             print(f"self-test: warnings {crate.warnings}", file=sys.stderr)
@@ -812,16 +831,24 @@ def self_test():
         with contextlib.redirect_stdout(buf):
             status = run([tmp])
         out = buf.getvalue().replace(tmp + "/", "")
-        for want in ("a.rs:1 -> b.rs", "b.rs:2 -> a.rs", "b.rs:4 -> a.rs", "1 cycle(s)"):
+        for want in (
+            "a.rs:1 -> b.rs",
+            "b.rs:2 -> a.rs",
+            "b.rs:4 -> a.rs",
+            "q/e.rs:1 -> q/mod.rs",
+            "2 cycle(s)",
+        ):
             if want not in out:
                 print(f"self-test: {want!r} not in the report:\n{out}", file=sys.stderr)
                 ok = False
         if status != 1:
             print(f"self-test: exit status {status}, expected 1", file=sys.stderr)
             ok = False
-        # Without b's use of a, no cycle and exit status 0.
+        # Without b's use of a and q's call into e, no cycle and exit status 0.
         with open(os.path.join(tmp, "b.rs"), "w", encoding="utf-8") as f:
             f.write("pub struct B;\n")
+        with open(os.path.join(tmp, "q/mod.rs"), "w", encoding="utf-8") as f:
+            f.write("mod e;\npub struct Q;\n")
         with contextlib.redirect_stdout(io.StringIO()):
             status = run([tmp])
         if status != 0:

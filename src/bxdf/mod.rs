@@ -13,6 +13,7 @@
 //! mapping) and [`NormalMapMicrofacet`] (microfacet-based normal mapping), each wrapping any inner
 //! [`Bxdf`]. Which are reciprocal and which conserve or normalise energy: docs/bxdf.md.
 
+use crate::ndf::deref_dispatch;
 use glam::{Vec2, Vec3};
 
 mod albedo;
@@ -177,17 +178,71 @@ pub trait Bxdf {
     }
 }
 
-impl<T: Bxdf + ?Sized> Bxdf for &T {
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        (**self).eval(wo, wi)
+/// Implements every method of [`Bxdf`] for a type that hands each call to a BRDF it holds:
+/// `$dispatch!` is a macro of the form `($s:ident, $b:ident => $e:expr)` that binds the inner BRDF of
+/// `$s` to `$b` and evaluates `$e` (a `match` over an enum's variants, or a dereference). Written
+/// once, so every forwarding type forwards every method, the default `eval_pdf` included; the unit
+/// test `forward_bxdf_names_every_method_of_the_trait` fails when the trait gains a method this list
+/// lacks. `[$generics]` are the impl's generic parameters, possibly empty.
+macro_rules! forward_bxdf {
+    ([$($generics:tt)*] $ty:ty, $dispatch:ident) => {
+        impl<$($generics)*> $crate::bxdf::Bxdf for $ty {
+            #[inline]
+            fn eval(&self, wo: glam::Vec3, wi: glam::Vec3) -> glam::Vec3 {
+                $dispatch!(self, b => b.eval(wo, wi))
+            }
+            #[inline]
+            fn pdf(&self, wo: glam::Vec3, wi: glam::Vec3) -> f32 {
+                $dispatch!(self, b => b.pdf(wo, wi))
+            }
+            #[inline]
+            fn sample(
+                &self,
+                wo: glam::Vec3,
+                uc: f32,
+                u: glam::Vec2,
+            ) -> Option<$crate::bxdf::BxdfSample> {
+                $dispatch!(self, b => b.sample(wo, uc, u))
+            }
+            #[inline]
+            fn eval_pdf(&self, wo: glam::Vec3, wi: glam::Vec3) -> (glam::Vec3, f32) {
+                $dispatch!(self, b => b.eval_pdf(wo, wi))
+            }
+        }
+    };
+}
+pub(crate) use forward_bxdf;
+
+// A reference to a BRDF is a BRDF.
+forward_bxdf!([T: Bxdf + ?Sized] &T, deref_dispatch);
+
+#[cfg(test)]
+mod forwarding_tests {
+    use std::collections::BTreeSet;
+
+    /// The names of the `fn`s in `text` (comment lines skipped).
+    fn fn_names(text: &str) -> BTreeSet<String> {
+        text.lines()
+            .map(str::trim_start)
+            .filter(|l| !l.starts_with("//"))
+            .filter_map(|l| l.split("fn ").nth(1))
+            .map(|rest| rest.split('(').next().unwrap_or("").trim().to_string())
+            .collect()
     }
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        (**self).pdf(wo, wi)
+
+    /// The text from `head` to the first line that is `}` alone.
+    fn block<'a>(src: &'a str, head: &str) -> &'a str {
+        let start = src.find(head).expect("block head");
+        let len = src[start..].find("\n}\n").expect("block end");
+        &src[start..start + len]
     }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BxdfSample> {
-        (**self).sample(wo, uc, u)
-    }
-    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
-        (**self).eval_pdf(wo, wi)
+
+    #[test]
+    fn forward_bxdf_names_every_method_of_the_trait() {
+        let src = include_str!("mod.rs");
+        let methods = fn_names(block(src, "pub trait Bxdf {"));
+        let forwarded = fn_names(block(src, "macro_rules! forward_bxdf {"));
+        assert!(methods.len() >= 4, "{methods:?}");
+        assert_eq!(methods, forwarded);
     }
 }

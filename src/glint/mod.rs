@@ -41,19 +41,20 @@
 //!
 //! ## Adding a model
 //!
-//! 1. A folder `src/glint/<model>/` whose `mod.rs` holds the model type, its parameters, its
-//!    per-query options and their `DEFAULT_*` constants; the model implements [`GlintNdf`] (its
+//! 1. A folder `src/glint/<model>/` whose `params.rs` holds its parameters, its per-query options
+//!    and their `DEFAULT_*` constants, and whose `mod.rs` (or a `model.rs`) holds the model type
+//!    (docs/architecture.md, "Adding a glint model"); the model implements [`GlintNdf`] (its
 //!    patch takes its buffers from the scratch's pool of their type with `GlintScratch`'s
 //!    crate-private `home::<T>()`, so the scratch needs no field for it) and the crate-private `Stored` trait of `io/format.rs`
 //!    (`save` / `load` in the crate's file format).
 //! 2. One line per registry: the model's file-format `Kind` code (`io/format.rs`), its line in the
 //!    `glint_models!` registry (`model.rs`: the [`GlintModel`] and [`GlintPatch`] variants, the
-//!    [`GlintOptions`] field, save/load dispatch), its `serde` line (`io/serde.rs`), and
+//!    [`GlintOptions`] field, save/load dispatch), its `serde` line (`serialize.rs`), and
 //!    `pub mod` plus the re-export of its model and patch types here.
 //! 3. The registry's completeness test (tests/it/glint_registry.rs) lists an example of every
 //!    registered model and fails until the new one is there: it saves and loads each through
-//!    [`GlintModel`], round-trips each through `serde`, and checks that a patch built in a warm
-//!    scratch allocates nothing.
+//!    [`GlintModel`]; tests/serde.rs round-trips each through `serde` and tests/alloc.rs checks
+//!    that a patch built in a warm scratch allocates nothing.
 //!
 //! ## Texel space (every glint model relies on this)
 //!
@@ -108,6 +109,8 @@ pub mod mixture;
 mod model;
 pub mod position_normal;
 mod scratch;
+#[cfg(feature = "serde")]
+mod serialize;
 mod surface;
 mod truth;
 
@@ -123,13 +126,13 @@ pub use surface::{
     moments_mean_covariance, scratched,
 };
 pub use surface::{
-    DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, ImageDecoding, ImageOptions,
-    MAX_IMPLAUSIBLE_FRACTION, RAW_EVIDENCE_BELOW,
+    DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, HemisphereBins,
+    ImageDecoding, ImageOptions, MAX_IMPLAUSIBLE_FRACTION, RAW_EVIDENCE_BELOW,
 };
 pub use truth::{
     BinMasses, BinnedPndf, DEFAULT_MAX_QUADRATURE, DEFAULT_QUADRATURE_TOLERANCE, FootprintBrdf,
-    HemisphereBins, JITTERS, Kernel, REFERENCE_BATCHES, adaptive_bin_masses, bin_masses,
-    binned_pndf, convolved_pndf, footprint_brdf, for_each_footprint_slope, naive_brdf, tv_distance,
+    JITTERS, Kernel, REFERENCE_BATCHES, adaptive_bin_masses, bin_masses, binned_pndf,
+    convolved_pndf, footprint_brdf, for_each_footprint_slope, naive_brdf, tv_distance,
 };
 
 use crate::ndf::Ndf;

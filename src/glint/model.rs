@@ -4,7 +4,7 @@
 //! [`GlintNdf`] has a generic associated patch type, so it is not a trait object; a renderer that
 //! chooses the model per material at run time (from a scene file, say) holds a [`GlintModel`]
 //! instead, usually behind an `Arc` shared by the materials that use the same map. Its patch,
-//! [`GlintPatch`], is an [`Ndf`] like every model's patch, so the one-line glint BRDF stays
+//! [`GlintPatch`], is an [`Ndf`](crate::ndf::Ndf) like every model's patch, so the one-line glint BRDF stays
 //! `MicrofacetBrdf::new(model.patch(&footprint), fresnel)`.
 //!
 //! The `glint_models!` invocation at the end of this file is the registry: one line per model
@@ -15,8 +15,7 @@
 use super::io::format::{self, Kind, Stored};
 use super::{BeckmannMixture, BinMap, Footprint, GlintNdf, GlintScratch, PositionNormalMap};
 use crate::error::{Error, Result};
-use crate::ndf::Ndf;
-use glam::{Vec2, Vec3};
+use crate::ndf::forward_ndf;
 use std::io::{Read, Write};
 
 /// Generates [`GlintModel`], [`GlintPatch`], [`GlintOptions`] and their impls from one line per
@@ -176,61 +175,4 @@ glint_models! {
     PositionNormal(PositionNormalMap), position_normal, "position-normal";
 }
 
-impl Ndf for GlintPatch<'_> {
-    #[inline]
-    fn d(&self, m: Vec3) -> f32 {
-        forward!(self, p => p.d(m))
-    }
-    #[inline]
-    fn lambda(&self, w: Vec3) -> f32 {
-        forward!(self, p => p.lambda(w))
-    }
-    #[inline]
-    fn projected_area(&self, w: Vec3) -> f32 {
-        forward!(self, p => p.projected_area(w))
-    }
-    #[inline]
-    fn visible_area(&self, w: Vec3) -> f32 {
-        forward!(self, p => p.visible_area(w))
-    }
-    #[inline]
-    fn g1(&self, w: Vec3, m: Vec3) -> f32 {
-        forward!(self, p => p.g1(w, m))
-    }
-    #[inline]
-    fn g2(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
-        forward!(self, p => p.g2(wo, wi, m))
-    }
-    #[inline]
-    fn g2_height_correlated(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
-        forward!(self, p => p.g2_height_correlated(wo, wi, m))
-    }
-    #[inline]
-    fn sample_normal(&self, u: Vec2) -> Vec3 {
-        forward!(self, p => p.sample_normal(u))
-    }
-    #[inline]
-    fn pdf_normal(&self, m: Vec3) -> f32 {
-        forward!(self, p => p.pdf_normal(m))
-    }
-    #[inline]
-    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
-        forward!(self, p => p.sample_visible(wo, u))
-    }
-    #[inline]
-    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
-        forward!(self, p => p.pdf_visible(wo, m))
-    }
-    #[inline]
-    fn view_visible_area(&self, wo: Vec3) -> f32 {
-        forward!(self, p => p.view_visible_area(wo))
-    }
-    #[inline]
-    fn pdf_normal_given_d(&self, m: Vec3, d_m: f32) -> f32 {
-        forward!(self, p => p.pdf_normal_given_d(m, d_m))
-    }
-    #[inline]
-    fn pdf_visible_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
-        forward!(self, p => p.pdf_visible_given_d(wo, m, d_m))
-    }
-}
+forward_ndf!(['a] GlintPatch<'a>, forward);

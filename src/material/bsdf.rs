@@ -1,18 +1,17 @@
-//! The BSDF of a material at one shading point: a [`Bxdf`] that borrows the material (and, for
+//! The BSDF of a material at one shading point: a [`Bxdf`](crate::bxdf::Bxdf) that borrows the material (and, for
 //! glints, the patch's buffers from the caller's scratch).
 
 use super::{AnalyticNdf, AnyFresnel};
 use crate::bxdf::{
-    BlinnPhongLobe, Bxdf, BxdfSample, EnergyCompensated, Lambert, LayeredBrdf, MicrofacetBrdf,
-    NormalMapMicrofacet, NormalMapTilt, OriginalPhong, Phong, SpecularReflection,
+    BlinnPhongLobe, EnergyCompensated, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet,
+    NormalMapTilt, OriginalPhong, Phong, SpecularReflection, forward_bxdf,
 };
 use crate::glint::GlintPatch;
-use glam::{Vec2, Vec3};
 
 /// A material's BRDF at one shading point ([`Material::bsdf`](super::Material::bsdf)): evaluate,
-/// sample and take densities through [`Bxdf`], in the local shading frame (z = normal, x along
+/// sample and take densities through [`Bxdf`](crate::bxdf::Bxdf), in the local shading frame (z = normal, x along
 /// ∂p/∂u, y along ∂p/∂v; crate-root conventions). Delta lobes (a mirror) follow the crate's delta
-/// convention: `eval` and `pdf` 0, samples flagged `SPECULAR` ([`Bxdf`]).
+/// convention: `eval` and `pdf` 0, samples flagged `SPECULAR` ([`Bxdf`](crate::bxdf::Bxdf)).
 ///
 /// It borrows the material and, for glint materials, buffers from the caller's
 /// [`GlintScratch`](crate::glint::GlintScratch), which it gives back when it drops; any number of
@@ -75,40 +74,6 @@ macro_rules! forward {
     };
 }
 
-impl Bxdf for Plain<'_> {
-    #[inline]
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        forward_plain!(self, b => b.eval(wo, wi))
-    }
-    #[inline]
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        forward_plain!(self, b => b.pdf(wo, wi))
-    }
-    #[inline]
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BxdfSample> {
-        forward_plain!(self, b => b.sample(wo, uc, u))
-    }
-    #[inline]
-    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
-        forward_plain!(self, b => b.eval_pdf(wo, wi))
-    }
-}
+forward_bxdf!(['a] Plain<'a>, forward_plain);
 
-impl Bxdf for Bsdf<'_> {
-    #[inline]
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        forward!(self, b => b.eval(wo, wi))
-    }
-    #[inline]
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        forward!(self, b => b.pdf(wo, wi))
-    }
-    #[inline]
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BxdfSample> {
-        forward!(self, b => b.sample(wo, uc, u))
-    }
-    #[inline]
-    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
-        forward!(self, b => b.eval_pdf(wo, wi))
-    }
-}
+forward_bxdf!(['a] Bsdf<'a>, forward);

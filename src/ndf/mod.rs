@@ -184,48 +184,116 @@ pub(crate) fn lambda_of(
     ((visible_area(w) as f64 / a as f64 - 1.0).max(0.0) as f32).min(f32::MAX)
 }
 
-/// A reference to an NDF is an NDF (so a BRDF can borrow a patch or a shared lobe).
-impl<T: Ndf + ?Sized> Ndf for &T {
-    fn d(&self, m: Vec3) -> f32 {
-        (**self).d(m)
+/// Implements every method of [`Ndf`] for a type that hands each call to an NDF it holds: `$dispatch!`
+/// is a macro of the form `($s:ident, $n:ident => $e:expr)` that binds the inner NDF of `$s` to `$n`
+/// and evaluates `$e` (a `match` over an enum's variants, or a dereference). Written once, so every
+/// forwarding type forwards every method, the default ones included (an inner NDF that overrides a
+/// default keeps its override behind the wrapper); the unit test
+/// `forward_ndf_names_every_method_of_the_trait` fails when the trait gains a method this list lacks.
+/// `[$generics]` are the impl's generic parameters, possibly empty.
+macro_rules! forward_ndf {
+    ([$($generics:tt)*] $ty:ty, $dispatch:ident) => {
+        impl<$($generics)*> $crate::ndf::Ndf for $ty {
+            #[inline]
+            fn d(&self, m: glam::Vec3) -> f32 {
+                $dispatch!(self, n => n.d(m))
+            }
+            #[inline]
+            fn lambda(&self, w: glam::Vec3) -> f32 {
+                $dispatch!(self, n => n.lambda(w))
+            }
+            #[inline]
+            fn projected_area(&self, w: glam::Vec3) -> f32 {
+                $dispatch!(self, n => n.projected_area(w))
+            }
+            #[inline]
+            fn visible_area(&self, w: glam::Vec3) -> f32 {
+                $dispatch!(self, n => n.visible_area(w))
+            }
+            #[inline]
+            fn g1(&self, w: glam::Vec3, m: glam::Vec3) -> f32 {
+                $dispatch!(self, n => n.g1(w, m))
+            }
+            #[inline]
+            fn g2(&self, wo: glam::Vec3, wi: glam::Vec3, m: glam::Vec3) -> f32 {
+                $dispatch!(self, n => n.g2(wo, wi, m))
+            }
+            #[inline]
+            fn g2_height_correlated(&self, wo: glam::Vec3, wi: glam::Vec3, m: glam::Vec3) -> f32 {
+                $dispatch!(self, n => n.g2_height_correlated(wo, wi, m))
+            }
+            #[inline]
+            fn sample_normal(&self, u: glam::Vec2) -> glam::Vec3 {
+                $dispatch!(self, n => n.sample_normal(u))
+            }
+            #[inline]
+            fn pdf_normal(&self, m: glam::Vec3) -> f32 {
+                $dispatch!(self, n => n.pdf_normal(m))
+            }
+            #[inline]
+            fn sample_visible(&self, wo: glam::Vec3, u: glam::Vec2) -> glam::Vec3 {
+                $dispatch!(self, n => n.sample_visible(wo, u))
+            }
+            #[inline]
+            fn pdf_visible(&self, wo: glam::Vec3, m: glam::Vec3) -> f32 {
+                $dispatch!(self, n => n.pdf_visible(wo, m))
+            }
+            #[inline]
+            fn view_visible_area(&self, wo: glam::Vec3) -> f32 {
+                $dispatch!(self, n => n.view_visible_area(wo))
+            }
+            #[inline]
+            fn pdf_normal_given_d(&self, m: glam::Vec3, d_m: f32) -> f32 {
+                $dispatch!(self, n => n.pdf_normal_given_d(m, d_m))
+            }
+            #[inline]
+            fn pdf_visible_given_d(&self, wo: glam::Vec3, m: glam::Vec3, d_m: f32) -> f32 {
+                $dispatch!(self, n => n.pdf_visible_given_d(wo, m, d_m))
+            }
+        }
+    };
+}
+pub(crate) use forward_ndf;
+
+/// The dispatch of a reference: binds `$n` to the referent.
+macro_rules! deref_dispatch {
+    ($s:ident, $n:ident => $e:expr) => {{
+        let $n = &**$s;
+        $e
+    }};
+}
+pub(crate) use deref_dispatch;
+
+// A reference to an NDF is an NDF (so a BRDF can borrow a patch or a shared lobe).
+forward_ndf!([T: Ndf + ?Sized] &T, deref_dispatch);
+
+#[cfg(test)]
+mod forwarding_tests {
+    use std::collections::BTreeSet;
+
+    /// The names of the `fn`s in `text` (comment lines skipped).
+    fn fn_names(text: &str) -> BTreeSet<String> {
+        text.lines()
+            .map(str::trim_start)
+            .filter(|l| !l.starts_with("//"))
+            .filter_map(|l| l.split("fn ").nth(1))
+            .map(|rest| rest.split('(').next().unwrap_or("").trim().to_string())
+            .collect()
     }
-    fn lambda(&self, w: Vec3) -> f32 {
-        (**self).lambda(w)
+
+    /// The text from the line that starts with `head` to the first line that is `}` alone.
+    fn block<'a>(src: &'a str, head: &str) -> &'a str {
+        let start = src.find(head).expect("block head");
+        let len = src[start..].find("\n}\n").expect("block end");
+        &src[start..start + len]
     }
-    fn projected_area(&self, w: Vec3) -> f32 {
-        (**self).projected_area(w)
-    }
-    fn visible_area(&self, w: Vec3) -> f32 {
-        (**self).visible_area(w)
-    }
-    fn g1(&self, w: Vec3, m: Vec3) -> f32 {
-        (**self).g1(w, m)
-    }
-    fn g2(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
-        (**self).g2(wo, wi, m)
-    }
-    fn g2_height_correlated(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
-        (**self).g2_height_correlated(wo, wi, m)
-    }
-    fn sample_normal(&self, u: Vec2) -> Vec3 {
-        (**self).sample_normal(u)
-    }
-    fn pdf_normal(&self, m: Vec3) -> f32 {
-        (**self).pdf_normal(m)
-    }
-    fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
-        (**self).sample_visible(wo, u)
-    }
-    fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
-        (**self).pdf_visible(wo, m)
-    }
-    fn view_visible_area(&self, wo: Vec3) -> f32 {
-        (**self).view_visible_area(wo)
-    }
-    fn pdf_normal_given_d(&self, m: Vec3, d_m: f32) -> f32 {
-        (**self).pdf_normal_given_d(m, d_m)
-    }
-    fn pdf_visible_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
-        (**self).pdf_visible_given_d(wo, m, d_m)
+
+    #[test]
+    fn forward_ndf_names_every_method_of_the_trait() {
+        let src = include_str!("mod.rs");
+        let methods = fn_names(block(src, "pub trait Ndf {"));
+        let forwarded = fn_names(block(src, "macro_rules! forward_ndf {"));
+        assert!(methods.len() >= 14, "{methods:?}");
+        assert_eq!(methods, forwarded);
     }
 }

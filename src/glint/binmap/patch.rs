@@ -460,19 +460,13 @@ impl<'a> BinMapPatch<'a> {
 
 /// ∫ cos θ dω over the equal-area image of the square-cell rectangle [x0, x1] × [y0, y1] ⊂ [0, 1]²,
 /// divided by 2π: its area × (1 − mean of max(a², b²)), (a, b) = 2u − 1 (z = 1 − max(a², b²) under
-/// the equal-area map; exact up to rounding, see [`HemisphereBins::mean_cos`]).
+/// the equal-area map; exact up to rounding, [`crate::warp::equal_area_mean_cos`]).
 fn cos_weighted_area(x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
     let area = (x1 - x0) * (y1 - y0);
     if area <= 0.0 {
         return 0.0;
     }
-    let mean = crate::glint::truth::mean_max_square(
-        2.0 * x0 - 1.0,
-        2.0 * x1 - 1.0,
-        2.0 * y0 - 1.0,
-        2.0 * y1 - 1.0,
-    );
-    area * (1.0 - mean)
+    area * crate::warp::equal_area_mean_cos(x0, x1, y0, y1)
 }
 
 /// The smoothing Gaussian of the smoothed D at half-vector h: h's slope (sx, sy), the cut-off radius

@@ -3,9 +3,9 @@
 //! - format.rs: the checksummed binary file format, its header, [`Kind`](format::Kind) codes,
 //!   encoder and bounded decoder, shared by every stored type's `save` / `load`.
 //! - multiset.rs: a randomised multiset fingerprint (the bin map's load check of 𝓑 against 𝓑⁻¹).
-//! - serde.rs: `Serialize` / `Deserialize` through the file bytes (feature `serde`).
+//!
+//! `serde` support (feature `serde`) goes through these bytes too, one layer up, beside the registry
+//! (glint/serialize.rs): it names every model, which this layer below the models must not.
 
 pub(crate) mod format;
 pub(crate) mod multiset;
-#[cfg(feature = "serde")]
-mod serde;

@@ -1,7 +1,9 @@
 //! What every glint model is built from and queried with: the normal map (its slopes, its
 //! bilinearly interpolated surface and the mip chain of its slope moments), the procedural maps, the
-//! image decoder, and the ray footprint.
+//! image decoder, the ray footprint, and the equal-area bins of the hemisphere (the bin map's bins,
+//! and the grid the truths are tabulated on).
 //!
+//! - bins.rs: [`HemisphereBins`], an equal-area binning of the hemisphere.
 //! - normal_map.rs: [`NormalMap`], the tiled grid of per-texel slopes and the interpolated surface.
 //! - moments.rs: the mip chain of slope moments behind [`NormalMap::moments`] and friends.
 //! - procedural.rs: the seeded generators [`scratched`], [`brushed`], [`bumpy`], [`flakes`].
@@ -11,6 +13,7 @@
 //! - ray_cone.rs: [`RayCone`], footprints for secondary rays (width and spread propagated through
 //!   reflections).
 
+mod bins;
 mod footprint;
 #[cfg(feature = "image")]
 mod image_io;
@@ -20,6 +23,7 @@ mod pixels;
 mod procedural;
 mod ray_cone;
 
+pub use bins::HemisphereBins;
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
 pub(crate) use moments::{MomentLevel, MomentPyramid};
 pub(crate) use normal_map::texel_count;

@@ -17,7 +17,7 @@
 //! # Reference
 //! \[Chermain2019\] eq. 8 (P-NDF), §5.1.1 (comparison to ground truth), §5.2.2 (naive reference).
 
-use super::bins::HemisphereBins;
+use crate::glint::surface::HemisphereBins;
 use crate::glint::{Footprint, NormalMap};
 use crate::ndf::Ndf;
 use glam::{Mat2, Vec2, Vec3};

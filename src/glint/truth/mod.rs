@@ -1,6 +1,6 @@
-//! The ground truths every glint model is judged by, and the bins they are tabulated on.
+//! The ground truths every glint model is judged by, tabulated on the equal-area
+//! [`HemisphereBins`](crate::glint::HemisphereBins) of `surface`.
 //!
-//! - [`HemisphereBins`] (bins.rs): an equal-area binning of the hemisphere.
 //! - The Dirac truth (binned.rs): [`binned_pndf`], the P-NDF of the interpolated normal map through a
 //!   footprint, binned, and [`tv_distance`] of a model to it.
 //! - The σ_ε-convolved truth (convolved.rs): [`convolved_pndf`], the same P-NDF widened by the
@@ -11,13 +11,10 @@
 //!   footprint (reference (b)), and [`naive_brdf`] at one position.
 
 mod binned;
-mod bins;
 mod convolved;
 mod footprint_brdf;
 
 pub use binned::{BinnedPndf, Kernel, REFERENCE_BATCHES, binned_pndf, tv_distance};
-pub use bins::HemisphereBins;
-pub(crate) use bins::mean_max_square;
 pub use convolved::{
     BinMasses, DEFAULT_MAX_QUADRATURE, DEFAULT_QUADRATURE_TOLERANCE, JITTERS, adaptive_bin_masses,
     bin_masses, convolved_pndf,
