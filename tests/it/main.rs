@@ -70,5 +70,6 @@ mod specular;
 mod store_corrupt_files;
 mod store_forged_files;
 mod store_fuzz_seeds;
+mod store_header_errors;
 mod store_roundtrip;
 mod warp;
