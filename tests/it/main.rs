@@ -29,6 +29,7 @@ mod glint_normal_map;
 mod glint_normal_map_images;
 mod glint_prepare;
 mod glint_procedural;
+mod glint_ray_differential;
 mod glint_reference;
 mod glint_registry;
 mod grazing_chi2;
