@@ -306,6 +306,9 @@ fn checked_constructors_give_the_same_footprint_for_finite_input() {
     }
 }
 
+/// One offset-ray field of a `RayDifferential`.
+type Field = fn(&mut RayDifferential) -> &mut Vec3;
+
 /// The ray cone's and the ray differential's checked footprints refuse every non-finite argument
 /// (and a zero direction or normal); the unchecked ones fall back to the minimal footprint.
 #[test]
@@ -337,7 +340,7 @@ fn ray_footprints_refuse_non_finite_input() {
             assert!(refuses(rf(ray, uv, pu, with3(pv, c, x), p, n), "dpdv"));
             assert!(refuses(rf(ray, uv, pu, pv, with3(p, c, x), n), "p"));
             assert!(refuses(rf(ray, uv, pu, pv, p, with3(n, c, x)), "n"));
-            let fields: [(&str, fn(&mut RayDifferential) -> &mut Vec3); 4] = [
+            let fields: [(&str, Field); 4] = [
                 ("rx_origin", |r| &mut r.rx_origin),
                 ("rx_direction", |r| &mut r.rx_direction),
                 ("ry_origin", |r| &mut r.ry_origin),

@@ -20,60 +20,15 @@
 //! than it holds fails with [`Error::Truncated`] having allocated at most about what it did hold.
 
 use super::checksum::Checksum;
+pub(crate) use super::header::Kind;
+use super::header::{MAGIC, VERSION};
 use super::header::{Seal, confirm, read_header};
 use crate::{Error, Result};
 use std::io::{Read, Write};
 
-/// The first 8 bytes of every file.
-pub(crate) const MAGIC: [u8; 8] = *b"BRDFGLNT";
-
-/// The format version written. Version 5 adds the mixture's seed kernel (files of older versions
-/// hold Gaussian-seeded mixtures). Version 4 holds no per-query options (the mixture's masking mode and
-/// cost cap, the position-normal map's footprint cap: read and ignored in older files, since options
-/// are per query); version 3 added 𝓑 to the bin map's payload and the levels' merge errors to the
-/// full mixture's; version 2 files of every kind but the bin map are still read ([`OLDEST_READ`]; a
-/// version-2 full mixture gets its merge errors recomputed).
-pub(crate) const VERSION: u32 = 5;
-
-/// The oldest format version read (for every kind but the bin map, whose loader needs version 3).
-pub(crate) const OLDEST_READ: u32 = 2;
-
-/// Bytes of the header (magic, version, kind, payload length).
-pub(crate) const HEADER_BYTES: usize = 24;
-
 /// Arrays are converted and hashed through a buffer of this many bytes (and grown by at most this
 /// much per read), so a lying length costs at most one chunk beyond the bytes actually present.
-pub(crate) const CHUNK_BYTES: usize = 1 << 16;
-
-/// The model stored in a file: the format's registry of kind codes (one line per stored type; the
-/// codes are part of the format, docs/format.md).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Kind {
-    /// [`crate::glint::NormalMap`].
-    NormalMap = 1,
-    /// [`crate::glint::BeckmannMixture`].
-    BeckmannMixture = 2,
-    /// [`crate::glint::PositionNormalMap`].
-    PositionNormalMap = 3,
-    /// [`crate::glint::BinMap`].
-    BinMap = 4,
-    /// [`crate::glint::BeckmannMixture`] in compact storage
-    /// ([`crate::glint::mixture::LobeStorage::Compact`]).
-    BeckmannMixtureCompact = 5,
-}
-
-impl Kind {
-    pub(crate) fn name(code: u32) -> String {
-        match code {
-            1 => "NormalMap".into(),
-            2 => "BeckmannMixture".into(),
-            3 => "PositionNormalMap".into(),
-            4 => "BinMap".into(),
-            5 => "BeckmannMixture (compact)".into(),
-            c => format!("unknown kind {c}"),
-        }
-    }
-}
+const CHUNK_BYTES: usize = 1 << 16;
 
 /// A type kept in the crate's file format, implemented by each stored model in its own module: the
 /// run-time [`GlintModel`](crate::glint::GlintModel) saves and loads through it.
@@ -234,7 +189,7 @@ pub(crate) struct Decoder<'a> {
     /// The first value found out of range by [`Decoder::array_in_range`], reported by
     /// [`Decoder::finish`] once the checksum has been checked.
     out_of_range: Option<Error>,
-    /// The file's format version ([`OLDEST_READ`] ..= [`VERSION`]).
+    /// The file's format version ([`OLDEST_READ`](super::header::OLDEST_READ) ..= [`VERSION`]).
     version: u32,
 }
 

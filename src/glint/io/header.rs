@@ -21,9 +21,58 @@
 //! version with the current one: the format keeps the header and the checksum in every version.
 
 use super::checksum::{Checksum, ChecksumV1, FileHash};
-use super::format::{CHUNK_BYTES, HEADER_BYTES, Kind, MAGIC, OLDEST_READ, VERSION};
 use crate::{Error, Result};
 use std::io::Read;
+
+/// The first 8 bytes of every file.
+pub(crate) const MAGIC: [u8; 8] = *b"BRDFGLNT";
+
+/// The format version written. Version 5 adds the mixture's seed kernel (files of older versions
+/// hold Gaussian-seeded mixtures). Version 4 holds no per-query options (the mixture's masking mode and
+/// cost cap, the position-normal map's footprint cap: read and ignored in older files, since options
+/// are per query); version 3 added 𝓑 to the bin map's payload and the levels' merge errors to the
+/// full mixture's; version 2 files of every kind but the bin map are still read ([`OLDEST_READ`]; a
+/// version-2 full mixture gets its merge errors recomputed).
+pub(crate) const VERSION: u32 = 5;
+
+/// The oldest format version read (for every kind but the bin map, whose loader needs version 3).
+pub(crate) const OLDEST_READ: u32 = 2;
+
+/// Bytes of the header (magic, version, kind, payload length).
+pub(crate) const HEADER_BYTES: usize = 24;
+
+/// Bytes of the rest of a file read at once when its checksum is consulted (not kept).
+const CONFIRM_CHUNK_BYTES: usize = 1 << 16;
+
+/// The model stored in a file: the format's registry of kind codes (one line per stored type; the
+/// codes are part of the format, docs/format.md).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Kind {
+    /// [`crate::glint::NormalMap`].
+    NormalMap = 1,
+    /// [`crate::glint::BeckmannMixture`].
+    BeckmannMixture = 2,
+    /// [`crate::glint::PositionNormalMap`].
+    PositionNormalMap = 3,
+    /// [`crate::glint::BinMap`].
+    BinMap = 4,
+    /// [`crate::glint::BeckmannMixture`] in compact storage
+    /// ([`crate::glint::mixture::LobeStorage::Compact`]).
+    BeckmannMixtureCompact = 5,
+}
+
+impl Kind {
+    pub(crate) fn name(code: u32) -> String {
+        match code {
+            1 => "NormalMap".into(),
+            2 => "BeckmannMixture".into(),
+            3 => "PositionNormalMap".into(),
+            4 => "BinMap".into(),
+            5 => "BeckmannMixture (compact)".into(),
+            c => format!("unknown kind {c}"),
+        }
+    }
+}
 
 /// Fewest bytes of a file's first 8 equal to `BRDFGLNT` (at the same places) for the file to be
 /// taken for a brdf file with a damaged magic rather than for foreign bytes.
@@ -175,7 +224,11 @@ fn hashed<H: FileHash>(mut sum: H, bytes: &[u8]) -> H {
 /// [`Error::Stream`] (the end of the data is [`Seal::EndsEarly`], not an error).
 pub(crate) fn confirm(r: &mut dyn Read, mut sum: impl FileHash, remaining: u64) -> Result<Seal> {
     let mut left = remaining;
-    let mut buf = vec![0u8; usize::try_from(left).map_or(CHUNK_BYTES, |l| l.min(CHUNK_BYTES))];
+    let mut buf = vec![
+        0u8;
+        usize::try_from(left)
+            .map_or(CONFIRM_CHUNK_BYTES, |l| l.min(CONFIRM_CHUNK_BYTES))
+    ];
     while left > 0 {
         let k = usize::try_from(left).map_or(buf.len(), |l| l.min(buf.len()));
         if read_up_to(r, &mut buf[..k])? < k {
