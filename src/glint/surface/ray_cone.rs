@@ -17,8 +17,10 @@
 //!    sample of density p, γ ← γ + the full angle of a cone of solid angle 1/p
 //!    ([`RayCone::scatter`]).
 //!
-//! So at a **delta** bounce (a mirror, a smooth dielectric) only the curvature step applies: the
-//! sample's pdf is a convention, not a density, and a mirror adds no spread of its own. At a
+//! So at a **delta** bounce (a mirror) only the curvature step applies: the sample's pdf is a
+//! convention, not a density, and a mirror adds no spread of its own. (The curvature step is a
+//! reflection's; a ray refracted through a curved interface spreads otherwise, which the cone does
+//! not model.) At a
 //! **smooth** bounce (a glossy lobe of small roughness) both apply and the roughness step is small
 //! (it scales as α, below), so the cone tends to the mirror's as α → 0. At a **rough** bounce (large
 //! α, Lambert) both apply and the roughness step dominates (at least 2π/3 for Lambert).
