@@ -93,6 +93,19 @@ pub enum Error {
         /// The newest version this build reads (the one it writes).
         supported: u32,
     },
+    /// A stored model's file header is damaged: a field holds a value that an intact file cannot
+    /// have, and nothing vouches for it (docs/format.md, "Damaged or unsupported"). The magic bytes
+    /// are at most two bytes off `BRDFGLNT`; or the version or kind is not one this loader reads and
+    /// the file's checksum does not match; or the payload length disagrees with the fields the
+    /// payload holds and the checksum does not match. An intact file with such a version or kind
+    /// (its checksum matches) is [`Error::UnsupportedVersion`] or [`Error::WrongModelKind`] instead.
+    #[error("corrupted file header ({field}): {reason}")]
+    CorruptHeader {
+        /// The header field judged damaged: "magic", "version", "kind" or "payload length".
+        field: &'static str,
+        /// What was found and why it is taken for damage.
+        reason: String,
+    },
     /// A stored model's file holds another kind of model than the one asked for.
     #[error("the file holds a {found}, not a {expected}")]
     WrongModelKind {
@@ -123,6 +136,19 @@ pub enum Error {
     InvalidFile {
         /// What is wrong.
         reason: String,
+    },
+    /// A ray footprint's input is not finite (a NaN or infinite uv, derivative, position or
+    /// direction: a bug upstream, in the renderer), refused by the checked footprint constructors
+    /// (`Footprint::try_from_differentials` and friends); the unchecked ones fall back to a
+    /// documented footprint instead.
+    #[error("invalid footprint input `{name}` = {value:?}: {reason}")]
+    InvalidFootprint {
+        /// The argument's name as it appears in the constructor's signature.
+        name: &'static str,
+        /// Its components (a 2D value has z = 0).
+        value: [f32; 3],
+        /// What the valid range is.
+        reason: &'static str,
     },
     /// Reading or writing a stream failed (other than by ending early).
     #[error("stream error: {source}")]

@@ -26,9 +26,10 @@
 //! ## Glints in a renderer
 //!
 //! A glint material is a normal map made into a glint model once; then, at every shading point, a
-//! footprint (from the hit's uv, ∂p/∂u, ∂p/∂v and ray differentials ∂p/∂x, ∂p/∂y, or a
-//! [`glint::RayCone`] for secondary rays) and a BRDF that the renderer integrates as it integrates any
-//! BRDF, with the geometric cosine:
+//! footprint (from the hit's uv, ∂p/∂u, ∂p/∂v and ray differentials ∂p/∂x, ∂p/∂y, which
+//! [`glint::RayDifferential`] gets from a camera ray's offset rays, or a [`glint::RayCone`] for
+//! secondary rays, with one rule at every bounce) and a BRDF that the renderer integrates as it
+//! integrates any BRDF, with the geometric cosine:
 //!
 //! ```
 //! use brdf::bxdf::{Bxdf, MicrofacetBrdf};

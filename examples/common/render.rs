@@ -9,7 +9,7 @@
 
 use brdf::bxdf::{Bxdf, LobeFlags};
 use brdf::frame::Frame;
-use brdf::glint::{Footprint, GlintScratch, RayCone};
+use brdf::glint::{GlintScratch, RayCone, RayDifferential};
 use brdf::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
 use brdf::{Material, Vec2, Vec3};
 use indicatif::ProgressBar;
@@ -115,23 +115,22 @@ impl Camera {
         self.direction(px).normalize()
     }
 
-    /// ∂p/∂x, ∂p/∂y at a hit (p, n): the rays through the neighbouring pixels intersected with the
-    /// tangent plane (the Footprint docs' recipe), the rays aimed at p itself: for a camera hit, the
-    /// ray differential (secondary hits use the path's `RayCone`). Zero where an offset ray runs
-    /// parallel to the plane.
-    fn dp_dxy(&self, p: Vec3, n: Vec3) -> (Vec3, Vec3) {
+    /// The camera ray toward `p` with its offset rays through the neighbouring pixels (x + 1 to
+    /// the right, y + 1 down), aimed as the ray to `p` is: what a camera hit's footprint is made
+    /// from (`RayDifferential::footprint`, the tangent-plane step of the Footprint docs' recipe);
+    /// secondary hits use the path's `RayCone`.
+    pub fn ray_differential(&self, p: Vec3) -> RayDifferential {
         let to_p = p - self.eye;
         let d = to_p / to_p.dot(self.forward).max(1e-6);
         let s = self.pixel_step();
-        let offset = |step: Vec3| {
-            let dir = d + step * s;
-            let denom = n.dot(dir);
-            if denom.abs() < 1e-8 {
-                return Vec3::ZERO;
-            }
-            self.eye + dir * (n.dot(to_p) / denom) - p
-        };
-        (offset(self.right), offset(-self.up))
+        RayDifferential {
+            origin: self.eye,
+            direction: d,
+            rx_origin: self.eye,
+            rx_direction: d + self.right * s,
+            ry_origin: self.eye,
+            ry_direction: d - self.up * s,
+        }
     }
 }
 
@@ -279,15 +278,15 @@ impl Scene {
                 break;
             }
             cone = cone.propagate((hit.p - o).length());
-            let (dpdx, dpdy) = if bounce == 0 {
-                let (dpdx, dpdy) = self.camera.dp_dxy(hit.p, hit.n);
-                (dpdx * footprint_scale, dpdy * footprint_scale)
+            let footprint = if bounce == 0 {
+                self.camera
+                    .ray_differential(hit.p)
+                    .scaled(footprint_scale)
+                    .footprint(hit.uv, hit.dpdu, hit.dpdv, hit.p, hit.n)
             } else {
-                cone.surface_differentials(d, hit.n)
+                cone.footprint(hit.uv, hit.dpdu, hit.dpdv, d, hit.n)
             };
             let material = &self.materials[self.material_at(&hit)];
-            let footprint =
-                Footprint::from_surface_differentials(hit.uv, hit.dpdu, hit.dpdv, dpdx, dpdy);
             let bsdf = material.bsdf(&footprint, scratch);
             let u = [
                 rng.random::<f32>(),
@@ -305,17 +304,17 @@ impl Scene {
             o = hit.p + hit.n * RAY_EPSILON;
             d = wi;
             // The sphere, seen from outside, is convex of curvature 1/radius; the ground is flat.
+            // The cone's rule at a bounce (RayCone's docs): the curvature step always, the
+            // roughness step unless the sample is a delta lobe's.
             let curvature = if hit.sphere { 1.0 / self.radius } else { 0.0 };
-            cone = cone.reflect(curvature);
+            cone = cone.bounce(curvature, &s);
             // A delta sample (a mirror) has no density to weigh against the sky sampler (its pdf
-            // is a convention, not a density: the crate's delta-lobe convention) and does not
-            // widen the cone.
-            if s.flags.contains(LobeFlags::SPECULAR) {
-                previous = None;
+            // is a convention, not a density: the crate's delta-lobe convention).
+            previous = if s.flags.contains(LobeFlags::SPECULAR) {
+                None
             } else {
-                previous = Some((hit.n, pdf));
-                cone = cone.scatter(pdf);
-            }
+                Some((hit.n, pdf))
+            };
         }
         if total.is_finite() {
             total.max(Vec3::ZERO)

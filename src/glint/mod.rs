@@ -24,7 +24,8 @@
 //!
 //! Measured on a metallic sphere under a point light against the exact P-BRDF, every model at the
 //! material's σ_ε = 0.01 and its default options, five maps (docs/glint.md, "Which model where";
-//! docs/data/orb_curves.csv). "Texels per pixel" is the pixel footprint's area on the map.
+//! docs/data/orb_curves.csv). "Texels per pixel" is the pixel footprint's area on the map
+//! ([`GlintModel::footprint_texels`]).
 //!
 //! | texels per pixel | first to a given error | not worth it |
 //! |---|---|---|
@@ -47,7 +48,7 @@
 //!    patch takes its buffers from the scratch's pool of their type with `GlintScratch`'s
 //!    crate-private `home::<T>()`, so the scratch needs no field for it) and the crate-private `Stored` trait of `io/format.rs`
 //!    (`save` / `load` in the crate's file format).
-//! 2. One line per registry: the model's file-format `Kind` code (`io/format.rs`), its line in the
+//! 2. One line per registry: the model's file-format `Kind` code (`io/header.rs`), its line in the
 //!    `glint_models!` registry (`model.rs`: the [`GlintModel`] and [`GlintPatch`] variants, the
 //!    [`GlintOptions`] field, save/load dispatch), its `serde` line (`serialize.rs`), and
 //!    `pub mod` plus the re-export of its model and patch types here.
@@ -122,8 +123,8 @@ pub use scratch::GlintScratch;
 pub use surface::{
     BrushedParams, FlakesParams, Footprint, MAX_ANISOTROPY, MAX_CARVE_WORK_PER_TEXEL,
     MAX_EXTENT_PERIODS, MAX_GENERATED_TEXELS, MAX_SLOPE, MIN_CELL_TEXELS, MIN_WIDTH_TEXELS,
-    NormalMap, NormalRepair, RayCone, ScratchedParams, TangentConvention, brushed, bumpy, flakes,
-    moments_mean_covariance, scratched,
+    NormalMap, NormalRepair, RayCone, RayDifferential, ScratchedParams, TangentConvention, brushed,
+    bumpy, flakes, moments_mean_covariance, scratched,
 };
 pub use surface::{
     DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, HemisphereBins,

@@ -12,7 +12,8 @@
 //! conversion, and the save / load dispatch (which requires the model to implement the crate's file
 //! format).
 
-use super::io::format::{self, Kind, Stored};
+use super::io::format::{Kind, Stored};
+use super::io::header;
 use super::{BeckmannMixture, BinMap, Footprint, GlintNdf, GlintScratch, PositionNormalMap};
 use crate::error::{Error, Result};
 use crate::ndf::forward_ndf;
@@ -109,23 +110,51 @@ macro_rules! glint_models {
             }
 
             /// Reads whichever glint model a file holds (written by [`GlintModel::save`] or by a
-            /// model's own `save`), with every check of that model's `load`.
+            /// model's own `save`), with every check of that model's `load`. The header is judged
+            /// as every loader judges it (docs/format.md, "Damaged or unsupported"): foreign bytes
+            /// are [`Error::BadMagic`], a damaged header [`Error::CorruptHeader`].
             ///
             /// # Errors
-            /// [`Error::WrongModelKind`] for a file of no glint model (a normal map, say), and every
-            /// error of the model's `load`.
+            /// [`Error::WrongModelKind`] for an intact file of no glint model (a normal map, say),
+            /// and every error of the model's `load`.
             pub fn load(r: &mut impl Read) -> Result<Self> {
-                let (head, code) = format::peek_kind(r)?;
-                let mut whole = (&head[..]).chain(r);
+                let kinds = [$(<$model as Stored>::KINDS),+].concat();
+                let header = header::read_header(r, &kinds, "glint model")?;
+                let mut whole = (&header.bytes[..]).chain(r);
                 $(
-                    if <$model as Stored>::KINDS.iter().any(|&k| k as u32 == code) {
+                    if <$model as Stored>::KINDS.contains(&header.kind) {
                         return <$model as Stored>::load_from(&mut whole).map(GlintModel::$variant);
                     }
                 )+
                 Err(Error::WrongModelKind {
                     expected: "glint model".into(),
-                    found: Kind::name(code),
+                    found: Kind::name(header.kind as u32),
                 })
+            }
+
+            /// The size of the normal map the model was built from, (width, height) in texels:
+            /// the texels a footprint is measured in ([`GlintModel::footprint_texels`]).
+            pub fn map_size(&self) -> (usize, usize) {
+                match self {
+                    $( GlintModel::$variant(m) => m.map_size(), )+
+                }
+            }
+
+            /// Texels per unit of uv along u and v, (width, height): the scale that turns a
+            /// footprint's ∂uv/∂x, ∂uv/∂y into texels (texels per pixel = |det(D ∂uv/∂x,
+            /// D ∂uv/∂y)| with D = diag(texel_scale), before the footprint's clamps).
+            pub fn texel_scale(&self) -> Vec2 {
+                let (w, h) = self.map_size();
+                Vec2::new(w as f32, h as f32)
+            }
+
+            /// The area of `footprint` in texels of the model's map, as the model sees it (with
+            /// the footprint's clamps: [`Footprint::area_texels`]). For a footprint made from one
+            /// pixel's ray differentials this is the texels per pixel that the docs' guides and
+            /// charts are given in.
+            pub fn footprint_texels(&self, footprint: &Footprint) -> f32 {
+                let (w, h) = self.map_size();
+                footprint.area_texels(w, h)
             }
         }
 

@@ -1,13 +1,16 @@
 //! Footprints from ray differentials: unclamped views are the differentials, the helpers have the
-//! requested area and orientation, the clamps (width, anisotropy, extent), and degenerate
-//! differentials fall back to the minimal footprint.
+//! requested area and orientation, the clamps (width, anisotropy, extent), degenerate differentials
+//! fall back to the minimal footprint, and the checked constructors refuse non-finite input (and
+//! give the unchecked ones' footprint, bit for bit, for finite input).
 //!
 //! Expected values come from plane geometry and closed-form areas written here.
 
 use crate::support;
 
-use brdf::Vec2;
-use brdf::glint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
+use brdf::glint::{
+    Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS, RayCone, RayDifferential,
+};
+use brdf::{Error, Vec2, Vec3};
 use rand::RngExt;
 
 /// (aaᵀ + bbᵀ)/12 in f64, the covariance of a uniform point of the parallelogram (each of the
@@ -188,4 +191,202 @@ fn degenerate_differentials_fall_back_to_the_minimal_footprint() {
     // uv wraps into [0, 1).
     let f = Footprint::from_differentials(Vec2::new(-3.25, 7.5), Vec2::ZERO, Vec2::ZERO);
     assert_eq!(f.center_uv(), Vec2::new(0.75, 0.5));
+}
+
+/// The footprint's fields as bits (the same footprint, bit for bit).
+fn bits(f: &Footprint) -> [u32; 6] {
+    let v = [f.center_uv(), f.duv_dx(), f.duv_dy()];
+    std::array::from_fn(|i| v[i / 2][i % 2].to_bits())
+}
+
+/// Whether `r` is the refusal of the argument `name`.
+fn refuses(r: brdf::Result<Footprint>, name: &str) -> bool {
+    matches!(r, Err(Error::InvalidFootprint { name: n, .. }) if n == name)
+}
+
+const NON_FINITE: [f32; 3] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY];
+
+/// `v` with component `c` replaced by `x`.
+fn with2(v: Vec2, c: usize, x: f32) -> Vec2 {
+    let mut a = v.to_array();
+    a[c] = x;
+    Vec2::from_array(a)
+}
+
+fn with3(v: Vec3, c: usize, x: f32) -> Vec3 {
+    let mut a = v.to_array();
+    a[c] = x;
+    Vec3::from_array(a)
+}
+
+#[test]
+fn checked_constructors_refuse_non_finite_differentials() {
+    let (uv, dx, dy) = (
+        Vec2::new(0.3, 0.7),
+        Vec2::new(0.01, 0.002),
+        Vec2::new(-0.003, 0.02),
+    );
+    for x in NON_FINITE {
+        for c in 0..2 {
+            let r = |uv, dx, dy| Footprint::try_from_differentials(uv, dx, dy);
+            assert!(refuses(r(with2(uv, c, x), dx, dy), "uv"));
+            assert!(refuses(r(uv, with2(dx, c, x), dy), "duv_dx"));
+            assert!(refuses(r(uv, dx, with2(dy, c, x)), "duv_dy"));
+        }
+    }
+    let (dpdu, dpdv, dpdx, dpdy) = (
+        Vec3::new(2.0, 0.1, 0.0),
+        Vec3::new(0.0, 1.5, 0.3),
+        Vec3::new(0.01, 0.0, 0.002),
+        Vec3::new(0.0, 0.02, -0.001),
+    );
+    let r = |uv, pu, pv, px, py| Footprint::try_from_surface_differentials(uv, pu, pv, px, py);
+    for x in NON_FINITE {
+        for c in 0..3 {
+            assert!(refuses(
+                r(with2(uv, c % 2, x), dpdu, dpdv, dpdx, dpdy),
+                "uv"
+            ));
+            assert!(refuses(r(uv, with3(dpdu, c, x), dpdv, dpdx, dpdy), "dpdu"));
+            assert!(refuses(r(uv, dpdu, with3(dpdv, c, x), dpdx, dpdy), "dpdv"));
+            assert!(refuses(r(uv, dpdu, dpdv, with3(dpdx, c, x), dpdy), "dpdx"));
+            assert!(refuses(r(uv, dpdu, dpdv, dpdx, with3(dpdy, c, x)), "dpdy"));
+        }
+    }
+    // The message names the argument and its value.
+    let e = Footprint::try_from_differentials(uv, dx, Vec2::new(f32::NAN, 0.0)).unwrap_err();
+    assert!(
+        e.to_string().contains("duv_dy") && e.to_string().contains("NaN"),
+        "{e}"
+    );
+}
+
+#[test]
+fn checked_constructors_give_the_same_footprint_for_finite_input() {
+    let mut rng = support::rng(41);
+    let mut v3 = || {
+        Vec3::new(
+            rng.random_range(-2.0..2.0),
+            rng.random_range(-2.0..2.0),
+            rng.random_range(-2.0..2.0),
+        )
+    };
+    for _ in 0..200 {
+        let (a, b, c, d, e) = (v3(), v3(), v3(), v3(), v3());
+        let uv = Vec2::new(a.x * 3.0, a.y * 3.0);
+        let (dx, dy) = (b.truncate() * 0.01, c.truncate() * 0.01);
+        assert_eq!(
+            bits(&Footprint::try_from_differentials(uv, dx, dy).unwrap()),
+            bits(&Footprint::from_differentials(uv, dx, dy))
+        );
+        let (pu, pv, px, py) = (b, c, d * 0.01, e * 0.01);
+        assert_eq!(
+            bits(&Footprint::try_from_surface_differentials(uv, pu, pv, px, py).unwrap()),
+            bits(&Footprint::from_surface_differentials(uv, pu, pv, px, py))
+        );
+        let cone = RayCone::new(0.01, 0.002);
+        let (dir, n) = (d, e);
+        assert_eq!(
+            bits(&cone.try_footprint(uv, pu, pv, dir, n).unwrap()),
+            bits(&cone.footprint(uv, pu, pv, dir, n))
+        );
+        let ray = RayDifferential {
+            origin: a,
+            direction: dir,
+            rx_origin: a,
+            rx_direction: dir + Vec3::X * 1e-3,
+            ry_origin: a,
+            ry_direction: dir + Vec3::Y * 1e-3,
+        };
+        let p = a + dir * 2.0;
+        assert_eq!(
+            bits(&ray.try_footprint(uv, pu, pv, p, n).unwrap()),
+            bits(&ray.footprint(uv, pu, pv, p, n))
+        );
+    }
+}
+
+/// One offset-ray field of a `RayDifferential`.
+type Field = fn(&mut RayDifferential) -> &mut Vec3;
+
+/// The ray cone's and the ray differential's checked footprints refuse every non-finite argument
+/// (and a zero direction or normal); the unchecked ones fall back to the minimal footprint.
+#[test]
+fn ray_footprints_refuse_non_finite_input() {
+    let (uv, pu, pv) = (Vec2::new(0.3, 0.7), Vec3::X * 2.0, Vec3::Z * 1.5);
+    let (dir, n, p) = (Vec3::new(0.2, -1.0, 0.1), Vec3::Y, Vec3::new(0.1, 0.0, 0.2));
+    let cone = RayCone::new(0.01, 0.001);
+    let ray = RayDifferential {
+        origin: Vec3::new(0.0, 2.0, 0.0),
+        direction: dir,
+        rx_origin: Vec3::new(0.0, 2.0, 0.0),
+        rx_direction: dir + Vec3::X * 1e-3,
+        ry_origin: Vec3::new(0.0, 2.0, 0.0),
+        ry_direction: dir + Vec3::Z * 1e-3,
+    };
+    assert!(cone.try_footprint(uv, pu, pv, dir, n).is_ok());
+    assert!(ray.try_footprint(uv, pu, pv, p, n).is_ok());
+    for x in NON_FINITE {
+        for c in 0..3 {
+            let cf = |uv, pu, pv, dir, n| cone.try_footprint(uv, pu, pv, dir, n);
+            assert!(refuses(cf(with2(uv, c % 2, x), pu, pv, dir, n), "uv"));
+            assert!(refuses(cf(uv, with3(pu, c, x), pv, dir, n), "dpdu"));
+            assert!(refuses(cf(uv, pu, with3(pv, c, x), dir, n), "dpdv"));
+            assert!(refuses(cf(uv, pu, pv, with3(dir, c, x), n), "dir"));
+            assert!(refuses(cf(uv, pu, pv, dir, with3(n, c, x)), "n"));
+            let rf = |ray: RayDifferential, uv, pu, pv, p, n| ray.try_footprint(uv, pu, pv, p, n);
+            assert!(refuses(rf(ray, with2(uv, c % 2, x), pu, pv, p, n), "uv"));
+            assert!(refuses(rf(ray, uv, with3(pu, c, x), pv, p, n), "dpdu"));
+            assert!(refuses(rf(ray, uv, pu, with3(pv, c, x), p, n), "dpdv"));
+            assert!(refuses(rf(ray, uv, pu, pv, with3(p, c, x), n), "p"));
+            assert!(refuses(rf(ray, uv, pu, pv, p, with3(n, c, x)), "n"));
+            let fields: [(&str, Field); 4] = [
+                ("rx_origin", |r| &mut r.rx_origin),
+                ("rx_direction", |r| &mut r.rx_direction),
+                ("ry_origin", |r| &mut r.ry_origin),
+                ("ry_direction", |r| &mut r.ry_direction),
+            ];
+            for (name, field) in fields {
+                let mut bad = ray;
+                let v = field(&mut bad);
+                *v = with3(*v, c, x);
+                assert!(refuses(rf(bad, uv, pu, pv, p, n), name), "{name}");
+                // The unchecked form falls back: finite, and no wider than the other offset's.
+                let f = bad.footprint(uv, pu, pv, p, n);
+                assert!(f.duv_dx().is_finite() && f.duv_dy().is_finite(), "{name}");
+            }
+        }
+    }
+    assert!(refuses(
+        cone.try_footprint(uv, pu, pv, Vec3::ZERO, n),
+        "dir"
+    ));
+    assert!(refuses(
+        cone.try_footprint(uv, pu, pv, dir, Vec3::ZERO),
+        "n"
+    ));
+    assert!(refuses(ray.try_footprint(uv, pu, pv, p, Vec3::ZERO), "n"));
+    // The unchecked cone footprint of a NaN direction is the minimal one.
+    let f = cone.footprint(uv, pu, pv, Vec3::NAN, n);
+    let (major, minor) = f.widths_texels(64, 64);
+    assert_eq!((major, minor), (MIN_WIDTH_TEXELS, MIN_WIDTH_TEXELS));
+}
+
+/// A finite solution beyond the f32 range (∂p/∂u tiny against ∂p/∂x) is a footprint at the maximum
+/// extent, not the minimal one a non-finite value would fall back to.
+#[test]
+fn an_overflowing_solution_is_the_widest_footprint() {
+    let (w, h) = (64usize, 64usize);
+    let f = Footprint::from_surface_differentials(
+        Vec2::new(0.5, 0.5),
+        Vec3::X * 1e-30,
+        Vec3::Y * 1e-30,
+        Vec3::X * 1e10,
+        Vec3::Y * 1e10,
+    );
+    assert!(f.duv_dx().is_finite() && f.duv_dy().is_finite());
+    let (major, minor) = f.widths_texels(w, h);
+    let max = MAX_EXTENT_PERIODS * w as f32;
+    assert!(close(major as f64, max as f64, 1e-6), "{major}");
+    assert!(close(minor as f64, max as f64, 1e-6), "{minor}");
 }

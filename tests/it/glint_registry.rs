@@ -125,3 +125,41 @@ fn options_survive_save_load() {
         );
     }
 }
+
+/// Every registered model reports the size of the map it was built from, on a non-square map (so
+/// that width and height cannot be swapped unseen), before and after a save / load, and a
+/// footprint's area in its texels.
+#[test]
+fn every_registered_model_reports_its_map_size() {
+    let map = brdf::glint::scratched(48, 32, Default::default(), 5).unwrap();
+    let mut seen = Vec::new();
+    for ex in support::registry::examples(&map) {
+        assert_eq!(ex.model.map_size(), (48, 32), "{}", ex.label);
+        assert_eq!(
+            ex.model.texel_scale(),
+            Vec2::new(48.0, 32.0),
+            "{}",
+            ex.label
+        );
+        let mut bytes = Vec::new();
+        ex.model.save(&mut bytes).unwrap();
+        let loaded = GlintModel::load(&mut bytes.as_slice()).unwrap();
+        assert_eq!(loaded.map_size(), (48, 32), "{}: loaded", ex.label);
+        // A 3 × 3-texel square of this map, and one whose uv differentials are a tenth of a period
+        // along u and along v: 4.8 × 3.2 texels. (Tolerance: f32 rounding of the areas.)
+        let square = Footprint::isotropic_texels(Vec2::new(0.3, 0.6), 9.0, 48, 32);
+        let a = ex.model.footprint_texels(&square);
+        assert!((a - 9.0).abs() < 1e-4, "{}: {a}", ex.label);
+        let tenth = Footprint::from_differentials(
+            Vec2::new(0.3, 0.6),
+            Vec2::new(0.1, 0.0),
+            Vec2::new(0.0, 0.1),
+        );
+        let a = ex.model.footprint_texels(&tenth);
+        assert!((a - 4.8 * 3.2).abs() < 1e-4, "{}: {a}", ex.label);
+        seen.push(ex.model.name());
+    }
+    for name in GlintModel::NAMES {
+        assert!(seen.contains(name), "{name}: no example");
+    }
+}

@@ -211,3 +211,61 @@ fn cone_width_is_the_geometric_mean_at_oblique_incidence() {
         );
     }
 }
+
+/// The rule at a bounce, stated once (`RayCone`'s docs) and followed by `RayCone::bounce`: the
+/// curvature step always, the roughness step unless the sample is a delta lobe's. Expected spreads
+/// from the documented formulas: 2κw for the curvature, 2 acos(1 − 1/(2π p)) for a sample of density
+/// p. A lobe that narrows toward a mirror (p → ∞) tends to the mirror's cone, with no jump.
+#[test]
+fn bounce_applies_curvature_always_and_roughness_unless_delta() {
+    use brdf::bxdf::{BxdfSample, LobeFlags};
+    use std::f64::consts::PI;
+    let (w, gamma, kappa) = (0.02f32, 0.001f32, 1.0f32);
+    let cone = RayCone::new(w, gamma);
+    let sample = |pdf: f32, flags: LobeFlags| BxdfSample {
+        wi: Vec3::Z,
+        f: Vec3::ONE,
+        pdf,
+        flags,
+    };
+    let curvature = gamma as f64 + 2.0 * kappa as f64 * w as f64;
+    let roughness = |p: f64| 2.0 * (1.0 - 1.0 / (2.0 * PI * p)).acos();
+    // Tolerance: f32 rounding of sums of a few terms of size ≤ π (10⁻⁵), plus, for the roughness
+    // step, the rounding of 1 − ε (ε = 1/(2π p); half an ulp of 1, 6·10⁻⁸) amplified by the slope
+    // of 2 acos near 1, 2/√(2ε).
+    let tol = |p: f64| 1e-5 + 2.0 * 6e-8 / (2.0 / (2.0 * PI * p)).sqrt();
+    let close = |got: f32, want: f64, tol: f64| (got as f64 - want).abs() < tol;
+    // Delta (a mirror): curvature only, whatever the pdf convention holds.
+    let mirror = cone.bounce(kappa, &sample(1.0, LobeFlags::SPECULAR));
+    assert!(
+        close(mirror.spread(), curvature, 1e-5),
+        "{}",
+        mirror.spread()
+    );
+    assert_eq!(mirror.width(), w);
+    // Rough (Lambert's largest density 1/π): both, the roughness step dominating.
+    let p = 1.0 / PI;
+    let rough = cone.bounce(kappa, &sample(p as f32, LobeFlags::DIFFUSE));
+    assert!(
+        close(rough.spread(), curvature + roughness(p), tol(p)),
+        "{}",
+        rough.spread()
+    );
+    // Smooth (glossy, dense lobes): both, and toward the mirror's spread as the density grows.
+    let mut last = f64::INFINITY;
+    for p in [1e2f64, 1e4, 1e6] {
+        let smooth = cone.bounce(kappa, &sample(p as f32, LobeFlags::GLOSSY));
+        assert!(
+            close(smooth.spread(), curvature + roughness(p), tol(p)),
+            "{p}: {}",
+            smooth.spread()
+        );
+        let gap = smooth.spread() as f64 - mirror.spread() as f64;
+        assert!(gap > 0.0 && gap < last, "{p}: {gap}");
+        last = gap;
+    }
+    assert!(last < 2e-3, "{last}");
+    // On a flat surface the curvature step adds nothing.
+    let flat = cone.bounce(0.0, &sample(1.0, LobeFlags::SPECULAR));
+    assert_eq!(flat.spread(), gamma);
+}

@@ -169,8 +169,9 @@ fn pixel_areas(scene: &Scene, tiles: Vec2, map_size: usize) -> Vec<f64> {
             let Some(hit) = scene.intersect(cam.eye, d).filter(|h| h.sphere) else {
                 continue;
             };
-            let (dpdx, dpdy) = cam.dp_dxy(hit.p, hit.n);
-            let fp = Footprint::from_surface_differentials(hit.uv, hit.dpdu, hit.dpdv, dpdx, dpdy);
+            let fp = cam
+                .ray_differential(hit.p)
+                .footprint(hit.uv, hit.dpdu, hit.dpdv, hit.p, hit.n);
             let mapped = Footprint::from_differentials(
                 fp.center_uv() * tiles,
                 fp.duv_dx() * tiles,

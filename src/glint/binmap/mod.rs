@@ -331,6 +331,11 @@ impl BinMap {
         self.height
     }
 
+    /// The map size (width, height) in texels.
+    pub fn map_size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
     /// The direction bins.
     pub fn bins(&self) -> &HemisphereBins {
         &self.bins

@@ -103,7 +103,8 @@ impl BinMap {
     /// one's.
     ///
     /// # Errors
-    /// [`crate::Error::BadMagic`], [`crate::Error::UnsupportedVersion`],
+    /// [`crate::Error::BadMagic`] (foreign bytes), [`crate::Error::CorruptHeader`] (a damaged header,
+    /// docs/format.md "Damaged or unsupported"), [`crate::Error::UnsupportedVersion`],
     /// [`crate::Error::WrongModelKind`], [`crate::Error::Truncated`],
     /// [`crate::Error::ChecksumMismatch`], [`crate::Error::Stream`]; [`crate::Error::InvalidFile`] for
     /// parameters the builder refuses, sizes that do not match the map or the bins, and any

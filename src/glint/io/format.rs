@@ -11,64 +11,24 @@
 //! | 24 | P | payload: the model's parameters, then its arrays, each preceded by its element count |
 //! | 24 + P | 8 | checksum ([`Checksum`]) of bytes [0, 24 + P) |
 //!
+//! The header is read and judged by [`read_header`](super::header::read_header) (foreign bytes, a
+//! damaged header, an intact file of a version or kind not read).
+//!
 //! The full description, payload by payload, is docs/format.md. The reader trusts nothing: every
 //! length is checked against the model's parameters and against what the declared payload can hold
 //! before anything is allocated, and arrays are read in bounded chunks, so a file that claims more
 //! than it holds fails with [`Error::Truncated`] having allocated at most about what it did hold.
 
+use super::checksum::Checksum;
+pub(crate) use super::header::Kind;
+use super::header::{MAGIC, VERSION};
+use super::header::{Seal, confirm, read_header};
 use crate::{Error, Result};
 use std::io::{Read, Write};
-
-/// The first 8 bytes of every file.
-pub(crate) const MAGIC: [u8; 8] = *b"BRDFGLNT";
-
-/// The format version written. Version 5 adds the mixture's seed kernel (files of older versions
-/// hold Gaussian-seeded mixtures). Version 4 holds no per-query options (the mixture's masking mode and
-/// cost cap, the position-normal map's footprint cap: read and ignored in older files, since options
-/// are per query); version 3 added 𝓑 to the bin map's payload and the levels' merge errors to the
-/// full mixture's; version 2 files of every kind but the bin map are still read ([`OLDEST_READ`]; a
-/// version-2 full mixture gets its merge errors recomputed).
-pub(crate) const VERSION: u32 = 5;
-
-/// The oldest format version read (for every kind but the bin map, whose loader needs version 3).
-pub(crate) const OLDEST_READ: u32 = 2;
-
-/// Bytes of the header (magic, version, kind, payload length).
-const HEADER_BYTES: usize = 24;
 
 /// Arrays are converted and hashed through a buffer of this many bytes (and grown by at most this
 /// much per read), so a lying length costs at most one chunk beyond the bytes actually present.
 const CHUNK_BYTES: usize = 1 << 16;
-
-/// The model stored in a file: the format's registry of kind codes (one line per stored type; the
-/// codes are part of the format, docs/format.md).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Kind {
-    /// [`crate::glint::NormalMap`].
-    NormalMap = 1,
-    /// [`crate::glint::BeckmannMixture`].
-    BeckmannMixture = 2,
-    /// [`crate::glint::PositionNormalMap`].
-    PositionNormalMap = 3,
-    /// [`crate::glint::BinMap`].
-    BinMap = 4,
-    /// [`crate::glint::BeckmannMixture`] in compact storage
-    /// ([`crate::glint::mixture::LobeStorage::Compact`]).
-    BeckmannMixtureCompact = 5,
-}
-
-impl Kind {
-    pub(crate) fn name(code: u32) -> String {
-        match code {
-            1 => "NormalMap".into(),
-            2 => "BeckmannMixture".into(),
-            3 => "PositionNormalMap".into(),
-            4 => "BinMap".into(),
-            5 => "BeckmannMixture (compact)".into(),
-            c => format!("unknown kind {c}"),
-        }
-    }
-}
 
 /// A type kept in the crate's file format, implemented by each stored model in its own module: the
 /// run-time [`GlintModel`](crate::glint::GlintModel) saves and loads through it.
@@ -79,118 +39,6 @@ pub(crate) trait Stored: Sized {
     fn save_to(&self, w: &mut dyn Write) -> Result<()>;
     /// Reads a whole file (the type's `load`).
     fn load_from(r: &mut dyn Read) -> Result<Self>;
-}
-
-/// Bytes of the header up to and including the kind code.
-pub(crate) const KIND_END: usize = 16;
-
-/// Reads the first [`KIND_END`] bytes of a file and returns them with the kind code they hold (the
-/// magic and version are checked later, by the loader the bytes are handed back to).
-///
-/// # Errors
-/// [`Error::Truncated`], [`Error::Stream`].
-pub(crate) fn peek_kind(r: &mut dyn Read) -> Result<([u8; KIND_END], u32)> {
-    let mut head = [0u8; KIND_END];
-    read_exact(r, &mut head, "the header")?;
-    Ok((head, u32::get(&head[12..])))
-}
-
-/// The file checksum: four interleaved 64-bit multiply-rotate lanes over little-endian 64-bit words.
-///
-/// Word k of the input (8 bytes, the last one zero-padded) goes to lane k mod 4; lane j starts at
-/// 0xCBF2_9CE4_8422_2325 + j and takes a word w as h ← rotl₂₉((h ⊕ w) · 0x9E37_79B9_7F4A_7C15).
-/// At the end h = lane 0, then for j = 1, 2, 3: h ← rotl₂₉((h ⊕ lane j) · 0x9E37_79B9_7F4A_7C15);
-/// then h ← h ⊕ (byte count) and the SplitMix64 finaliser (h ⊕= h ≫ 30; h ·= 0xBF58_476D_1CE4_E5B9;
-/// h ⊕= h ≫ 27; h ·= 0x94D0_49BB_1331_11EB; h ⊕= h ≫ 31). Every step is a bijection of its lane (or
-/// of h) for fixed other inputs, so any change of one word changes the result; it detects
-/// corruption, it is not a cryptographic signature. The four lanes are independent dependency
-/// chains, so the hash runs at the multiplier's throughput (~0.2 cycle per byte) rather than its
-/// latency (~0.7 for the single chain of format version 1).
-#[derive(Clone, Debug)]
-pub(crate) struct Checksum {
-    lanes: [u64; 4],
-    pending: [u8; 32],
-    pending_len: usize,
-    total: u64,
-}
-
-impl Checksum {
-    const SEED: u64 = 0xCBF2_9CE4_8422_2325;
-    const MUL: u64 = 0x9E37_79B9_7F4A_7C15;
-
-    pub(crate) fn new() -> Checksum {
-        Checksum {
-            lanes: std::array::from_fn(|j| Self::SEED.wrapping_add(j as u64)),
-            pending: [0; 32],
-            pending_len: 0,
-            total: 0,
-        }
-    }
-
-    #[inline]
-    fn mix(h: u64, w: u64) -> u64 {
-        (h ^ w).wrapping_mul(Self::MUL).rotate_left(29)
-    }
-
-    /// One 32-byte block: words 0-3 into lanes 0-3.
-    #[inline]
-    fn block(&mut self, b: &[u8]) {
-        for (j, lane) in self.lanes.iter_mut().enumerate() {
-            let w = u64::from_le_bytes(b[8 * j..8 * j + 8].try_into().unwrap_or([0; 8]));
-            *lane = Self::mix(*lane, w);
-        }
-    }
-
-    pub(crate) fn update(&mut self, mut bytes: &[u8]) {
-        self.total += bytes.len() as u64;
-        if self.pending_len > 0 {
-            let take = (32 - self.pending_len).min(bytes.len());
-            self.pending[self.pending_len..self.pending_len + take].copy_from_slice(&bytes[..take]);
-            self.pending_len += take;
-            bytes = &bytes[take..];
-            if self.pending_len < 32 {
-                return;
-            }
-            let block = self.pending;
-            self.block(&block);
-            self.pending_len = 0;
-        }
-        let mut blocks = bytes.chunks_exact(32);
-        for b in &mut blocks {
-            self.block(b);
-        }
-        let rest = blocks.remainder();
-        self.pending[..rest.len()].copy_from_slice(rest);
-        self.pending_len = rest.len();
-    }
-
-    pub(crate) fn finish(mut self) -> u64 {
-        // The last (< 32) bytes: whole and zero-padded words into lanes 0, 1, ... in order.
-        let mut tail = [0u8; 32];
-        tail[..self.pending_len].copy_from_slice(&self.pending[..self.pending_len]);
-        for j in 0..self.pending_len.div_ceil(8) {
-            let w = u64::from_le_bytes(tail[8 * j..8 * j + 8].try_into().unwrap_or([0; 8]));
-            self.lanes[j] = Self::mix(self.lanes[j], w);
-        }
-        let mut h = self.lanes[0];
-        for &lane in &self.lanes[1..] {
-            h = Self::mix(h, lane);
-        }
-        h ^= self.total;
-        h ^= h >> 30;
-        h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        h ^= h >> 27;
-        h = h.wrapping_mul(0x94D0_49BB_1331_11EB);
-        h ^ (h >> 31)
-    }
-}
-
-/// The checksum of a byte string (what [`Checksum`] computes over a whole file but its last 8 bytes).
-#[cfg(test)]
-pub(crate) fn checksum(bytes: &[u8]) -> u64 {
-    let mut c = Checksum::new();
-    c.update(bytes);
-    c.finish()
 }
 
 fn stream(source: std::io::Error) -> Error {
@@ -341,16 +189,17 @@ pub(crate) struct Decoder<'a> {
     /// The first value found out of range by [`Decoder::array_in_range`], reported by
     /// [`Decoder::finish`] once the checksum has been checked.
     out_of_range: Option<Error>,
-    /// The file's format version ([`OLDEST_READ`] ..= [`VERSION`]).
+    /// The file's format version ([`OLDEST_READ`](super::header::OLDEST_READ) ..= [`VERSION`]).
     version: u32,
 }
 
 impl<'a> Decoder<'a> {
-    /// Reads and checks the header: magic, version, kind.
+    /// Reads and checks the header ([`read_header`](super::header::read_header)): magic, version,
+    /// kind.
     ///
     /// # Errors
-    /// [`Error::Truncated`], [`Error::BadMagic`], [`Error::UnsupportedVersion`],
-    /// [`Error::WrongModelKind`], [`Error::Stream`].
+    /// [`Error::Truncated`], [`Error::BadMagic`], [`Error::CorruptHeader`],
+    /// [`Error::UnsupportedVersion`], [`Error::WrongModelKind`], [`Error::Stream`].
     pub(crate) fn open(r: &'a mut dyn Read, expected: Kind) -> Result<Decoder<'a>> {
         Self::open_any(r, &[expected]).map(|(d, _)| d)
     }
@@ -358,39 +207,27 @@ impl<'a> Decoder<'a> {
     /// [`Decoder::open`] for a loader that reads several kinds (`expected`, not empty): the
     /// decoder and the kind found ([`Error::WrongModelKind`] names the first expected kind).
     pub(crate) fn open_any(r: &'a mut dyn Read, expected: &[Kind]) -> Result<(Decoder<'a>, Kind)> {
-        let mut head = [0u8; HEADER_BYTES];
-        read_exact(r, &mut head, "the header")?;
-        let mut magic = [0u8; 8];
-        magic.copy_from_slice(&head[..8]);
-        if magic != MAGIC {
-            return Err(Error::BadMagic { found: magic });
-        }
-        let version = u32::get(&head[8..]);
-        if !(OLDEST_READ..=VERSION).contains(&version) {
-            return Err(Error::UnsupportedVersion {
-                found: version,
-                supported: VERSION,
-            });
-        }
-        let kind = u32::get(&head[12..]);
-        let Some(&found) = expected.iter().find(|&&k| k as u32 == kind) else {
-            return Err(Error::WrongModelKind {
-                expected: Kind::name(expected[0] as u32),
-                found: Kind::name(kind),
-            });
-        };
+        let header = read_header(r, expected, &Kind::name(expected[0] as u32))?;
         let mut sum = Checksum::new();
-        sum.update(&head);
+        sum.update(&header.bytes);
         Ok((
             Decoder {
                 r,
                 sum,
-                remaining: u64::get(&head[16..]),
+                remaining: header.payload,
                 out_of_range: None,
-                version,
+                version: header.version,
             },
-            found,
+            header.kind,
         ))
+    }
+
+    /// Whether the rest of the file, as the header declares it, matches its checksum (reads it:
+    /// only for judging an error).
+    fn seal(&mut self) -> Result<Seal> {
+        let sum = std::mem::replace(&mut self.sum, Checksum::new());
+        let remaining = std::mem::take(&mut self.remaining);
+        confirm(self.r, sum, remaining)
     }
 
     /// The file's format version.
@@ -398,31 +235,51 @@ impl<'a> Decoder<'a> {
         self.version
     }
 
-    /// Refuses a file older than `oldest` (a payload whose layout changed in that version).
+    /// Refuses a file older than `oldest` (a payload whose layout changed in that version), judged
+    /// as the header's other fields are (an intact file is unsupported, a damaged one corrupted).
     ///
     /// # Errors
-    /// [`Error::UnsupportedVersion`].
-    pub(crate) fn require_version(&self, oldest: u32) -> Result<()> {
-        if self.version < oldest {
-            return Err(Error::UnsupportedVersion {
-                found: self.version,
-                supported: VERSION,
-            });
+    /// [`Error::UnsupportedVersion`], [`Error::CorruptHeader`], [`Error::Truncated`],
+    /// [`Error::Stream`].
+    pub(crate) fn require_version(&mut self, oldest: u32) -> Result<()> {
+        if self.version >= oldest {
+            return Ok(());
         }
-        Ok(())
+        let version = self.version;
+        let intact = Error::UnsupportedVersion {
+            found: version,
+            supported: VERSION,
+        };
+        Err(self.seal()?.judge(intact, "version", || {
+            format!(
+                "this kind is read from version {oldest} on, the header says {version}, and the \
+                 file's checksum does not match"
+            )
+        }))
     }
 
+    /// Counts `n` more payload bytes against what the header declares. A field that needs more than
+    /// is left is judged by the checksum: an intact file is inconsistent ([`Error::InvalidFile`]),
+    /// a damaged one has a payload length (or a count read before) that is wrong
+    /// ([`Error::CorruptHeader`]).
     fn take(&mut self, n: usize, what: &'static str) -> Result<()> {
-        if (n as u64) > self.remaining {
-            return Err(Error::InvalidFile {
-                reason: format!(
-                    "{what} needs {n} more bytes but the header declares only {} left in the payload",
-                    self.remaining
-                ),
-            });
+        if (n as u64) <= self.remaining {
+            self.remaining -= n as u64;
+            return Ok(());
         }
-        self.remaining -= n as u64;
-        Ok(())
+        let left = self.remaining;
+        let intact = Error::InvalidFile {
+            reason: format!(
+                "{what} needs {n} more bytes but the header declares only {left} left in the payload"
+            ),
+        };
+        Err(self.seal()?.judge(intact, "payload length", || {
+            format!(
+                "{what} needs {n} more bytes but the header declares only {left} left in the \
+                 payload, and the file's checksum does not match (the payload length, or a count \
+                 read before {what}, is damaged)"
+            )
+        }))
     }
 
     /// One scalar.
@@ -562,17 +419,30 @@ impl<'a> Decoder<'a> {
     /// Checks that the payload was read exactly and that the checksum matches.
     ///
     /// # Errors
-    /// [`Error::InvalidFile`] if payload bytes are left over, [`Error::Truncated`] if the checksum is
-    /// missing, [`Error::ChecksumMismatch`].
+    /// Payload bytes left over: [`Error::InvalidFile`] if the file's checksum matches (a file
+    /// written inconsistent), else [`Error::CorruptHeader`] (the fields were all read, so the
+    /// declared length is what is wrong), also when the file ends before the declared length.
+    /// [`Error::Truncated`] if the checksum is missing, [`Error::ChecksumMismatch`].
     /// Then reports the first value [`Decoder::array_in_range`] found out of range, if any.
-    pub(crate) fn finish(self) -> Result<()> {
+    pub(crate) fn finish(mut self) -> Result<()> {
         if self.remaining != 0 {
-            return Err(Error::InvalidFile {
+            let extra = self.remaining;
+            let intact = Error::InvalidFile {
                 reason: format!(
-                    "the header declares {} payload bytes more than the model's fields hold",
-                    self.remaining
+                    "the header declares {extra} payload bytes more than the model's fields hold"
                 ),
-            });
+            };
+            let seal = match self.seal()? {
+                Seal::EndsEarly(_) => Seal::Broken,
+                seal => seal,
+            };
+            return Err(seal.judge(intact, "payload length", || {
+                format!(
+                    "the header declares {extra} payload bytes more than the model's fields hold, \
+                     and the file's checksum does not match or the file ends before it (the \
+                     payload length, or the version that sets the fields, is damaged)"
+                )
+            }));
         }
         let mut b = [0u8; 8];
         read_exact(self.r, &mut b, "the checksum")?;
@@ -650,58 +520,4 @@ fn first_out_of_range<const N: usize>(
         }
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn checksum_is_independent_of_chunking() {
-        let data: Vec<u8> = (0..1000u32).map(|k| (k * 7 + 3) as u8).collect();
-        let whole = checksum(&data);
-        for split in [1, 3, 7, 8, 9, 31, 32, 33, 500, 999] {
-            let mut c = Checksum::new();
-            for part in data.chunks(split) {
-                c.update(part);
-            }
-            assert_eq!(c.finish(), whole, "chunks of {split}");
-        }
-        // Any single flipped bit, and an appended zero byte, change it.
-        for bit in [0usize, 7, 63, 64, 4000, 7999] {
-            let mut d = data.clone();
-            d[bit / 8] ^= 1 << (bit % 8);
-            assert_ne!(checksum(&d), whole, "bit {bit}");
-        }
-        let mut d = data.clone();
-        d.push(0);
-        assert_ne!(checksum(&d), whole);
-    }
-
-    /// The reference value of the documented algorithm, computed by hand-written steps here: 9 bytes,
-    /// i.e. word 0 ("BRDFGLNT") into lane 0 and word 1 (0x01, zero-padded) into lane 1.
-    #[test]
-    fn checksum_matches_the_documented_steps() {
-        let bytes = b"BRDFGLNT\x01";
-        let seed: u64 = 0xCBF2_9CE4_8422_2325;
-        let mul: u64 = 0x9E37_79B9_7F4A_7C15;
-        let mix = |h: u64, w: u64| (h ^ w).wrapping_mul(mul).rotate_left(29);
-        let lanes = [
-            mix(seed, u64::from_le_bytes(*b"BRDFGLNT")),
-            mix(seed + 1, 1),
-            seed + 2,
-            seed + 3,
-        ];
-        let mut h = lanes[0];
-        for lane in &lanes[1..] {
-            h = mix(h, *lane);
-        }
-        h ^= 9;
-        h ^= h >> 30;
-        h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        h ^= h >> 27;
-        h = h.wrapping_mul(0x94D0_49BB_1331_11EB);
-        h ^= h >> 31;
-        assert_eq!(checksum(bytes), h);
-    }
 }

@@ -100,7 +100,8 @@ impl BeckmannMixture {
     /// arrive (in 64 KiB steps), whatever the header claims.
     ///
     /// # Errors
-    /// [`crate::Error::BadMagic`], [`crate::Error::UnsupportedVersion`],
+    /// [`crate::Error::BadMagic`] (foreign bytes), [`crate::Error::CorruptHeader`] (a damaged header,
+    /// docs/format.md "Damaged or unsupported"), [`crate::Error::UnsupportedVersion`],
     /// [`crate::Error::WrongModelKind`], [`crate::Error::Truncated`],
     /// [`crate::Error::ChecksumMismatch`], [`crate::Error::Stream`]; [`crate::Error::InvalidFile`] for
     /// parameters the builder refuses, a map size out of range, a lobe count that does not match the

@@ -35,7 +35,8 @@ impl PositionNormalMap {
     /// footprint cap that files of format versions 2 and 3 stored is read and ignored).
     ///
     /// # Errors
-    /// [`crate::Error::BadMagic`], [`crate::Error::UnsupportedVersion`],
+    /// [`crate::Error::BadMagic`] (foreign bytes), [`crate::Error::CorruptHeader`] (a damaged header,
+    /// docs/format.md "Damaged or unsupported"), [`crate::Error::UnsupportedVersion`],
     /// [`crate::Error::WrongModelKind`], [`crate::Error::Truncated`],
     /// [`crate::Error::ChecksumMismatch`], [`crate::Error::Stream`]; [`crate::Error::InvalidFile`] for
     /// parameters the builder refuses, a map size out of range, an element count that does not match

@@ -20,6 +20,7 @@
 //! \[Chermain2019\] §4.1 (Gaussian footprint k_P); \[Igehy1999\] (ray differentials); \[Atanasov2020\] §2
 //! (the pixel footprint A of the bin map, from ray differentials).
 
+use crate::{Error, Result};
 use glam::{Mat2, Vec2, Vec3};
 
 /// Smallest footprint width along any principal axis, in texels (so the smallest area is 10⁻⁴ texel²).
@@ -28,8 +29,9 @@ use glam::{Mat2, Vec2, Vec3};
 /// P-NDF tends to a Dirac delta that no f32 density can represent, and Gaussian weights of the
 /// mixture/Yan models underflow. 0.01 texel is far below any useful pixel footprint (a 4096² map seen
 /// at 4K resolution is still ~1 texel per pixel) and far above f32 resolution of texel coordinates.
-/// Non-finite or vanishing differentials fall back to the minimal isotropic footprint
-/// (a square of side `MIN_WIDTH_TEXELS`).
+/// Vanishing differentials, and non-finite ones given to the unchecked constructors, give the
+/// minimal isotropic footprint (a square of side `MIN_WIDTH_TEXELS`; the type's docs, "Non-finite
+/// input").
 pub const MIN_WIDTH_TEXELS: f32 = 0.01;
 
 /// Largest ratio of the major to the minor width; the minor axis is widened to major / 32.
@@ -67,6 +69,9 @@ pub const MAX_EXTENT_PERIODS: f32 = 2.0;
 /// 3. if the material scales uv (a map repeated k times: uv' = k uv), scale uv and both differentials
 ///    by k, or call [`Footprint::from_differentials`] with the scaled ∂uv directly.
 ///
+/// [`RayDifferential::footprint`](crate::glint::RayDifferential::footprint) does steps 1 and 2 from
+/// pbrt-style offset rays.
+///
 /// Secondary rays (after a diffuse or glossy bounce) have no ray differentials: carry a
 /// [`RayCone`](crate::glint::RayCone) along the path instead and read the footprint from it at each
 /// hit ([`RayCone::footprint`](crate::glint::RayCone::footprint)), which ends in step 2 too.
@@ -82,6 +87,24 @@ pub const MAX_EXTENT_PERIODS: f32 = 2.0;
 /// along ∂p/∂u and y along +∂p/∂v for either handedness, so a slope (x̃, ỹ) of the map and the
 /// footprint's axes are the same (u, v) axes. (`Frame::from_normal_tangent(n, ∂p/∂u)` instead mirrors
 /// v on a left-handed parametrisation: its slopes would no longer match the footprint's texels.)
+///
+/// # Non-finite input
+/// Every footprint constructor comes in two forms. The unchecked ones
+/// ([`Footprint::from_differentials`], [`Footprint::from_surface_differentials`],
+/// [`RayCone::footprint`](crate::glint::RayCone::footprint),
+/// [`RayDifferential::footprint`](crate::glint::RayDifferential::footprint)) are total, as
+/// evaluation is: a non-finite uv becomes (0, 0), non-finite differentials become zero, i.e. the
+/// minimal isotropic footprint ([`MIN_WIDTH_TEXELS`]), so no NaN reaches a model. That fallback is
+/// the patch of one point of the surface, which renders as sparse sparkles: a NaN differential is
+/// always a bug upstream (a zero-length vector normalised, a degenerate camera), and the fallback
+/// hides it. The checked ones (`try_*`) return the same footprint bit for bit for finite input and
+/// [`Error::InvalidFootprint`] naming the first non-finite argument otherwise.
+///
+/// Both are kept, rather than `Result` everywhere, because the footprint is built in the
+/// renderer's shading loop once per hit, where an error has no handling but a fallback: a renderer
+/// calls the checked form where it can act on the error (a debug build, a validation pass, its
+/// tests, a `debug_assert!` of its own) and the unchecked form where it cannot, and the crate's
+/// evaluation stays total either way.
 ///
 /// Then read it in texel units of a map with [`Footprint::gaussian_texels`] or
 /// [`Footprint::parallelogram_texels`] (the glint models do this). See the
@@ -138,7 +161,9 @@ impl Footprint {
     ///
     /// Infallible: a non-finite `uv` is replaced by (0, 0) and is otherwise wrapped into [0, 1)² (maps
     /// tile); if either differential is non-finite both are set to 0, which the texel views turn into
-    /// the minimal isotropic footprint ([`MIN_WIDTH_TEXELS`]). Never produces NaN.
+    /// the minimal isotropic footprint ([`MIN_WIDTH_TEXELS`]). Never produces NaN. To have
+    /// non-finite input reported instead: [`Footprint::try_from_differentials`] (the type's docs,
+    /// "Non-finite input").
     pub fn from_differentials(uv: Vec2, duv_dx: Vec2, duv_dy: Vec2) -> Footprint {
         let uv = Vec2::select(uv.is_finite_mask(), uv, Vec2::ZERO);
         let mut uv = uv - uv.floor();
@@ -152,6 +177,42 @@ impl Footprint {
         Footprint { uv, duv_dx, duv_dy }
     }
 
+    /// [`Footprint::from_differentials`] that refuses non-finite input instead of falling back:
+    /// the same footprint, bit for bit, for finite input.
+    ///
+    /// # Errors
+    /// [`Error::InvalidFootprint`] naming the first of `uv`, `duv_dx`, `duv_dy` that is not finite.
+    pub fn try_from_differentials(uv: Vec2, duv_dx: Vec2, duv_dy: Vec2) -> Result<Footprint> {
+        finite_input("uv", uv.extend(0.0))?;
+        finite_input("duv_dx", duv_dx.extend(0.0))?;
+        finite_input("duv_dy", duv_dy.extend(0.0))?;
+        Ok(Footprint::from_differentials(uv, duv_dx, duv_dy))
+    }
+
+    /// [`Footprint::from_surface_differentials`] that refuses non-finite input instead of falling
+    /// back: the same footprint, bit for bit, for finite input (a singular parametrisation, which
+    /// is geometry rather than a bug, still gives the minimal footprint).
+    ///
+    /// # Errors
+    /// [`Error::InvalidFootprint`] naming the first of `uv`, `dpdu`, `dpdv`, `dpdx`, `dpdy` that is
+    /// not finite.
+    pub fn try_from_surface_differentials(
+        uv: Vec2,
+        dpdu: Vec3,
+        dpdv: Vec3,
+        dpdx: Vec3,
+        dpdy: Vec3,
+    ) -> Result<Footprint> {
+        finite_input("uv", uv.extend(0.0))?;
+        finite_input("dpdu", dpdu)?;
+        finite_input("dpdv", dpdv)?;
+        finite_input("dpdx", dpdx)?;
+        finite_input("dpdy", dpdy)?;
+        Ok(Footprint::from_surface_differentials(
+            uv, dpdu, dpdv, dpdx, dpdy,
+        ))
+    }
+
     /// The footprint of a ray hit from the surface's ∂p/∂u, ∂p/∂v and the ray differentials ∂p/∂x,
     /// ∂p/∂y (any common world frame and unit; the recipe is in the type's docs): ∂uv/∂x is the
     /// least-squares solution of ∂p/∂u ∂u/∂x + ∂p/∂v ∂v/∂x = ∂p/∂x (normal equations in `f64`), the
@@ -162,7 +223,10 @@ impl Footprint {
     ///
     /// Degenerate cases: a singular parametrisation (∂p/∂u ∥ ∂p/∂v, or either zero) or non-finite
     /// input gives zero differentials, i.e. the minimal footprint ([`MIN_WIDTH_TEXELS`]); the result
-    /// is never NaN.
+    /// is never NaN ([`Footprint::try_from_surface_differentials`] reports non-finite input
+    /// instead). A finite solution beyond the f32 range (∂p/∂u tiny against ∂p/∂x) is clamped to
+    /// ±`f32::MAX`, a footprint the texel views clamp to [`MAX_EXTENT_PERIODS`], never a minimal
+    /// one.
     ///
     /// # Reference
     /// \[Igehy1999\] (ray differentials); the least-squares step is pbrt-v4's
@@ -187,7 +251,8 @@ impl Footprint {
             let (b0, b1) = (dot(pu, f(d)), dot(pv, f(d)));
             let du = (a11 * b0 - a01 * b1) / det;
             let dv = (a00 * b1 - a01 * b0) / det;
-            Vec2::new(du as f32, dv as f32)
+            let to_f32 = |x: f64| x.clamp(-f32::MAX as f64, f32::MAX as f64) as f32;
+            Vec2::new(to_f32(du), to_f32(dv))
         };
         Footprint::from_differentials(uv, solve(dpdx), solve(dpdy))
     }
@@ -356,6 +421,18 @@ impl Footprint {
         let v = self.texel_view(width, height);
         (v.widths[0] * v.widths[1]) as f32
     }
+}
+
+/// `Ok` if every component of the argument `name` is finite, else [`Error::InvalidFootprint`].
+pub(crate) fn finite_input(name: &'static str, value: Vec3) -> Result<()> {
+    if value.is_finite() {
+        return Ok(());
+    }
+    Err(Error::InvalidFootprint {
+        name,
+        value: value.to_array(),
+        reason: "must be finite",
+    })
 }
 
 fn to_vec2(v: [f64; 2]) -> Vec2 {

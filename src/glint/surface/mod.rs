@@ -10,8 +10,10 @@
 //! - pixels.rs: decoding normal maps from 8-bit, 16-bit or float pixel slices (always available).
 //! - image_io.rs: decoding PNG / EXR normal-map files into those pixels (feature `image`).
 //! - footprint.rs: [`Footprint`], a ray footprint as a parallelogram and a Gaussian.
+//! - ray_differential.rs: [`RayDifferential`], a camera ray's offset rays and the tangent-plane
+//!   step from them to ∂p/∂x, ∂p/∂y and the footprint.
 //! - ray_cone.rs: [`RayCone`], footprints for secondary rays (width and spread propagated through
-//!   reflections).
+//!   bounces, one rule for every lobe).
 
 mod bins;
 mod footprint;
@@ -22,6 +24,7 @@ mod normal_map;
 mod pixels;
 mod procedural;
 mod ray_cone;
+mod ray_differential;
 
 pub use bins::HemisphereBins;
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
@@ -39,3 +42,4 @@ pub use procedural::{
     ScratchedParams, brushed, bumpy, flakes, scratched,
 };
 pub use ray_cone::RayCone;
+pub use ray_differential::RayDifferential;

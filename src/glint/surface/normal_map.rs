@@ -496,7 +496,8 @@ impl NormalMap {
     /// `image`); `save` / `load` are the crate's own binary format, as for every glint model.
     ///
     /// # Errors
-    /// [`Error::BadMagic`], [`Error::UnsupportedVersion`], [`Error::WrongModelKind`],
+    /// [`Error::BadMagic`] (foreign bytes), [`Error::CorruptHeader`] (a damaged header, docs/format.md
+    /// "Damaged or unsupported"), [`Error::UnsupportedVersion`], [`Error::WrongModelKind`],
     /// [`Error::Truncated`], [`Error::ChecksumMismatch`], [`Error::Stream`]; [`Error::InvalidFile`]
     /// for a size that is zero, too large or does not match the slope count, and for slopes that
     /// [`NormalMap::from_slopes`] refuses (non-finite or above [`MAX_SLOPE`]).

@@ -8,10 +8,32 @@
 //! 1. travel a distance t: w ← |w + γ t| ([`RayCone::propagate`]);
 //! 2. at the hit, read the footprint ([`RayCone::footprint`]): the cross-section projected along the
 //!    ray onto the tangent plane, then [`Footprint::from_surface_differentials`];
-//! 3. reflect off a curved surface: γ ← γ + 2 κ w with κ = 1/radius, positive where the surface
-//!    bends away from the ray (convex) ([`RayCone::reflect`]);
-//! 4. leave through a rough BRDF sample of density p: γ ← γ + the full angle of a cone of solid
-//!    angle 1/p ([`RayCone::scatter`]).
+//! 3. leave the surface along a sampled direction: [`RayCone::bounce`], the one rule below.
+//!
+//! **The rule at a bounce** ([`RayCone::bounce`]), the same for every lobe:
+//! 1. the curvature step, always: γ ← γ + 2 κ w with κ = 1/radius, positive where the surface
+//!    bends away from the ray (convex), 0 on a flat surface ([`RayCone::reflect`]);
+//! 2. then the roughness step, unless the sample is a delta lobe's ([`LobeFlags::SPECULAR`]): for a
+//!    sample of density p, γ ← γ + the full angle of a cone of solid angle 1/p
+//!    ([`RayCone::scatter`]).
+//!
+//! So at a **delta** bounce (a mirror) only the curvature step applies: the sample's pdf is a
+//! convention, not a density, and a mirror adds no spread of its own. (The curvature step is a
+//! reflection's; a ray refracted through a curved interface spreads otherwise, which the cone does
+//! not model.) At a
+//! **smooth** bounce (a glossy lobe of small roughness) both apply and the roughness step is small
+//! (it scales as α, below), so the cone tends to the mirror's as α → 0. At a **rough** bounce (large
+//! α, Lambert) both apply and the roughness step dominates (at least 2π/3 for Lambert).
+//!
+//! Why both at a non-delta bounce: the two spreads have different causes and their full angles add.
+//! Across the footprint's width w the surface normal turns by κ w, so the mirror directions of the
+//! footprint's points fan out over 2 κ w whatever the lobe; a lobe then spreads each point's
+//! reflection over its own cone around that point's mirror direction. The beam leaving the
+//! footprint covers the union of those cones, whose full angle is the sum of the two (to first
+//! order), as for any two supports swept one along the other. The cone's spread is such a full
+//! angle, not a standard deviation (which would add in quadrature). Dropping the curvature step at
+//! rough bounces would make the cone jump down when a mirror is replaced by a lobe of tiny α;
+//! dropping the roughness step would make rough bounces as sharp as mirrors.
 //!
 //! The width is the diameter of \[AkenineMoller2019\] and the spread the full cone angle of
 //! \[AkenineMoller2019\] and \[AkenineMoller2021\] (the refraction chapter of Ray Tracing Gems II uses
@@ -37,7 +59,10 @@
 //! \[AkenineMoller2021\] §3 (curvature approximations, preferring underestimated spread in a Monte
 //! Carlo path tracer); \[Igehy1999\] (the ray differentials tests compare against).
 
-use super::footprint::Footprint;
+use super::footprint::{Footprint, finite_input};
+use super::ray_differential::nonzero_normal;
+use crate::Result;
+use crate::bxdf::{BxdfSample, LobeFlags};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -130,6 +155,23 @@ impl RayCone {
         RayCone::new(self.width, self.spread + RayCone::scatter_spread(pdf))
     }
 
+    /// The cone after leaving a surface of curvature `curvature` along `sample` (a BRDF's sample
+    /// at the hit): the rule at a bounce (module docs), [`RayCone::reflect`]`(curvature)`, then
+    /// [`RayCone::scatter`]`(sample.pdf)` unless the sample is a delta lobe's
+    /// ([`LobeFlags::SPECULAR`]). Call it after [`RayCone::propagate`] and the footprint read at the
+    /// hit.
+    ///
+    /// # Reference
+    /// \[AkenineMoller2019\] (the curvature step); the roughness step is the module docs' own rule.
+    pub fn bounce(self, curvature: f32, sample: &BxdfSample) -> RayCone {
+        let reflected = self.reflect(curvature);
+        if sample.flags.contains(LobeFlags::SPECULAR) {
+            reflected
+        } else {
+            reflected.scatter(sample.pdf)
+        }
+    }
+
     /// The spread a rough BRDF adds for a sample of density `pdf`: the full angle of the cone of
     /// solid angle Ω = 1/pdf, 2 acos(1 − Ω/2π), at most π (Ω ≥ 2π, or pdf ≤ 0 or non-finite, which
     /// carries no information about the lobe's width). A near-specular sample (pdf → ∞) adds 0.
@@ -171,10 +213,41 @@ impl RayCone {
 
     /// The footprint of the cone at a hit: [`Footprint::from_surface_differentials`] of the
     /// surface's `uv`, ∂p/∂u, ∂p/∂v and the edges of [`RayCone::surface_differentials`]`(dir, n)`.
-    /// Any handedness of (∂p/∂u, ∂p/∂v); degenerate input gives the minimal footprint, never NaN.
+    /// Any handedness of (∂p/∂u, ∂p/∂v); degenerate input gives the minimal footprint, never NaN
+    /// ([`RayCone::try_footprint`] reports non-finite input instead).
     pub fn footprint(&self, uv: Vec2, dpdu: Vec3, dpdv: Vec3, dir: Vec3, n: Vec3) -> Footprint {
         let (dpdx, dpdy) = self.surface_differentials(dir, n);
         Footprint::from_surface_differentials(uv, dpdu, dpdv, dpdx, dpdy)
+    }
+
+    /// [`RayCone::footprint`] that refuses non-finite input: the same footprint, bit for bit, when
+    /// every argument is finite and `dir` and `n` are not zero. (The cone itself is always finite:
+    /// its constructors and steps replace non-finite values, as their docs say.)
+    ///
+    /// # Errors
+    /// [`Error::InvalidFootprint`](crate::Error::InvalidFootprint) naming the first of `uv`,
+    /// `dpdu`, `dpdv`, `dir`, `n` that is not finite, or `dir` or `n` if it is zero.
+    pub fn try_footprint(
+        &self,
+        uv: Vec2,
+        dpdu: Vec3,
+        dpdv: Vec3,
+        dir: Vec3,
+        n: Vec3,
+    ) -> Result<Footprint> {
+        finite_input("uv", uv.extend(0.0))?;
+        finite_input("dpdu", dpdu)?;
+        finite_input("dpdv", dpdv)?;
+        finite_input("dir", dir)?;
+        if dir == Vec3::ZERO {
+            return Err(crate::Error::InvalidFootprint {
+                name: "dir",
+                value: dir.to_array(),
+                reason: "must not be zero",
+            });
+        }
+        nonzero_normal(n)?;
+        Ok(self.footprint(uv, dpdu, dpdv, dir, n))
     }
 }
 

@@ -2,9 +2,11 @@
 //! query directions, and the offsets of the fields in a mixture file (docs/format.md).
 
 use super::format::reseal;
-use brdf::Vec3;
+use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{LobeStorage, MixtureParams, SeedKernel};
-use brdf::glint::{BeckmannMixture, NormalMap};
+use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::{BeckmannMixture, BinMap, NormalMap, PositionNormalMap};
+use brdf::{Error, Vec3};
 
 /// White-noise slopes in [−0.6, 0.6]² (seed `n`): every lobe and element different.
 pub fn map(n: usize) -> NormalMap {
@@ -56,6 +58,91 @@ pub fn small_compact_file() -> Vec<u8> {
 /// Loads a mixture from bytes.
 pub fn load_mixture(bytes: &[u8]) -> brdf::Result<BeckmannMixture> {
     BeckmannMixture::load(&mut &bytes[..])
+}
+
+/// A small file of every kind, with its loader.
+#[allow(clippy::type_complexity)]
+pub fn small_files() -> Vec<(&'static str, Vec<u8>, fn(&[u8]) -> brdf::Result<()>)> {
+    let m = map(6);
+    let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
+    let bm_params = BinMapParams {
+        bins_per_axis: 3,
+        leaf_size: 2,
+        ..BinMapParams::default()
+    };
+    let bm = BinMap::build(&m, bm_params).unwrap();
+    vec![
+        ("mixture", small_mixture_file(), |b| {
+            load_mixture(b).map(drop)
+        }),
+        ("compact mixture", small_compact_file(), |b| {
+            load_mixture(b).map(drop)
+        }),
+        ("normal map", saved(|w| m.save(w)), |b| {
+            NormalMap::load(&mut &b[..]).map(drop)
+        }),
+        ("position-normal", saved(|w| pn.save(w)), |b| {
+            PositionNormalMap::load(&mut &b[..]).map(drop)
+        }),
+        ("bin map", saved(|w| bm.save(w)), |b| {
+            BinMap::load(&mut &b[..]).map(drop)
+        }),
+    ]
+}
+
+/// Whether `e` is the documented error (docs/format.md, "What a loader checks" and "Damaged or
+/// unsupported") of `file` with byte `k` XOR `mask`, for a loader that reads the kinds `reads_kind`
+/// accepts (the file being a current-version file that loader reads).
+pub fn is_flip_error(
+    file: &[u8],
+    k: usize,
+    mask: u8,
+    e: &Error,
+    reads_kind: impl Fn(u32) -> bool,
+) -> bool {
+    let mut f = file.to_vec();
+    f[k] ^= mask;
+    let word = |at: usize| u32::from_le_bytes(f[at..at + 4].try_into().unwrap());
+    // Damage the loader meets inside the payload: a parameter or count refused before the checksum
+    // is read, a field that runs past the declared payload (a damaged count, judged by the
+    // checksum: the payload length disagrees), data that run out, or the checksum.
+    let payload_error = matches!(
+        e,
+        Error::InvalidFile { .. }
+            | Error::ChecksumMismatch { .. }
+            | Error::Truncated { .. }
+            | Error::CorruptHeader {
+                field: "payload length",
+                ..
+            }
+    );
+    match k {
+        // One damaged byte of the magic (7 of 8 still right).
+        0..8 => matches!(e, Error::CorruptHeader { field: "magic", .. }),
+        // A flip that lands on another version this build reads (5 ^ 0x01 = 4): the payload is
+        // read in that version's layout, and its checks or the checksum catch the damage.
+        8..12 if (2..=5).contains(&word(8)) => payload_error,
+        8..12 => matches!(
+            e,
+            Error::CorruptHeader {
+                field: "version",
+                ..
+            }
+        ),
+        // The same for a kind this loader reads.
+        12..16 if reads_kind(word(12)) => payload_error,
+        12..16 => matches!(e, Error::CorruptHeader { field: "kind", .. }),
+        // Too long: every field is read and bytes are left (or the file ends first); too short: a
+        // field runs past it. The checksum does not match either way.
+        16..24 => matches!(
+            e,
+            Error::CorruptHeader {
+                field: "payload length",
+                ..
+            }
+        ),
+        _ => payload_error,
+    }
 }
 
 /// `file` with `fields` inserted at byte `offset` of the file, the header's version set to `version`
