@@ -132,9 +132,9 @@
 //! method that first reaches it on each map, with a glint model's equal-error speedup over naive
 //! (∞: naive does not get there by 4,096 spp); build times not counted (docs/glint.md, "Which model
 //! where", has the per-map tables with builds). Times are wall-clock, ±30 % between runs. Last
-//! column: the error of the mixture ([`BeckmannMixture`](crate::glint::BeckmannMixture)) at its
-//! defaults, one evaluation per pixel. Generated from docs/data/orb_curves.csv by `python3
-//! tools/orb_which.py --write`.
+//! column: the error of [the mixture](crate::glint::BeckmannMixture) at its defaults, one
+//! evaluation per pixel. Generated from docs/data/orb_curves.csv by `python3 tools/orb_which.py
+//! --write`.
 //!
 //! | texels per pixel | first to 0.2 | first to 0.1 | first to 0.05 | mixture's error |
 //! |---|---|---|---|---|

@@ -198,10 +198,11 @@ def mixture_errors(rows, sc):
 def summary(rows, maps, scales, texels, errors, form):
     """The summary guide as Markdown lines; `form` "rust" links the types for rustdoc."""
     if form == "rust":
-        mix = "[`BeckmannMixture`](crate::glint::BeckmannMixture)"
+        # A label that is not a path: the same line resolves in the crate root and in `glint`.
+        mix = "[the mixture](crate::glint::BeckmannMixture)"
         per_map = "docs/glint.md, \"Which model where\", has the per-map tables with builds"
     else:
-        mix = "`BeckmannMixture`"
+        mix = "the mixture (`BeckmannMixture`)"
         per_map = "the per-map tables below count them"
     intro = (
         "Measured on the orb (docs/results.md, \"Error against time\"): a metallic sphere under a point "
@@ -213,7 +214,7 @@ def summary(rows, maps, scales, texels, errors, form):
         "with a glint model's equal-error speedup over naive (∞: naive does not get there by "
         f"4,096 spp); build times not counted ({per_map}). Times are wall-clock, ±30 % between "
         "runs. Last column: "
-        f"the error of the mixture ({mix}) at its defaults, one evaluation per pixel. Generated "
+        f"the error of {mix} at its defaults, one evaluation per pixel. Generated "
         "from docs/data/orb_curves.csv by `python3 tools/orb_which.py --write`."
     )
     width = WIDTH - (4 if form == "rust" else 0)
