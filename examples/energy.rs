@@ -1,7 +1,8 @@
 //! Energy compensation charts: the white furnace before / after against α and θo, and rough gold
 //! spheres uncompensated against compensated; see `common::energy`.
 //!
-//! `cargo run --release --example energy -- [--out DIR] [--quick]`
+//! `cargo run --release --example energy -- [--out DIR]` (every value by deterministic quadrature;
+//! `--quick` is accepted and changes nothing).
 
 mod common;
 

@@ -292,6 +292,7 @@ fn write_outputs(
                             (r.texels as f64, y)
                         })
                         .collect(),
+                    errors: Vec::new(),
                 })
                 .collect();
             let title = format!(

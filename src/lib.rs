@@ -106,22 +106,46 @@
 //!
 //! ## Which model when
 //!
-//! From docs/results.md, "Accuracy against speed": every glint model renders the same material
-//! (intrinsic roughness σ_ε = 0.01), four procedural maps at 1024², footprints of 0.25-256 texels,
-//! mean total-variation distance to the ground-truth P-NDF convolved by σ_ε (TV), one thread on a
-//! loaded machine (times are inflated; ratios hold); memory from "Memory per model" (2048²). The
-//! full sweep against rendered error is in "Error against time". Provisional where a model's level
-//! of detail is still set by hand (the mixture's `lod_lobes`).
+//! - **No normal map** (smooth to rough metal, plastic): [`Material::microfacet`] over [`Ggx`] or
+//!   [`Beckmann`] ([`Material::microfacet_compensated`] to keep the energy of multiple scattering),
+//!   [`Material::layered`] for a coat, [`Material::mirror`] for the smooth limit: closed forms.
+//! - **A normal map, no glints** (the look is smooth): [`material::NormalMappedMaterial`]
+//!   (microfacet-based normal mapping), one map lookup per shading point.
+//! - **Glints**: a glint model of the map, at its defaults. Each chooses its own form per footprint
+//!   from measured errors (no setting by hand): the mixture ([`glint::BeckmannMixture`], exact
+//!   masking by default) a sub-texel lobe below 2 texels, its gathered lobes (merged levels within
+//!   a TV budget of 0.01, and a cost cap) and its filtered mixture from 4,096 texels where that
+//!   stays within 0.15 TV of the full mixture ([`glint::mixture::PatchOptions`]); the bin map
+//!   ([`glint::BinMap`]) its exact or moment-lobe masking; position-normal
+//!   ([`glint::PositionNormalMap`]) its element sum or filtered mixture. Which is first to a given
+//!   error depends on the pixel's footprint on the map (texels per pixel), as below.
+//! - **Memory** (docs/results.md, "Memory per model"): the mixture holds 119 B/texel at the
+//!   defaults (at 512²-2048²: lobes, lobe blocks, quadtree, the moment and filtered-mixture mip
+//!   chains, levels of detail), 15.4 B/texel with `LobeStorage::Compact` (1.4-1.8× the query time);
+//!   the bin map 29.2 B/texel at 2048², position-normal 29.3 (and up to 32 more once a footprint
+//!   needs its filtered mixture).
 //!
-//! | need | use | figures |
-//! |---|---|---|
-//! | no map: smooth to rough metal, plastic | [`Material::microfacet`] over [`Ggx`] or [`Beckmann`], [`Material::layered`] for a coat, [`Material::mirror`] for the smooth limit | closed forms; GGX 0.1 µs per eval ("Classic BRDFs") |
-//! | a normal map, no glints (pixels cover many texels, or the look is smooth) | [`material::NormalMappedMaterial`] (microfacet-based normal mapping) | one map lookup per shading point |
-//! | glints, the default | [`glint::BeckmannMixture`], approximate masking | TV 0.098, 0.27 µs per eval, 87 B/texel |
-//! | glints, many materials in memory | the mixture with `LobeStorage::Compact` | TV within 5·10⁻⁵ of full storage, 1.3-1.7× the query time, 15.4 B/texel ("Compact storage") |
-//! | glints, cost flat in footprint size | [`glint::BinMap`], B = 255², s = 2, smoothed at α = √2 σ_ε | TV 0.138, 0.45 µs per eval, `d` ≤ 0.6 µs up to 256 texels, 29 B/texel |
-//! | the closest to the material, cost no object | [`glint::PositionNormalMap`], rate 2 | TV 0.012, 4.4 µs per eval (16× the mixture), `d` 93 µs at 256 texels, 117 B/texel |
-//! | far away (footprints of thousands of texels) | any glint model's level of detail: merged lobes or one filtered lobe | filtered lobe 0.06 µs per eval, TV 0.30 |
+//! <!-- which-model:begin -->
+//! Measured on the orb (docs/results.md, "Error against time"): a metallic sphere under a point
+//! light, 128² pixels, 5 maps of 512² (scratched, brushed, bumpy, flakes, fractal) at 5 pixel
+//! footprints, every glint model at the material's σ_ε = 0.01 and its default options (the mixture
+//! also with its level of detail off, "no LOD"), against naive normal mapping at 1-4,096 samples
+//! per pixel. Per footprint and target error (denoised relative RMSE against the exact P-BRDF): the
+//! method that first reaches it on each map, with a glint model's equal-error speedup over naive
+//! (∞: naive does not get there by 4,096 spp); build times not counted (docs/glint.md, "Which model
+//! where", has the per-map tables with builds). Times are wall-clock, ±30 % between runs. Last
+//! column: the error of [the mixture](crate::glint::BeckmannMixture) at its defaults, one
+//! evaluation per pixel. Generated from docs/data/orb_curves.csv by `python3 tools/orb_which.py
+//! --write`.
+//!
+//! | texels per pixel | first to 0.2 | first to 0.1 | first to 0.05 | mixture's error |
+//! |---|---|---|---|---|
+//! | 1 | naive: scratched, brushed, bumpy, fractal; mixture (no LOD): flakes (1.2×) | naive: brushed, bumpy, flakes, fractal; mixture: scratched (1.3×) | naive: brushed, bumpy, flakes, fractal; mixture: scratched (2.4×) | 0.02-0.70 |
+//! | 9 | naive: brushed, bumpy, fractal; pos.-normal: scratched, flakes (1.2-2.4×) | naive: brushed, bumpy, fractal; mixture (no LOD): scratched, flakes (3.8-5.1×) | naive: scratched, brushed, fractal; mixture (no LOD): flakes (13×); nothing: bumpy | 0.03-0.43 |
+//! | 34 | naive: brushed, bumpy, flakes, fractal; mixture (no LOD): scratched (3.8×) | naive: scratched, brushed, flakes, fractal; nothing: bumpy | naive: scratched, brushed; nothing: bumpy, flakes, fractal | 0.12-0.28 |
+//! | 2,186 | bin map: scratched, brushed (5.5-39×); mixture: bumpy, fractal (∞×); naive: flakes | mixture: brushed, fractal (4.5-∞×); naive: scratched; pos.-normal: flakes (3.8×); nothing: bumpy | mixture: scratched, flakes (3.2-∞×); nothing: brushed, bumpy, fractal | 0.01-0.10 |
+//! | 139,898 | mixture: scratched, brushed, bumpy, fractal (13-∞×); naive: flakes | mixture: scratched, brushed, bumpy, fractal (50-∞×); nothing: flakes | bin map: scratched, brushed (34-∞×); mixture: fractal (∞×); nothing: bumpy, flakes | 0.04-0.27 |
+//! <!-- which-model:end -->
 //!
 //! Any of them as one run-time type: [`Material`] (module [`material`]).
 

@@ -316,17 +316,21 @@ fn methods(rows: &[Row]) -> Vec<String> {
     m
 }
 
-fn series(rows: &[Row], keep: &dyn Fn(&str) -> bool, y: &dyn Fn(&Row) -> f64) -> Vec<Series> {
+/// One series per kept method against 90° − θo, with error bars of half-width `err` if given.
+fn series(
+    rows: &[Row],
+    keep: &dyn Fn(&str) -> bool,
+    y: &dyn Fn(&Row) -> f64,
+    err: Option<fn(&Row) -> f64>,
+) -> Vec<Series> {
     methods(rows)
         .into_iter()
         .filter(|m| keep(m))
         .map(|m| {
-            let pts = rows
-                .iter()
-                .filter(|r| r.method == m)
-                .map(|r| (90.0 - r.theta, y(r)))
-                .collect();
-            Series::new(m, pts)
+            let of_m: Vec<&Row> = rows.iter().filter(|r| r.method == m).collect();
+            let pts = of_m.iter().map(|r| (90.0 - r.theta, y(r))).collect();
+            let errors = err.map_or(Vec::new(), |e| of_m.iter().map(|r| e(r)).collect());
+            Series::new(m, pts).with_errors(errors)
         })
         .collect()
 }
@@ -341,6 +345,8 @@ struct GrazingChart {
     /// Include the published position-normal BRDF (its V column repeats the patch's).
     with_published: bool,
     value: fn(&Row) -> f64,
+    /// Half-width of the error bar of a point, if the value is an estimate.
+    error: Option<fn(&Row) -> f64>,
     caption: &'static str,
 }
 
@@ -379,6 +385,7 @@ pub fn report(rows: &[Row], out: &Path) -> Res<(Vec<Artifact>, String)> {
             y_range: (1e-8, 10.0),
             with_published: false,
             value: |r| r.v_rel_error.max(1e-8),
+            error: None,
             caption: "Relative error of V(wo) = A(1 + Λ) against 90° − θo: analytic NDFs against f64 \
                       closed forms, glint patches against a Monte Carlo integral of their own D \
                       (floor ≈ its standard error).",
@@ -391,9 +398,11 @@ pub fn report(rows: &[Row], out: &Path) -> Res<(Vec<Artifact>, String)> {
             y_range: (0.0, 1.6),
             with_published: true,
             value: |r| r.furnace,
+            error: Some(|r| 2.0 * r.furnace_se),
             caption: "White furnace against 90° − θo in the renderer's measure (∫ eval · cos θi \
                       dωi with the geometric cosine) for every model, the published \
-                      position-normal BRDF included.",
+                      position-normal BRDF included: the mean sample weight, bars ±2 standard \
+                      errors (of independent samples; the R2 points' error is smaller).",
         },
         GrazingChart {
             file: "grazing_weight_spread.png",
@@ -403,6 +412,7 @@ pub fn report(rows: &[Row], out: &Path) -> Res<(Vec<Artifact>, String)> {
             y_range: (1e-4, 1e3),
             with_published: true,
             value: |r| r.weight_spread.max(1e-4),
+            error: None,
             caption: "Relative standard deviation of one sample's weight f·c/pdf (visible-normal \
                       sampling where the model has it) against 90° − θo: where a renderer's noise \
                       grows.",
@@ -419,7 +429,7 @@ pub fn report(rows: &[Row], out: &Path) -> Res<(Vec<Artifact>, String)> {
         chart.y_range = Some(c.y_range);
         let path = out.join(c.file);
         let keep = |m: &str| c.with_published || !m.contains("published");
-        line_chart(&path, &chart, &series(rows, &keep, &c.value))?;
+        line_chart(&path, &chart, &series(rows, &keep, &c.value, c.error))?;
         artifacts.push(Artifact::new(&path, c.caption));
     }
 

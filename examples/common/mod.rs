@@ -16,6 +16,7 @@ pub mod normal_mapping;
 pub mod orb;
 pub mod orb_curves;
 pub mod pndf_images;
+pub mod quadrature;
 pub mod render;
 pub mod shading_points;
 
@@ -145,6 +146,8 @@ pub struct Series {
     pub label: String,
     /// (x, y) points, drawn in order.
     pub points: Vec<(f64, f64)>,
+    /// Half-widths of an error bar per point (drawn from y − e to y + e); empty: no bars.
+    pub errors: Vec<f64>,
 }
 
 impl Series {
@@ -153,7 +156,14 @@ impl Series {
         Series {
             label: label.into(),
             points,
+            errors: Vec::new(),
         }
+    }
+
+    /// The series with an error bar of half-width `errors[k]` at point k.
+    pub fn with_errors(mut self, errors: Vec<f64>) -> Series {
+        self.errors = errors;
+        self
     }
 }
 
@@ -186,6 +196,8 @@ pub struct Chart<'a> {
     pub size: (u32, u32),
     /// Fixed y range (e.g. a floor for log plots of functions that underflow); `None` fits the data.
     pub y_range: Option<(f64, f64)>,
+    /// Where the legend sits (default: middle right).
+    pub legend: SeriesLabelPosition,
 }
 
 impl<'a> Chart<'a> {
@@ -201,6 +213,7 @@ impl<'a> Chart<'a> {
             scatter: false,
             size: (800, 500),
             y_range: None,
+            legend: SeriesLabelPosition::MiddleRight,
         }
     }
 }
@@ -273,6 +286,30 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
                             .legend(move |(x, y)| {
                                 PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
                             });
+                        // Error bars, clipped to the y range.
+                        let (lo, hi) = (y0.min(y1), y0.max(y1));
+                        let bars: Vec<((f64, f64), (f64, f64))> = s
+                            .points
+                            .iter()
+                            .zip(&s.errors)
+                            .filter(|(p, e)| {
+                                keep(p.0, chart.x_scale) && keep_y(p.1) && e.is_finite()
+                            })
+                            .map(|(p, e)| {
+                                let top = (p.1 + e).min(hi);
+                                let bottom = (p.1 - e).max(lo);
+                                let bottom = if chart.y_scale == Scale::Log && bottom <= 0.0 {
+                                    lo
+                                } else {
+                                    bottom
+                                };
+                                ((p.0, bottom), (p.0, top))
+                            })
+                            .collect();
+                        ctx.draw_series(
+                            bars.into_iter()
+                                .map(|(a, b)| PathElement::new(vec![a, b], color.stroke_width(2))),
+                        )?;
                         if chart.markers {
                             // A lone point (one method in a scatter-like chart) gets a big marker.
                             let r = if pts.len() == 1 { 7 } else { 3 };
@@ -283,6 +320,7 @@ pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Res<()> {
                     }
                 }
                 ctx.configure_series_labels()
+                    .position(chart.legend.clone())
                     .background_style(WHITE.mix(0.8))
                     .border_style(BLACK)
                     .draw()?;

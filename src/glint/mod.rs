@@ -22,16 +22,31 @@
 //!
 //! ## Which model where
 //!
-//! Measured on a metallic sphere under a point light against the exact P-BRDF, every model at the
-//! material's σ_ε = 0.01 and its default options, five maps (docs/glint.md, "Which model where";
-//! docs/data/orb_curves.csv). "Texels per pixel" is the pixel footprint's area on the map
+//! The crate's one guide (the same table as the crate docs' and docs/glint.md's, whose "Which model
+//! where" adds the per-map tables). "Texels per pixel" is the pixel footprint's area on the map
 //! ([`GlintModel::footprint_texels`]).
 //!
-//! | texels per pixel | first to a given error | not worth it |
-//! |---|---|---|
-//! | below ~10 | naive normal mapping, a few samples per pixel (the mixture on scratched and flakes) | every glint model once its build counts (the mixture at `spacing` 0.25 reaches 0.01-0.14, at 8-12× the render time and 16× the build) |
-//! | ~10 to ~2 000 | the mixture (2.5-26× sooner than naive to its error: 0.03-0.43 at 9-34 texels per pixel, 0.009-0.10 at ~2 000), position-normal to 0.1 on flakes, the bin map to 0.2 where its moment-lobe masking serves (scratched, brushed) | any model for errors below 0.1 at ~34 texels per pixel (the mixture's floor there is one Gaussian per bilinear patch) |
-//! | beyond ~10⁵ (distant surfaces) | the mixture's filtered mixture to 0.1-0.2 (13-345× sooner than naive), the bin map smoothed at σ_ε to 0.05 and below (0.000-0.064) | position-normal for errors below 0.1 (its filtered mixture: as fast, 0.10-0.19); glints on flakes (nothing reaches 0.1) |
+//! <!-- which-model:begin -->
+//! Measured on the orb (docs/results.md, "Error against time"): a metallic sphere under a point
+//! light, 128² pixels, 5 maps of 512² (scratched, brushed, bumpy, flakes, fractal) at 5 pixel
+//! footprints, every glint model at the material's σ_ε = 0.01 and its default options (the mixture
+//! also with its level of detail off, "no LOD"), against naive normal mapping at 1-4,096 samples
+//! per pixel. Per footprint and target error (denoised relative RMSE against the exact P-BRDF): the
+//! method that first reaches it on each map, with a glint model's equal-error speedup over naive
+//! (∞: naive does not get there by 4,096 spp); build times not counted (docs/glint.md, "Which model
+//! where", has the per-map tables with builds). Times are wall-clock, ±30 % between runs. Last
+//! column: the error of [the mixture](crate::glint::BeckmannMixture) at its defaults, one
+//! evaluation per pixel. Generated from docs/data/orb_curves.csv by `python3 tools/orb_which.py
+//! --write`.
+//!
+//! | texels per pixel | first to 0.2 | first to 0.1 | first to 0.05 | mixture's error |
+//! |---|---|---|---|---|
+//! | 1 | naive: scratched, brushed, bumpy, fractal; mixture (no LOD): flakes (1.2×) | naive: brushed, bumpy, flakes, fractal; mixture: scratched (1.3×) | naive: brushed, bumpy, flakes, fractal; mixture: scratched (2.4×) | 0.02-0.70 |
+//! | 9 | naive: brushed, bumpy, fractal; pos.-normal: scratched, flakes (1.2-2.4×) | naive: brushed, bumpy, fractal; mixture (no LOD): scratched, flakes (3.8-5.1×) | naive: scratched, brushed, fractal; mixture (no LOD): flakes (13×); nothing: bumpy | 0.03-0.43 |
+//! | 34 | naive: brushed, bumpy, flakes, fractal; mixture (no LOD): scratched (3.8×) | naive: scratched, brushed, flakes, fractal; nothing: bumpy | naive: scratched, brushed; nothing: bumpy, flakes, fractal | 0.12-0.28 |
+//! | 2,186 | bin map: scratched, brushed (5.5-39×); mixture: bumpy, fractal (∞×); naive: flakes | mixture: brushed, fractal (4.5-∞×); naive: scratched; pos.-normal: flakes (3.8×); nothing: bumpy | mixture: scratched, flakes (3.2-∞×); nothing: brushed, bumpy, fractal | 0.01-0.10 |
+//! | 139,898 | mixture: scratched, brushed, bumpy, fractal (13-∞×); naive: flakes | mixture: scratched, brushed, bumpy, fractal (50-∞×); nothing: flakes | bin map: scratched, brushed (34-∞×); mixture: fractal (∞×); nothing: bumpy, flakes | 0.04-0.27 |
+//! <!-- which-model:end -->
 //!
 //! Cost of one renderer shading point at each footprint (every model at its defaults, against an
 //! analytic GGX one): docs/results.md, "Cost and error of a shading point against footprint". Each

@@ -232,15 +232,27 @@ pub(super) fn view_angle(
     let path = out.join("compare_energy_vs_view.png");
     let mut chart = Chart::new(&title, "θo (degrees)", "∫ f cos θi dωi");
     chart.markers = true;
-    line_chart(
-        &path,
-        &chart,
-        &by_theta(results, settings, view_methods, &|r| r.furnace),
-    )?;
+    // Error bars: ±2 standard errors of the mean over the m maps, √(Σ se²) / m = √(mean se² / m).
+    let mut maps: Vec<&str> = results.view.iter().map(|r| r.map).collect();
+    maps.sort_unstable();
+    maps.dedup();
+    let m = maps.len().max(1) as f64;
+    let furnace: Vec<Series> = by_theta(results, settings, view_methods, &|r| r.furnace)
+        .into_iter()
+        .zip(by_theta(results, settings, view_methods, &|r| {
+            r.furnace_se * r.furnace_se
+        }))
+        .map(|(s, var)| {
+            let bars = var.points.iter().map(|p| 2.0 * (p.1 / m).sqrt()).collect();
+            s.with_errors(bars)
+        })
+        .collect();
+    line_chart(&path, &chart, &furnace)?;
     artifacts.push(Artifact::new(
         path,
         "White furnace (F = 1) as a renderer integrates it, ∫ eval · cos θi dωi with the geometric \
-         cosine (mean of sample().weight()), mean over the maps: ≤ 1 for an energy-conserving model.",
+         cosine (mean of sample().weight()), mean over the maps, bars ±2 standard errors: ≤ 1 for \
+         an energy-conserving model.",
     ));
     Ok(artifacts)
 }

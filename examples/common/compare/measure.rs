@@ -126,6 +126,8 @@ pub struct ViewRow {
     pub v_rel_error: f64,
     /// ∫ f cos θi dωi with the geometric cosine (the renderer's measure).
     pub furnace: f64,
+    /// The furnace's standard error.
+    pub furnace_se: f64,
 }
 
 /// One row of the build table.
@@ -146,17 +148,23 @@ pub struct Results {
     pub build: Vec<BuildRow>,
 }
 
-/// The renderer's furnace ∫ f cos θi dωi: the mean of `sample().weight()` with the BRDF's own sampler.
-fn furnace(brdf: &(dyn Bxdf + Sync), wo: Vec3, n: usize) -> f64 {
-    let mut sum = 0.0;
+/// The renderer's furnace ∫ f cos θi dωi: the mean of `sample().weight()` with the BRDF's own
+/// sampler, and its standard error as if the points were independent (an upper estimate of the
+/// R2 points' error).
+fn furnace(brdf: &(dyn Bxdf + Sync), wo: Vec3, n: usize) -> (f64, f64) {
+    let (mut sum, mut sum2) = (0.0, 0.0);
     for k in 0..n {
         let u = r2(k);
         let uc = ((k as f64 + 0.5) / n as f64) as f32;
         if let Some(s) = brdf.sample(wo, uc, u) {
-            sum += s.weight().x as f64;
+            let w = s.weight().x as f64;
+            sum += w;
+            sum2 += w * w;
         }
     }
-    sum / n as f64
+    let mean = sum / n as f64;
+    let var = (sum2 / n as f64 - mean * mean).max(0.0);
+    (mean, (var / n as f64).sqrt())
 }
 
 /// Mean single-thread seconds per call of `f` over `n` inputs (after one warm-up pass).
@@ -249,7 +257,7 @@ pub fn measure(settings: &Settings, progress: &mut dyn FnMut(&str)) -> Res<Resul
                     });
                 }
                 for &theta in &settings.thetas {
-                    let (v_rel_error, furnace) =
+                    let (v_rel_error, (furnace, furnace_se)) =
                         at_view(method.as_ref(), &view_fp, &view_ref, theta, settings);
                     results.view.push(ViewRow {
                         map: map_name,
@@ -257,6 +265,7 @@ pub fn measure(settings: &Settings, progress: &mut dyn FnMut(&str)) -> Res<Resul
                         theta,
                         v_rel_error,
                         furnace,
+                        furnace_se,
                     });
                 }
                 progress(&format!("{map_name}: {label} done"));
@@ -352,10 +361,10 @@ fn at_view(
     view_ref: &BinnedPndf,
     theta: f64,
     settings: &Settings,
-) -> (f64, f64) {
+) -> (f64, (f64, f64)) {
     let wo = view(theta);
     let v_ref = reference_visible_area(view_ref, wo);
-    let (mut v_rel_error, mut furnace_value) = (0.0, 0.0);
+    let (mut v_rel_error, mut furnace_value) = (0.0, (0.0, 0.0));
     method.with_patch(view_fp, &mut |p| {
         let v = p.visible_area(wo) as f64;
         v_rel_error = (v - v_ref).abs() / v_ref.max(1e-12);

@@ -50,8 +50,6 @@ struct Mixture {
     mix: Arc<BeckmannMixture>,
     options: PatchOptions,
     label: &'static str,
-    /// Only the moment mip chain counts (the filtered lobe alone needs nothing else).
-    mip_only: bool,
 }
 
 impl Method for Mixture {
@@ -61,15 +59,11 @@ impl Method for Mixture {
     fn sigma(&self) -> f32 {
         self.mix.params().sigma_min
     }
+    /// Everything the built mixture holds (`memory().total()`): every row is the same model at
+    /// other patch options, so they share its memory.
     fn bytes_per_texel(&self) -> f64 {
-        let m = self.mix.memory();
         let (w, h) = self.mix.map_size();
-        let bytes = if self.mip_only {
-            m.mip_bytes
-        } else {
-            m.lobe_bytes + m.hierarchy_bytes + m.mip_bytes
-        };
-        bytes as f64 / (w * h) as f64
+        self.mix.memory().total() as f64 / (w * h) as f64
     }
     fn with_patch(&self, footprint: &Footprint, f: &mut dyn FnMut(&(dyn Ndf + Sync))) {
         f(&self.mix.patch_with(footprint, &self.options, None))
@@ -100,36 +94,26 @@ fn mixture_methods(map: &NormalMap, _settings: &Settings) -> Res<Vec<Box<dyn Met
         ..PatchOptions::default()
     };
     let inf = f32::INFINITY;
-    let m = |options, label, mip_only| -> Box<dyn Method> {
+    let m = |options, label| -> Box<dyn Method> {
         Box::new(Mixture {
             mix: mix.clone(),
             options,
             label,
-            mip_only,
         })
     };
     let mut methods = vec![
-        m(opts(MaskingMode::Exact, inf), "mixture (exact)", false),
-        m(
-            opts(MaskingMode::Approximate, inf),
-            "mixture (approx.)",
-            false,
-        ),
+        m(opts(MaskingMode::Exact, inf), "mixture (exact)"),
+        m(opts(MaskingMode::Approximate, inf), "mixture (approx.)"),
     ];
-    methods.push(m(PatchOptions::default(), "mixture (defaults)", false));
+    methods.push(m(PatchOptions::default(), "mixture (defaults)"));
     methods.push(m(
         PatchOptions {
             sub_texel_area: f32::INFINITY,
             ..PatchOptions::default()
         },
         "sub-texel lobe",
-        true,
     ));
-    methods.push(m(
-        opts(MaskingMode::Approximate, 0.0),
-        "filtered lobe",
-        true,
-    ));
+    methods.push(m(opts(MaskingMode::Approximate, 0.0), "filtered lobe"));
     Ok(methods)
 }
 

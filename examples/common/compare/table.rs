@@ -51,18 +51,19 @@ fn accuracy_csv(results: &Results) -> Res<String> {
     Ok(csv)
 }
 
-/// One line per map, method and view angle: visible-area error and furnace.
+/// One line per map, method and view angle: visible-area error, furnace and its standard error.
 fn view_csv(results: &Results) -> Res<String> {
-    let mut csv = String::from("map,method,theta_deg,v_rel_error,furnace\n");
+    let mut csv = String::from("map,method,theta_deg,v_rel_error,furnace,furnace_se\n");
     for r in &results.view {
         writeln!(
             csv,
-            "{},{},{},{:.5},{:.5}",
+            "{},{},{},{:.5},{:.5},{:.5}",
             r.map,
             quoted(&r.method),
             r.theta,
             r.v_rel_error,
-            r.furnace
+            r.furnace,
+            r.furnace_se
         )?;
     }
     Ok(csv)

@@ -21,12 +21,12 @@ pub fn write_images(
     out: &Path,
 ) -> Res<Vec<Artifact>> {
     let size = scene.size;
-    let (noise, ref_s, exposure) = (reference.noise, reference.render_s, reference.exposure);
+    let (noise, exposure) = (reference.noise, reference.exposure);
     let mut artifacts = Vec::new();
     let mut panels = vec![(
         tone_map(scene, &reference.image, exposure),
         reference.label.clone(),
-        format!("noise {noise:.2}, {ref_s:.1} s"),
+        format!("noise {noise:.2}"),
     )];
     for row in rows {
         let (m, e) = (row.rendered, &row.errors);
@@ -47,10 +47,7 @@ pub fn write_images(
         panels.push((
             rgb,
             m.label.clone(),
-            format!(
-                "err {:.2} / 4x4 {:.2}, {:.1} s",
-                e.rel_rmse, e.rel_rmse_blocks, m.render_s
-            ),
+            format!("err {:.2} / 4x4 {:.2}", e.rel_rmse, e.rel_rmse_blocks),
         ));
     }
     let ref_path = out.join(format!("orb_{name}_reference.png"));
@@ -76,7 +73,8 @@ pub fn write_images(
                 "Metallic orb, {name} normal map ({}², tiled {}×{}), point light, every row with the \
                  pixel's Gaussian footprint: reference (a) (exact P-BRDF), reference (b) \
                  (normal-mapped) and each glint model at the same exposure (errors against (a): \
-                 relative RMSE per pixel / on 4×4 blocks, over the pixels fully on the sphere).",
+                 relative RMSE per pixel / on 4×4 blocks, over the pixels fully on the sphere; \
+                 render times in the per-method captions and the printed table).",
                 map_width, tiles.x, tiles.y
             ),
         ),
@@ -135,10 +133,42 @@ pub fn tone_map(scene: &Scene, img: &Image, exposure: f32) -> Vec<u8> {
     rgb
 }
 
-/// Lays out tone-mapped panels side by side with a label band above each (two lines of text).
+/// Font size and line height (pixels) of the strip's labels.
+const LABEL_PX: u32 = 13;
+const LINE_PX: u32 = 16;
+
+/// `text` broken at spaces into lines no wider than `width` pixels in `font` (a word wider than
+/// that stays on a line of its own).
+fn wrap(text: &str, font: &FontDesc, width: u32) -> Vec<String> {
+    let fits = |s: &str| font.box_size(s).map_or(true, |(w, _)| w <= width);
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split(' ') {
+        match lines.last_mut() {
+            Some(line) if fits(&format!("{line} {word}")) => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    lines
+}
+
+/// Lays out tone-mapped panels side by side with a label band above each: the title and the
+/// figures, each wrapped to the panel's width, the band as tall as the longest label needs.
 pub fn strip(panels: &[(Vec<u8>, String, String)], size: u32) -> Res<(u32, u32, Vec<u8>)> {
     register_font();
-    let band = 40u32;
+    let font = ("sans-serif", LABEL_PX).into_font();
+    let labels: Vec<Vec<String>> = panels
+        .iter()
+        .map(|(_, title, figures)| {
+            // 12 px of margin: neighbouring labels stay apart even when one fills its panel.
+            let mut lines = wrap(title, &font, size - 12);
+            lines.extend(wrap(figures, &font, size - 12));
+            lines
+        })
+        .collect();
+    let band = labels.iter().map(Vec::len).max().unwrap_or(0) as u32 * LINE_PX + 6;
     let gap = 4u32;
     let n = panels.len() as u32;
     let (w, h) = (n * size + (n.saturating_sub(1)) * gap, size + band);
@@ -155,11 +185,12 @@ pub fn strip(panels: &[(Vec<u8>, String, String)], size: u32) -> Res<(u32, u32, 
     }
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        let font = ("sans-serif", 14).into_font();
-        for (i, (_, line1, line2)) in panels.iter().enumerate() {
+        for (i, lines) in labels.iter().enumerate() {
             let x0 = (i as u32 * (size + gap)) as i32 + 3;
-            root.draw(&Text::new(line1.clone(), (x0, 3), font.clone()))?;
-            root.draw(&Text::new(line2.clone(), (x0, 21), font.clone()))?;
+            for (k, line) in lines.iter().enumerate() {
+                let y = 3 + (k as u32 * LINE_PX) as i32;
+                root.draw(&Text::new(line.clone(), (x0, y), font.clone()))?;
+            }
         }
         root.present()?;
     }

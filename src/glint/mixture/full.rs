@@ -1,8 +1,9 @@
 //! Full storage of the mixture's lobes ([`super::LobeStorage::Full`]): every level of detail (level 0
 //! = the lobes, levels l ≥ 1 the merged lobes of levels.rs) as raw moments (20 bytes per node), lobe
 //! blocks in `f32` (32 bytes, blocks.rs) and the slope-box quadtree from level 1 up, the levels'
-//! merge errors at every resolution of [`super::LOD_RESOLUTIONS`], and the moment mip chain of the
-//! lobes for the filtered lobe (hierarchy.rs): ~87 bytes per lobe, the fastest queries.
+//! merge errors at every resolution of [`super::LOD_RESOLUTIONS`], the moment mip chain of the
+//! lobes for the filtered lobe (hierarchy.rs) and the filtered mixture's chain (gmm.rs): ~119 bytes
+//! per lobe, the fastest queries.
 //!
 //! Only the moments (and the merge errors) are stored in files; everything else is derived from them
 //! by the same code at build and at load ([`derive_blocks_and_tree`], `build_levels`), so loaded

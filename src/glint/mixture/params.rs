@@ -265,7 +265,7 @@ pub const MAX_SUPERSAMPLING: u32 = 64;
 /// How a [`BeckmannMixture`](super::BeckmannMixture) holds its lobes in memory (and in files).
 ///
 /// Trade-off (docs/mixture.md, "Compact storage"; measured in docs/results.md): `Compact` holds
-/// ≤ 16 bytes per lobe in all (15.4 measured, against ~87 for `Full`) and loads several times faster, at the cost
+/// ≤ 16 bytes per lobe in all (15.4 measured, against ~119 for `Full`) and loads several times faster, at the cost
 /// of a per-block decode in every query (`d`, the exact masking and the visible sampler run slower,
 /// see the results) and of an encoding error far below the mixture's own (mean slopes to 16 bits
 /// inside their block's slope box, the inverse Cholesky factor to binary16: TV change against the
@@ -274,8 +274,9 @@ pub const MAX_SUPERSAMPLING: u32 = 64;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum LobeStorage {
     /// The raw moments (20 B per lobe), the lobe blocks in `f32` (32 B), the quadtree, the moment
-    /// mip chain and the levels of detail in the same form: ~87 bytes per lobe (87.1 measured: 64 for
-    /// level 0 and its mip chain, 23.1 for the levels l ≥ 1), the fastest queries.
+    /// mip chain, the filtered mixture's chain and the levels of detail in the same form: ~119 bytes
+    /// per lobe (119.1 measured: 96 for level 0 and its two mip chains, 23.1 for the levels l ≥ 1),
+    /// the fastest queries.
     #[default]
     Full,
     /// Every level of detail only as compact blocks (per lobe the mean slope as two `u16` inside its
