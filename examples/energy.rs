@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release --example energy -- [--out DIR] [--quick]`
 
-mod common;
+use brdf_examples::common;
 
 fn main() -> common::Res<()> {
     let out = common::out_dir()?;
