@@ -8,7 +8,7 @@
 //! the P-NDF of the interpolated map (Dirac) and the same convolved with the material's σ_ε = 0.01
 //! micro-roughness. See `examples/common/compare/` for what is measured and how.
 
-mod common;
+use brdf_examples::common;
 
 fn main() -> common::Res<()> {
     let out = common::out_dir()?;

@@ -4,7 +4,7 @@
 //! `cargo run --release --example energy -- [--out DIR]` (every value by deterministic quadrature;
 //! `--quick` is accepted and changes nothing).
 
-mod common;
+use brdf_examples::common;
 
 fn main() -> common::Res<()> {
     let out = common::out_dir()?;

@@ -6,7 +6,7 @@
 //! quick settings so that the whole gallery stays within a few minutes on 2 cores; `--full` runs them
 //! at full size.
 
-mod common;
+use brdf_examples::common;
 
 use common::{Artifact, Res};
 use std::fmt::Write as _;

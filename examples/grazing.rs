@@ -7,7 +7,7 @@
 //! prints the table. See `examples/common/grazing.rs` for what is measured and docs/robustness.md for
 //! what it shows.
 
-mod common;
+use brdf_examples::common;
 
 fn main() -> common::Res<()> {
     let out = common::out_dir()?;

@@ -2,7 +2,7 @@
 //!
 //! `cargo run --release --example lobes -- [--out DIR] [--quick]`
 
-mod common;
+use brdf_examples::common;
 
 fn main() -> common::Res<()> {
     let out = common::out_dir()?;

@@ -17,7 +17,7 @@
 //! two Markdown tables (docs/results.md, "Levels of detail chosen by error"): TV / time /
 //! level per configuration and footprint, and issue 15's target cell by cell at ≥ 4096 texels.
 
-mod common;
+use brdf_examples::common;
 
 use brdf::glint::GlintNdf;
 use brdf::glint::mixture::{DEFAULT_LOD_LOBES, MixtureParams, PatchOptions};

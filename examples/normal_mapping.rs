@@ -6,7 +6,7 @@
 //! Writes `normal_mapping_albedo.png` and `normal_mapping_lobes.png` into DIR (default
 //! `target/brdf-out/`); `examples/common/normal_mapping.rs` says what they show.
 
-mod common;
+use brdf_examples::common;
 
 fn main() -> common::Res<()> {
     let out = common::out_dir()?;

@@ -12,7 +12,7 @@
 //! Writes one PNG per method, a labelled strip and a CSV of times and errors into DIR (default
 //! `target/brdf-out/`), and prints the table.
 
-mod common;
+use brdf_examples::common;
 
 use common::orb::{MapSource, OrbOptions};
 use common::{Res, arg_value, has_flag};

@@ -2,7 +2,7 @@
 //!
 //! `cargo run --release --example pndf_images [-- --out DIR] [--quick]`
 
-mod common;
+use brdf_examples::common;
 
 fn main() -> common::Res<()> {
     let out = common::out_dir()?;

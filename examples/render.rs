@@ -14,7 +14,7 @@
 //! and conventional normal mapping on one scratched map at three map scales, alternating, and writes
 //! `render_timing.csv` (examples/common/render/timing.rs). See docs/render.md.
 
-mod common;
+use brdf_examples::common;
 
 use common::Res;
 use common::render::showcase::{Options, run_with};

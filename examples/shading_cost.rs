@@ -14,7 +14,7 @@
 //! model) into DIR (default `target/brdf-out/`). See docs/results.md, "Cost and error of a
 //! shading point against footprint".
 
-mod common;
+use brdf_examples::common;
 
 use brdf::Vec2;
 use brdf::fresnel::ConductorFresnel;

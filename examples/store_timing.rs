@@ -16,7 +16,7 @@
 //! the build, the load and the fill floor on a log time axis, with the target (load at
 //! build / 20) marked.
 
-mod common;
+use brdf_examples::common;
 
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{LobeStorage, MixtureParams};
