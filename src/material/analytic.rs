@@ -1,6 +1,6 @@
 //! The analytic NDFs a material can hold, as one enum implementing [`Ndf`] by dispatch.
 
-use crate::bxdf::{AlbedoTable, TabulatedAlbedo};
+use crate::bxdf::{AlbedoTable, AnisotropicAlbedoTable, TabulatedAlbedo};
 use crate::ndf::{Beckmann, Ggx, Ndf};
 use glam::{Vec2, Vec3};
 
@@ -88,7 +88,10 @@ impl TabulatedAlbedo for AnalyticNdf {
     fn albedo_table(&self) -> &'static AlbedoTable {
         forward!(self, n => n.albedo_table())
     }
-    fn table_alpha(&self) -> f32 {
-        forward!(self, n => n.table_alpha())
+    fn anisotropic_albedo_table(&self) -> &'static AnisotropicAlbedoTable {
+        forward!(self, n => n.anisotropic_albedo_table())
+    }
+    fn table_alphas(&self) -> (f32, f32) {
+        forward!(self, n => n.table_alphas())
     }
 }
