@@ -516,7 +516,7 @@ fn anisotropic_white_furnace_is_one() {
 }
 
 #[test]
-#[ignore = "full grid, ~10 min: cargo test --release --test it energy_compensation:: -- --ignored anisotropic_white_furnace_on_the_full_grid --nocapture"]
+#[ignore = "full grid, ~5 min: cargo test --release --test it energy_compensation:: -- --ignored anisotropic_white_furnace_on_the_full_grid --nocapture"]
 fn anisotropic_white_furnace_on_the_full_grid() {
     // 8 × 8 (αx, αy) log-spaced in [0.01, 1] × θo ∈ {0, 30, 60, 70, 80, 85}° × φo ∈ {0, 30, 45,
     // 60, 90}°, both families, both estimators.
