@@ -10,11 +10,22 @@
 //! as its error estimate and the largest bilinear-interpolation error at cell centres (θo ≤ 85°).
 //! E_avg is the exact average of each row's interpolant (`brdf::bxdf::average_of_row`).
 //!
-//! Run: `cargo run --release --example albedo_tables [-- OUT.rs [M]]`
-//! (defaults: src/bxdf/albedo_tables.rs, M = 512).
+//! It also writes `src/bxdf/albedo_anisotropic_{ggx,beckmann}.bin`: E(μ, φ, αx, αy) on the grid of
+//! `brdf::bxdf::AnisotropicAlbedoTable`, as little-endian u16 (E · 65535). There the sample weight is
+//! integrated by the midpoint rule on M × M points of the unit square after the change of variables
+//! u = q(v) = v³ (10 − 15 v + 6 v²) per axis (weight q'(v) = 30 v² (1 − v)²), which flattens the
+//! sampler's mappings at the square's edges: at M = 128 the rule agrees with M = 1024 to ~3·10⁻⁵
+//! (the plain rule at M = 512 is off by up to 10⁻³ at grazing views). The tool prints
+//! max |E(M) − E(M/2)| (θo ≤ 85°, every fourth φ node), an upper estimate of E(M)'s error. E(φ; αx, αy) = E(π/2 − φ; αy, αx) (mirror symmetry), so only
+//! αx ≥ αy is integrated.
+//!
+//! Run: `cargo run --release --example albedo_tables [-- iso [OUT.rs [M]] | aniso [DIR [M]]]`
+//! (no argument: both; defaults: src/bxdf/albedo_tables.rs, M = 512; src/bxdf, M = 96).
 
 use brdf::bxdf::{
-    ALBEDO_GRID, ALBEDO_MU_EPSILON, AlbedoTable, Bxdf, MicrofacetBrdf, average_of_row,
+    ALBEDO_GRID, ALBEDO_MU_EPSILON, ANISO_ALPHA_NODES, ANISO_ENTRIES, ANISO_MU_NODES,
+    ANISO_PHI_NODES, AlbedoTable, AnisotropicAlbedoTable, Bxdf, MicrofacetBrdf, average_of_row,
+    encode_albedo,
 };
 use brdf::fresnel::NoFresnel;
 use brdf::ndf::{Beckmann, Ggx, Ndf};
@@ -127,15 +138,110 @@ fn write_family(out: &mut String, upper: &str, rows: &Rows) {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let path = args
-        .first()
-        .cloned()
-        .unwrap_or_else(|| "src/bxdf/albedo_tables.rs".into());
-    let m: usize = args
-        .get(1)
-        .map(|s| s.parse().expect("M: an integer"))
-        .unwrap_or(512);
+    let mode = args.first().map(String::as_str).unwrap_or("both");
+    let arg = |k: usize| args.get(k).filter(|_| mode != "both").cloned();
+    let m = |k: usize, default: usize| -> usize {
+        arg(k).map_or(default, |s| s.parse().expect("M: an integer"))
+    };
+    if mode == "iso" || mode == "both" {
+        let path = arg(1).unwrap_or_else(|| "src/bxdf/albedo_tables.rs".into());
+        write_isotropic(&path, m(2, 512));
+    }
+    if mode == "aniso" || mode == "both" {
+        let dir = arg(1).unwrap_or_else(|| "src/bxdf".into());
+        write_anisotropic(&dir, m(2, 96));
+    }
+}
 
+/// The smoothstep change of variables of the anisotropic rule: (q(v), q'(v)).
+fn smooth_map(v: f64) -> (f64, f64) {
+    let v2 = v * v;
+    (
+        v2 * v * (10.0 - 15.0 * v + 6.0 * v2),
+        30.0 * v2 * (1.0 - v) * (1.0 - v),
+    )
+}
+
+/// E(wo) = ∫ weight(u) du by the mapped midpoint rule on M × M points, in f64.
+fn albedo_mapped<D: Ndf>(ndf: D, wo: Vec3, m: usize) -> f64 {
+    let brdf = MicrofacetBrdf::new(ndf, NoFresnel);
+    let mut sum = 0.0f64;
+    for a in 0..m {
+        let (ua, ja) = smooth_map((a as f64 + 0.5) / m as f64);
+        for b in 0..m {
+            let (ub, jb) = smooth_map((b as f64 + 0.5) / m as f64);
+            if let Some(s) = brdf.sample(wo, 0.5, Vec2::new(ua as f32, ub as f32)) {
+                sum += s.weight().x as f64 * ja * jb;
+            }
+        }
+    }
+    sum / (m * m) as f64
+}
+
+/// E at (μ, φ) for the family at (αx, αy), by the mapped rule.
+fn e_aniso(family: &str, ax: f32, ay: f32, mu: f32, phi: f32, m: usize) -> f64 {
+    let mu = mu.max(ALBEDO_MU_EPSILON);
+    let st = (1.0 - mu * mu).max(0.0).sqrt();
+    let wo = Vec3::new(st * phi.cos(), st * phi.sin(), mu);
+    match family {
+        "ggx" => albedo_mapped(Ggx::new(ax, ay).expect("α of the grid"), wo, m),
+        _ => albedo_mapped(Beckmann::new(ax, ay).expect("α of the grid"), wo, m),
+    }
+}
+
+/// Writes `DIR/albedo_anisotropic_{family}.bin` for both families.
+fn write_anisotropic(dir: &str, m: usize) {
+    type T = AnisotropicAlbedoTable;
+    let grazing = 85f32.to_radians().cos();
+    for family in ["ggx", "beckmann"] {
+        let start = std::time::Instant::now();
+        // (a, b, k) rows with αx_a ≥ αy_b; the others by E(φ; αx, αy) = E(π/2 − φ; αy, αx).
+        let rows: Vec<(usize, usize, usize)> = (0..ANISO_ALPHA_NODES)
+            .flat_map(|a| (0..=a).flat_map(move |b| (0..ANISO_PHI_NODES).map(move |k| (a, b, k))))
+            .collect();
+        let done: Vec<([f64; ANISO_MU_NODES], f64)> = rows
+            .par_iter()
+            .map(|&(a, b, k)| {
+                let (ax, ay, phi) = (T::alpha_node(a), T::alpha_node(b), T::phi_node(k));
+                let mut row = [0.0f64; ANISO_MU_NODES];
+                let mut err = 0.0f64;
+                for (i, e) in row.iter_mut().enumerate() {
+                    let mu = T::mu_node(i);
+                    *e = e_aniso(family, ax, ay, mu, phi, m);
+                    if mu >= grazing && k % 4 == 0 {
+                        let coarse = e_aniso(family, ax, ay, mu, phi, m / 2);
+                        err = err.max((*e - coarse).abs());
+                    }
+                }
+                (row, err)
+            })
+            .collect();
+        let mut table = vec![0u16; ANISO_ENTRIES];
+        let mut err = 0.0f64;
+        for (&(a, b, k), (row, e)) in rows.iter().zip(&done) {
+            err = err.max(*e);
+            for (i, &v) in row.iter().enumerate() {
+                table[T::index(a, b, k, i)] = encode_albedo(v);
+                if a != b {
+                    table[T::index(b, a, ANISO_PHI_NODES - 1 - k, i)] = encode_albedo(v);
+                }
+            }
+        }
+        let bytes: Vec<u8> = table.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let path = format!("{dir}/albedo_anisotropic_{family}.bin");
+        std::fs::write(&path, &bytes).expect("write the table file");
+        eprintln!(
+            "{family}: anisotropic, {} entries ({} bytes), quadrature |E(M) − E(M/2)| ≤ {err:.2e} \
+             (θo ≤ 85°, M = {m}), {:.0} s; wrote {path}",
+            table.len(),
+            bytes.len(),
+            start.elapsed().as_secs_f64()
+        );
+    }
+}
+
+/// Writes the isotropic table file.
+fn write_isotropic(path: &str, m: usize) {
     let mut out = String::new();
     writeln!(
         out,
@@ -160,6 +266,6 @@ fn main() {
         .unwrap();
         write_family(&mut out, upper, &rows);
     }
-    std::fs::write(&path, out).expect("write the table file");
+    std::fs::write(path, out).expect("write the table file");
     eprintln!("wrote {path}");
 }

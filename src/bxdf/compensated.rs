@@ -5,12 +5,16 @@
 //! f = f_ss + F_ms · f_ms,  f_ms(wo, wi) = (1 − E(μo)) (1 − E(μi)) / (π (1 − E_avg)),
 //! F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg)),  F_avg = 2 ∫₀¹ F(μ) μ dμ,
 //!
-//! with E, E_avg the tabulated albedo of the single-scattering BRDF with F = 1 ([`AlbedoTable`]).
-//! With F = 1, ∫ f_ms cos θi dωi = 1 − E(μo) exactly (E_avg is the exact average of the table's
-//! interpolant), so the white furnace is E_true(μo) + 1 − E_table(μo): 1 up to the table's error.
-//! f_ms is symmetric in (wo, wi), so the sum is reciprocal where f_ss is.
+//! with E, E_avg the tabulated albedo of the single-scattering BRDF with F = 1 ([`AlbedoTable`] for
+//! isotropic NDFs; [`AnisotropicAlbedoTable`] for anisotropic ones, where E depends on wo's azimuth
+//! too and f_ms = (1 − E(wo)) (1 − E(wi)) / (π (1 − E_avg)) with E_avg averaged over μ and φ).
+//! With F = 1, ∫ f_ms cos θi dωi = 1 − E(wo) exactly (E_avg is the exact average of the table's
+//! interpolant), so the white furnace is E_true(wo) + 1 − E_table(wo): 1 up to the table's error.
+//! f_ms is a product of the same function of wo and of wi over a constant, so it is symmetric in
+//! (wo, wi) and the sum is reciprocal where f_ss is.
 
 use super::albedo::{ALBEDO_ALPHA_MAX, AlbedoTable};
+use super::albedo_anisotropic::{AnisotropicAlbedo, AnisotropicAlbedoTable};
 use super::lobe::lobe_probability;
 use super::microfacet::{Masking, MicrofacetBrdf};
 use super::{Bxdf, BxdfSample, LobeFlags};
@@ -30,25 +34,29 @@ const FRESNEL_AVERAGE_POINTS: usize = 1024;
 /// the compensation lobe is 0, so that no quotient of two roundings is formed.
 const MIN_LOSS: f32 = 1e-6;
 
-/// An NDF whose single-scattering albedo is tabulated: the table and the α to read it at.
+/// An NDF whose single-scattering albedo is tabulated: the tables and the (αx, αy) to read them at.
 ///
-/// Implemented for [`Ggx`] and [`Beckmann`]. Anisotropic NDFs read the isotropic table at the RMS
-/// roughness α = √((αx² + αy²)/2) (for Beckmann the isotropic surface with the same mean-square
-/// slope); this is an approximation whose furnace error, up to 16 % for αy/αx = 2…10 at grazing
-/// views along an axis, is measured in docs/results.md.
+/// Implemented for [`Ggx`] and [`Beckmann`]. Isotropic NDFs (αx = αy) read [`AlbedoTable`], E(μ, α);
+/// anisotropic ones read [`AnisotropicAlbedoTable`], E(μ, φ, αx, αy), which follows the azimuth of
+/// wo (furnace error measured in docs/results.md).
 pub trait TabulatedAlbedo: Ndf {
-    /// The family's table.
+    /// The family's isotropic table.
     fn albedo_table(&self) -> &'static AlbedoTable;
-    /// The α at which the table is read (√((αx² + αy²)/2)).
-    fn table_alpha(&self) -> f32;
+    /// The family's anisotropic table.
+    fn anisotropic_albedo_table(&self) -> &'static AnisotropicAlbedoTable;
+    /// (αx, αy), the roughness the tables are read at.
+    fn table_alphas(&self) -> (f32, f32);
 }
 
 impl TabulatedAlbedo for Ggx {
     fn albedo_table(&self) -> &'static AlbedoTable {
         &AlbedoTable::GGX
     }
-    fn table_alpha(&self) -> f32 {
-        (0.5 * (self.alpha_x() * self.alpha_x() + self.alpha_y() * self.alpha_y())).sqrt()
+    fn anisotropic_albedo_table(&self) -> &'static AnisotropicAlbedoTable {
+        &AnisotropicAlbedoTable::GGX
+    }
+    fn table_alphas(&self) -> (f32, f32) {
+        (self.alpha_x(), self.alpha_y())
     }
 }
 
@@ -56,8 +64,36 @@ impl TabulatedAlbedo for Beckmann {
     fn albedo_table(&self) -> &'static AlbedoTable {
         &AlbedoTable::BECKMANN
     }
-    fn table_alpha(&self) -> f32 {
-        (0.5 * (self.alpha_x() * self.alpha_x() + self.alpha_y() * self.alpha_y())).sqrt()
+    fn anisotropic_albedo_table(&self) -> &'static AnisotropicAlbedoTable {
+        &AnisotropicAlbedoTable::BECKMANN
+    }
+    fn table_alphas(&self) -> (f32, f32) {
+        (self.alpha_x(), self.alpha_y())
+    }
+}
+
+/// The directional albedo E(wo) and E_avg the compensation reads: the isotropic table at α, or the
+/// anisotropic table's slice at (αx, αy) (1.2 kB, boxed so that isotropic materials stay small).
+#[derive(Clone, Debug)]
+enum Albedo {
+    Isotropic(&'static AlbedoTable, f32),
+    Anisotropic(Box<AnisotropicAlbedo>),
+}
+
+impl Albedo {
+    #[inline]
+    fn albedo(&self, w: Vec3) -> f32 {
+        match self {
+            Albedo::Isotropic(table, alpha) => table.albedo(w.z, *alpha),
+            Albedo::Anisotropic(slice) => slice.albedo(w),
+        }
+    }
+
+    fn average(&self) -> f32 {
+        match self {
+            Albedo::Isotropic(table, alpha) => table.average_albedo(*alpha),
+            Albedo::Anisotropic(slice) => slice.average(),
+        }
     }
 }
 
@@ -98,14 +134,17 @@ pub fn multiple_scattering_fresnel(f_avg: Vec3, e_avg: f32) -> Vec3 {
 }
 
 /// A microfacet BRDF with Kulla-Conty multiple-scattering energy compensation:
-/// f = f_ss + F_ms (1 − E(μo)) (1 − E(μi)) / (π (1 − E_avg)) (module docs).
+/// f = f_ss + F_ms (1 − E(wo)) (1 − E(wi)) / (π (1 − E_avg)) (module docs).
+///
+/// Anisotropic NDFs read the anisotropic table's slice at (αx, αy), built in `new` (a 1.2 kB boxed
+/// slice; the type is `Clone`, not `Copy`); isotropic ones read the isotropic table.
 ///
 /// Opt-in: [`MicrofacetBrdf`] stays the single-scattering model that matches pbrt-v4 and Mitsuba 3;
 /// wrap it to give back the energy its masking removes (white furnace 1 within 0.5 % for
-/// α ∈ [0.01, 1], θo ≤ 85°, isotropic; anisotropic NDFs read the table at the RMS α, docs/bxdf.md).
+/// α ∈ [0.01, 1], θo ≤ 85°, isotropic; the anisotropic error is measured in docs/results.md).
 ///
 /// Sampling: a mixture of the single-scattering sampler (probability p) and the cosine-weighted
-/// hemisphere (1 − p), p = s / (s + d) with s = E(μo) · mean(F_avg) and d = (1 − E(μo)) · mean(F_ms),
+/// hemisphere (1 − p), p = s / (s + d) with s = E(wo) · mean(F_avg) and d = (1 − E(wo)) · mean(F_ms),
 /// the two lobes' approximate albedos; `pdf` is p · pdf_ss + (1 − p) cos θi / π. Samples of the
 /// compensation lobe carry [`LobeFlags::DIFFUSE`].
 ///
@@ -114,7 +153,7 @@ pub fn multiple_scattering_fresnel(f_avg: Vec3, e_avg: f32) -> Vec3 {
 ///
 /// # Degenerate cases
 /// As [`MicrofacetBrdf`]: `wo` or `wi` not strictly above the horizon or non-finite → 0, pdf 0,
-/// `sample` → `None`. Table lookups are clamped (μ to [0, 1], α to the table's range).
+/// `sample` → `None`. Table lookups are clamped (μ to [0, 1], α to the tables' range).
 ///
 /// # Example
 /// ```
@@ -126,17 +165,16 @@ pub fn multiple_scattering_fresnel(f_avg: Vec3, e_avg: f32) -> Vec3 {
 /// let brdf = EnergyCompensated::new(MicrofacetBrdf::new(Ggx::isotropic(0.8)?, NoFresnel))?;
 /// let wo = Vec3::new(0.6, 0.0, 0.8);
 /// // The compensation lobe gives back what single scattering loses at this view.
-/// assert!(brdf.albedo(wo.z) < 1.0 && brdf.multiple_scattering_fresnel() == Vec3::ONE);
+/// assert!(brdf.albedo(wo) < 1.0 && brdf.multiple_scattering_fresnel() == Vec3::ONE);
 /// if let Some(s) = brdf.sample(wo, 0.9, Vec2::new(0.3, 0.7)) {
 ///     assert_eq!((s.f, s.pdf), brdf.eval_pdf(wo, s.wi));
 /// }
 /// # Ok::<(), brdf::Error>(())
 /// ```
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct EnergyCompensated<D, F> {
     brdf: MicrofacetBrdf<D, F>,
-    table: &'static AlbedoTable,
-    alpha: f32,
+    albedo: Albedo,
     e_avg: f32,
     f_avg: Vec3,
     f_ms: Vec3,
@@ -149,9 +187,10 @@ impl<D: TabulatedAlbedo, F: Fresnel> EnergyCompensated<D, F> {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `masking` if the BRDF uses [`Masking::Separable`] (the
-    /// tables are for height-correlated masking), or `alpha` if the table α (√((αx² + αy²)/2)) exceeds
-    /// [`ALBEDO_ALPHA_MAX`] = 1 (the tables' range; α below the table's minimum cannot occur, the
-    /// NDFs clamp α to the same minimum).
+    /// tables are for height-correlated masking), or `alpha_x` / `alpha_y` if either exceeds
+    /// [`ALBEDO_ALPHA_MAX`] = 1 (the tables' range; α below the tables' minimum cannot occur for
+    /// isotropic NDFs, which clamp α to the same minimum; anisotropic α below
+    /// [`ANISO_ALPHA_LOW`](super::ANISO_ALPHA_LOW) reads that node).
     pub fn new(brdf: MicrofacetBrdf<D, F>) -> Result<Self> {
         if brdf.masking() != Masking::HeightCorrelated {
             return Err(Error::InvalidParameter {
@@ -160,16 +199,26 @@ impl<D: TabulatedAlbedo, F: Fresnel> EnergyCompensated<D, F> {
                 reason: "energy compensation is tabulated for height-correlated masking only",
             });
         }
-        let alpha = brdf.ndf().table_alpha();
-        if !(alpha.is_finite() && alpha <= ALBEDO_ALPHA_MAX) {
-            return Err(Error::InvalidParameter {
-                name: "alpha",
-                value: alpha as f64,
-                reason: "energy compensation needs sqrt(alpha_x alpha_y) <= 1 (the albedo tables' range)",
-            });
+        let (alpha_x, alpha_y) = brdf.ndf().table_alphas();
+        for (name, alpha) in [("alpha_x", alpha_x), ("alpha_y", alpha_y)] {
+            if !(alpha.is_finite() && alpha <= ALBEDO_ALPHA_MAX) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: alpha as f64,
+                    reason: "energy compensation needs alpha <= 1 (the albedo tables' range)",
+                });
+            }
         }
-        let table = brdf.ndf().albedo_table();
-        let e_avg = table.average_albedo(alpha);
+        let albedo = if alpha_x == alpha_y {
+            Albedo::Isotropic(brdf.ndf().albedo_table(), alpha_x)
+        } else {
+            Albedo::Anisotropic(Box::new(
+                brdf.ndf()
+                    .anisotropic_albedo_table()
+                    .slice(alpha_x, alpha_y),
+            ))
+        };
+        let e_avg = albedo.average();
         let f_avg = average_fresnel(brdf.fresnel());
         let f_ms = multiple_scattering_fresnel(f_avg, e_avg);
         let loss = 1.0 - e_avg;
@@ -180,8 +229,7 @@ impl<D: TabulatedAlbedo, F: Fresnel> EnergyCompensated<D, F> {
         };
         Ok(EnergyCompensated {
             brdf,
-            table,
-            alpha,
+            albedo,
             e_avg,
             f_avg,
             f_ms,
@@ -196,19 +244,20 @@ impl<D: Ndf, F: Fresnel> EnergyCompensated<D, F> {
         &self.brdf
     }
 
-    /// The α at which the table is read.
-    pub fn table_alpha(&self) -> f32 {
-        self.alpha
+    /// Whether the anisotropic table is read (αx ≠ αy).
+    pub fn is_anisotropic(&self) -> bool {
+        matches!(self.albedo, Albedo::Anisotropic(_))
     }
 
-    /// E_avg at the table α.
+    /// E_avg: the cosine-weighted hemispherical average of [`albedo`](Self::albedo).
     pub fn average_albedo(&self) -> f32 {
         self.e_avg
     }
 
-    /// E(μ) at the table α: the single-scattering albedo with F = 1.
-    pub fn albedo(&self, mu: f32) -> f32 {
-        self.table.albedo(mu, self.alpha)
+    /// E(w): the tabulated single-scattering albedo with F = 1 toward `w` (local frame; isotropic
+    /// NDFs read only μ = w.z).
+    pub fn albedo(&self, w: Vec3) -> f32 {
+        self.albedo.albedo(w)
     }
 
     /// F_avg of the Fresnel term.
@@ -224,15 +273,15 @@ impl<D: Ndf, F: Fresnel> EnergyCompensated<D, F> {
     /// The compensation lobe F_ms f_ms(wo, wi) for directions already checked to be upper.
     #[inline]
     fn lobe(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        let lo = 1.0 - self.albedo(wo.z);
-        let li = 1.0 - self.albedo(wi.z);
+        let lo = 1.0 - self.albedo(wo);
+        let li = 1.0 - self.albedo(wi);
         self.scale * (lo.max(0.0) * li.max(0.0))
     }
 
     /// The probability of drawing from the single-scattering sampler at `wo` (upper).
     #[inline]
     fn specular_probability(&self, wo: Vec3) -> f32 {
-        let e = self.albedo(wo.z);
+        let e = self.albedo(wo);
         let mean = |v: Vec3| (v.x + v.y + v.z) / 3.0;
         let d = if self.scale == Vec3::ZERO {
             0.0
@@ -319,7 +368,9 @@ mod tests {
         assert!(EnergyCompensated::new(sep).is_err());
         let rough = MicrofacetBrdf::new(Ggx::new(1.0, 1.5).unwrap(), NoFresnel);
         assert!(EnergyCompensated::new(rough).is_err());
-        let ok = MicrofacetBrdf::new(Beckmann::new(0.5, 1.3).unwrap(), NoFresnel);
+        let beyond = MicrofacetBrdf::new(Beckmann::new(0.5, 1.3).unwrap(), NoFresnel);
+        assert!(EnergyCompensated::new(beyond).is_err());
+        let ok = MicrofacetBrdf::new(Beckmann::new(0.5, 1.0).unwrap(), NoFresnel);
         assert!(EnergyCompensated::new(ok).is_ok());
     }
 }

@@ -17,6 +17,7 @@ use crate::ndf::deref_dispatch;
 use glam::{Vec2, Vec3};
 
 mod albedo;
+mod albedo_anisotropic;
 mod albedo_tables;
 mod blinn_phong;
 mod compensated;
@@ -30,6 +31,10 @@ mod specular;
 
 pub use albedo::{
     ALBEDO_ALPHA_MAX, ALBEDO_ALPHA_MIN, ALBEDO_GRID, ALBEDO_MU_EPSILON, AlbedoTable, average_of_row,
+};
+pub use albedo_anisotropic::{
+    ANISO_ALPHA_LOW, ANISO_ALPHA_NODES, ANISO_ALPHA_OFFSET, ANISO_ENTRIES, ANISO_MU_NODES,
+    ANISO_PHI_NODES, AnisotropicAlbedo, AnisotropicAlbedoTable, encode_albedo,
 };
 pub use blinn_phong::{BlinnPhongLobe, BlinnPhongNormalization};
 pub use compensated::{

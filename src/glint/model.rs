@@ -17,6 +17,7 @@ use super::io::header;
 use super::{BeckmannMixture, BinMap, Footprint, GlintNdf, GlintScratch, PositionNormalMap};
 use crate::error::{Error, Result};
 use crate::ndf::forward_ndf;
+use glam::Vec2;
 use std::io::{Read, Write};
 
 /// Generates [`GlintModel`], [`GlintPatch`], [`GlintOptions`] and their impls from one line per

@@ -1,6 +1,6 @@
 //! The analytic NDFs a material can hold, as one enum implementing [`Ndf`](crate::ndf::Ndf) by dispatch.
 
-use crate::bxdf::{AlbedoTable, TabulatedAlbedo};
+use crate::bxdf::{AlbedoTable, AnisotropicAlbedoTable, TabulatedAlbedo};
 use crate::ndf::{Beckmann, Ggx, forward_ndf};
 
 /// GGX or Beckmann (isotropic or anisotropic), chosen at run time: the NDF of an analytic
@@ -42,7 +42,10 @@ impl TabulatedAlbedo for AnalyticNdf {
     fn albedo_table(&self) -> &'static AlbedoTable {
         forward!(self, n => n.albedo_table())
     }
-    fn table_alpha(&self) -> f32 {
-        forward!(self, n => n.table_alpha())
+    fn anisotropic_albedo_table(&self) -> &'static AnisotropicAlbedoTable {
+        forward!(self, n => n.anisotropic_albedo_table())
+    }
+    fn table_alphas(&self) -> (f32, f32) {
+        forward!(self, n => n.table_alphas())
     }
 }

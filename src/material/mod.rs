@@ -115,7 +115,7 @@ impl Material {
     /// ([`Material::Compensated`]).
     ///
     /// # Errors
-    /// Those of [`EnergyCompensated::new`]: a table α (√((αx² + αy²)/2)) above 1.
+    /// Those of [`EnergyCompensated::new`]: αx or αy above 1.
     pub fn microfacet_compensated(
         ndf: impl Into<AnalyticNdf>,
         fresnel: impl Into<AnyFresnel>,
