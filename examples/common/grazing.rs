@@ -68,6 +68,12 @@ pub struct Settings {
     pub v_samples: usize,
 }
 
+impl Default for Settings {
+    fn default() -> Settings {
+        Settings::new()
+    }
+}
+
 impl Settings {
     /// The example's settings (2¹² furnace samples per point, about two minutes on 2 cores).
     pub fn new() -> Settings {
