@@ -223,24 +223,7 @@ forward_bxdf!([T: Bxdf + ?Sized] &T, deref_dispatch);
 
 #[cfg(test)]
 mod forwarding_tests {
-    use std::collections::BTreeSet;
-
-    /// The names of the `fn`s in `text` (comment lines skipped).
-    fn fn_names(text: &str) -> BTreeSet<String> {
-        text.lines()
-            .map(str::trim_start)
-            .filter(|l| !l.starts_with("//"))
-            .filter_map(|l| l.split("fn ").nth(1))
-            .map(|rest| rest.split('(').next().unwrap_or("").trim().to_string())
-            .collect()
-    }
-
-    /// The text from `head` to the first line that is `}` alone.
-    fn block<'a>(src: &'a str, head: &str) -> &'a str {
-        let start = src.find(head).expect("block head");
-        let len = src[start..].find("\n}\n").expect("block end");
-        &src[start..start + len]
-    }
+    use crate::ndf::forwarding_tests::{block, fn_names};
 
     #[test]
     fn forward_bxdf_names_every_method_of_the_trait() {

@@ -268,11 +268,11 @@ pub(crate) use deref_dispatch;
 forward_ndf!([T: Ndf + ?Sized] &T, deref_dispatch);
 
 #[cfg(test)]
-mod forwarding_tests {
+pub(crate) mod forwarding_tests {
     use std::collections::BTreeSet;
 
     /// The names of the `fn`s in `text` (comment lines skipped).
-    fn fn_names(text: &str) -> BTreeSet<String> {
+    pub(crate) fn fn_names(text: &str) -> BTreeSet<String> {
         text.lines()
             .map(str::trim_start)
             .filter(|l| !l.starts_with("//"))
@@ -282,7 +282,7 @@ mod forwarding_tests {
     }
 
     /// The text from the line that starts with `head` to the first line that is `}` alone.
-    fn block<'a>(src: &'a str, head: &str) -> &'a str {
+    pub(crate) fn block<'a>(src: &'a str, head: &str) -> &'a str {
         let start = src.find(head).expect("block head");
         let len = src[start..].find("\n}\n").expect("block end");
         &src[start..start + len]
