@@ -125,6 +125,7 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
         lod_tolerance: 0.0,
         sub_texel_area: 0.0,
         filtered_area: f32::INFINITY,
+        cut_nodes: 0,
         ..PatchOptions::default()
     };
     let mixture_s = t.elapsed().as_secs_f64();

@@ -41,6 +41,7 @@ mod layered;
 mod material;
 mod mixture;
 mod mixture_compact;
+mod mixture_cut;
 mod mixture_filtered;
 mod mixture_levels;
 mod mixture_lod;

@@ -39,6 +39,9 @@ const FULL_MIXTURE: PatchOptions = PatchOptions {
     lod_resolution: brdf::glint::mixture::DEFAULT_LOD_RESOLUTION,
     sub_texel_area: 0.0,
     filtered_area: f32::INFINITY,
+    cut_nodes: 0,
+    cut_tolerance: 0.0,
+    cut_area: 0.0,
     filtered_tolerance: 0.0,
 };
 

@@ -92,6 +92,7 @@ fn merged_patch<'a>(mix: &'a BeckmannMixture, area: f32, masking: MaskingMode) -
             lod_lobes: f32::INFINITY,
             lod_tolerance: 1.0,
             filtered_area: f32::INFINITY,
+            cut_nodes: 0,
             ..PatchOptions::default()
         },
         None,
@@ -145,6 +146,7 @@ fn chi_square_and_furnace_at_a_merged_level() {
             lod_lobes: 8.0,
             lod_tolerance: 0.0,
             filtered_area: f32::INFINITY,
+            cut_nodes: 0,
             ..PatchOptions::default()
         },
         None,

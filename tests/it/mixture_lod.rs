@@ -270,6 +270,7 @@ fn lod_diagnose() {
                 lod_lobes: lobes,
                 lod_tolerance: 0.0,
                 filtered_area: f32::INFINITY,
+                cut_nodes: 0,
                 ..PatchOptions::default()
             };
             let full_p = mix.patch_with(&fp, &opts(f32::INFINITY), None);
@@ -441,6 +442,7 @@ fn level_of_detail_respects_its_tolerance_at_its_resolution() {
                     lod_lobes: f32::INFINITY,
                     lod_tolerance: 0.0,
                     filtered_area: f32::INFINITY,
+                    cut_nodes: 0,
                     ..PatchOptions::default()
                 },
                 None,
@@ -466,6 +468,7 @@ fn level_of_detail_respects_its_tolerance_at_its_resolution() {
                             lod_tolerance: tol,
                             lod_resolution: r,
                             filtered_area: f32::INFINITY,
+                            cut_nodes: 0,
                             ..PatchOptions::default()
                         },
                         None,
@@ -521,6 +524,7 @@ fn lod_resolution_is_total() {
                 lod_tolerance: 0.3,
                 lod_resolution: r,
                 filtered_area: f32::INFINITY,
+                cut_nodes: 0,
                 ..PatchOptions::default()
             },
             None,

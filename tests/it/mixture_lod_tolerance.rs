@@ -34,6 +34,7 @@ fn check(n: usize, areas: &[f32], positions: usize) {
         lod_tolerance: 0.0,
         sub_texel_area: 0.0,
         filtered_area: f32::INFINITY,
+        cut_nodes: 0,
         ..PatchOptions::default()
     };
     for (name, map) in support::procedural_maps(n) {

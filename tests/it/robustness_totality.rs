@@ -157,6 +157,9 @@ proptest! {
             sub_texel_area: f32::NAN,
             filtered_area: f32::NAN,
             filtered_tolerance: f32::NAN,
+            cut_nodes: u32::MAX,
+            cut_tolerance: f32::NAN,
+            cut_area: f32::NAN,
         };
         for options in [
             mixture_options(MaskingMode::Exact, f32::INFINITY),
@@ -165,6 +168,8 @@ proptest! {
             mixture_options(MaskingMode::Approximate, -1.0),
             hostile,
             PatchOptions { lod_tolerance: f32::INFINITY, lod_resolution: f32::NAN, ..hostile },
+            PatchOptions { cut_nodes: 1, cut_tolerance: -1.0, ..hostile },
+            PatchOptions { cut_nodes: 0, ..hostile },
         ] {
             let patch = mixture.patch_with(&footprint, &options, None);
             check_ndf(&patch, wo, wi, uc, u);

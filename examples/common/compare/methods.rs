@@ -91,6 +91,7 @@ fn mixture_methods(map: &NormalMap, _settings: &Settings) -> Res<Vec<Box<dyn Met
         lod_tolerance: 0.0,
         sub_texel_area: 0.0,
         filtered_area: f32::INFINITY,
+        cut_nodes: 0,
         ..PatchOptions::default()
     };
     let inf = f32::INFINITY;

@@ -240,6 +240,7 @@ fn variants(map: &NormalMap) -> Res<Vec<Variant>> {
         lod_tolerance: 0.0,
         sub_texel_area: 0.0,
         filtered_area: f32::INFINITY,
+        cut_nodes: 0,
         ..PatchOptions::default()
     };
     let approx = PatchOptions {

@@ -22,6 +22,7 @@
 //! Cost: ~20 ns of build per lobe (one reduction of ≤ 4 [`GMM_LOBES`] components per node), 96
 //! bytes per node of the levels ≥ 1 (≤ 32 bytes per lobe), and O(1) per query.
 
+use super::gmm_residual::{Comp, Residual, node_residual};
 use super::lobe_set::LobeSet;
 use super::mip::{bilinear_nodes, trilinear_levels};
 use super::slope_tree::level_sizes;
@@ -34,13 +35,6 @@ pub const GMM_LOBES: usize = 4;
 /// `[E x̃, E ỹ, E x̃², E ỹ², E x̃ỹ]` of its Gaussian.
 type Stored = [f32; 6];
 
-/// A component during the build: weight, mean and covariance [xx, xy, yy], in `f64`.
-#[derive(Clone, Copy, Debug)]
-struct Comp {
-    w: f64,
-    mean: [f64; 2],
-    cov: [f64; 3],
-}
 
 impl Comp {
     fn of_lobe(g: &SlopeGaussian) -> Comp {
@@ -94,6 +88,16 @@ impl Comp {
         ]
     }
 
+    /// A stored component as a query serves it: its Gaussian read back with the standard deviations
+    /// floored at `sigma_min` (what [`GmmPyramid::push_node`] pushes), with its weight.
+    fn served(s: &Stored, sigma_min: f32) -> Comp {
+        let g = SlopeGaussian::from_moments([s[1], s[2], s[3], s[4], s[5]], sigma_min);
+        Comp {
+            w: s[0] as f64,
+            ..Comp::of_lobe(&g)
+        }
+    }
+
     fn from_stored(s: &Stored) -> Comp {
         let (mx, my) = (s[1] as f64, s[2] as f64);
         Comp {
@@ -137,6 +141,8 @@ pub(crate) struct GmmPyramid {
     sizes: Vec<[usize; 2]>,
     /// `levels[l - 1]`: level l's nodes, row major, each [`GMM_LOBES`] components (weight 0 pads).
     levels: Vec<Vec<[Stored; GMM_LOBES]>>,
+    /// `residuals[l - 1]`: level l's nodes' residuals (gmm_residual.rs), row major.
+    residuals: Vec<Vec<Residual>>,
     /// The floor σ_min of every stored component's standard deviations.
     sigma_min: f32,
 }
@@ -153,45 +159,67 @@ impl GmmPyramid {
         use rayon::prelude::*;
         let sizes = level_sizes(nx, ny);
         let mut levels: Vec<Vec<[Stored; GMM_LOBES]>> = Vec::new();
+        let mut residuals: Vec<Vec<Residual>> = Vec::new();
         for l in 1..sizes.len() {
             let [pw, ph] = sizes[l - 1];
             let [w, h] = sizes[l];
             let prev = levels.last();
-            let children_of = |x: usize, y: usize| -> Vec<Comp> {
+            let prev_res = residuals.last();
+            // Node (x, y)'s children as stored (weights divided by their count) and, for the
+            // residual, as served with their residuals.
+            let node = |x: usize, y: usize| -> ([Stored; GMM_LOBES], Residual) {
                 let mut comps = Vec::with_capacity(4 * GMM_LOBES);
-                let mut n = 0.0;
+                let mut served: Vec<Vec<Comp>> = Vec::with_capacity(4);
+                let mut child_res = Vec::with_capacity(4);
                 for cy in (2 * y)..(2 * y + 2).min(ph) {
                     for cx in (2 * x)..(2 * x + 2).min(pw) {
-                        n += 1.0;
                         let k = cy * pw + cx;
-                        match prev {
-                            Some(p) => comps.extend(p[k].iter().map(Comp::from_stored)),
-                            None => comps.push(Comp::of_lobe(&lobe0(k))),
+                        match (prev, prev_res) {
+                            (Some(p), Some(r)) => {
+                                comps.extend(p[k].iter().map(Comp::from_stored));
+                                served.push(
+                                    p[k].iter()
+                                        .filter(|c| c[0] > 0.0)
+                                        .map(|c| Comp::served(c, sigma_min))
+                                        .collect(),
+                                );
+                                child_res.push(r[k]);
+                            }
+                            _ => {
+                                let c = Comp::of_lobe(&lobe0(k));
+                                comps.push(c);
+                                served.push(vec![c]);
+                                child_res.push(Residual::default());
+                            }
                         }
                     }
                 }
+                let n = served.len() as f64;
                 for c in &mut comps {
                     c.w /= n;
                 }
-                comps
+                reduce(&mut comps, GMM_LOBES);
+                let mut out = [[0.0f32; 6]; GMM_LOBES];
+                for (o, c) in out.iter_mut().zip(&comps) {
+                    *o = c.stored();
+                }
+                let q: Vec<Comp> = out
+                    .iter()
+                    .filter(|c| c[0] > 0.0)
+                    .map(|c| Comp::served(c, sigma_min))
+                    .collect();
+                let children: Vec<&[Comp]> = served.iter().map(Vec::as_slice).collect();
+                (out, node_residual(&q, &children, &child_res))
             };
-            let level: Vec<[Stored; GMM_LOBES]> = (0..w * h)
-                .into_par_iter()
-                .map(|k| {
-                    let mut comps = children_of(k % w, k / w);
-                    reduce(&mut comps, GMM_LOBES);
-                    let mut out = [[0.0f32; 6]; GMM_LOBES];
-                    for (o, c) in out.iter_mut().zip(&comps) {
-                        *o = c.stored();
-                    }
-                    out
-                })
-                .collect();
+            let (level, res): (Vec<[Stored; GMM_LOBES]>, Vec<Residual>) =
+                (0..w * h).into_par_iter().map(|k| node(k % w, k / w)).unzip();
             levels.push(level);
+            residuals.push(res);
         }
         GmmPyramid {
             sizes,
             levels,
+            residuals,
             sigma_min,
         }
     }
@@ -203,10 +231,33 @@ impl GmmPyramid {
 
     /// Bytes held.
     pub fn bytes(&self) -> usize {
-        self.levels
-            .iter()
-            .map(|l| l.len() * std::mem::size_of::<[Stored; GMM_LOBES]>())
-            .sum()
+        let nodes: usize = self.levels.iter().map(Vec::len).sum();
+        nodes * (std::mem::size_of::<[Stored; GMM_LOBES]>() + std::mem::size_of::<Residual>())
+    }
+
+    /// The grid of every level, level 0 (the lobes) first.
+    pub fn sizes(&self) -> &[[usize; 2]] {
+        &self.sizes
+    }
+
+    /// The residual of node `k` of level `l` ≥ 1 (gmm_residual.rs; zero at level 0, whose nodes are
+    /// the lobes themselves).
+    pub fn residual(&self, l: usize, k: usize) -> Residual {
+        if l == 0 {
+            return Residual::default();
+        }
+        self.residuals[l - 1][k]
+    }
+
+    /// Pushes node `k` of level `l` ≥ 1 into `set`, its components' weights times `w` (as
+    /// [`GmmPyramid::lookup`] serves them).
+    pub fn push_node(&self, l: usize, k: usize, w: f64, set: &mut LobeSet) {
+        for c in &self.levels[l - 1][k] {
+            if c[0] > 0.0 {
+                let g = SlopeGaussian::from_moments([c[1], c[2], c[3], c[4], c[5]], self.sigma_min);
+                set.push((w * c[0] as f64) as f32, g);
+            }
+        }
     }
 
     /// The filtered mixture of a footprint centred at `p` (level-0 lobe units, lobe i centred at
@@ -234,15 +285,7 @@ impl GmmPyramid {
                 if l == 0 {
                     set.push(wn as f32, lobe0(k));
                 } else {
-                    for c in &self.levels[l - 1][k] {
-                        if c[0] > 0.0 {
-                            let g = SlopeGaussian::from_moments(
-                                [c[1], c[2], c[3], c[4], c[5]],
-                                self.sigma_min,
-                            );
-                            set.push((wn * c[0] as f64) as f32, g);
-                        }
-                    }
+                    self.push_node(l, k, wn, set);
                 }
             }
         };

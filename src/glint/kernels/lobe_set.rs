@@ -3,7 +3,10 @@
 //! the filtered mixture of a large footprint (gmm.rs, for the mixture and position-normal), with
 //! the terms of \[Chermain2019\] eq. 9-17 over its lobes:
 //!
-//! - D(m) = Σ w_i D_i(m);
+//! - D(m) = Σ w_i D_i(m) over the lobes whose slope box holds m's slope: the box of the ellipse
+//!   holding 1 − [`BOX_TAIL`] of the lobe (k = √(−2 ln tail) standard deviations per axis), so that a
+//!   query costs a box test per lobe and a density only where it contributes (as the mixture's
+//!   slope boxes at its default tail);
 //! - A(w) = max(cos θ − w_xy·μ, 0), μ = Σ w_i μ_i (the signed areas summed, as the mixture's);
 //! - V(w) = Σ w_i V_i(w) (exact, O(lobes));
 //! - `sample_normal`: a lobe ∝ w_i, then its slope Gaussian; density Σ w_i D_i(m) cos θ_m;
@@ -24,6 +27,20 @@ pub(crate) struct LobeSet {
     n: usize,
     w: Vec<f32>,
     g: Vec<SlopeGaussian>,
+    /// Slope boxes [min x, min y, max x, max y] (module docs).
+    boxes: Vec<[f32; 4]>,
+}
+
+/// Mass of a lobe left outside its slope box: 10⁻⁶, the mixture's default slope tail.
+pub(crate) const BOX_TAIL: f64 = 1.0e-6;
+
+/// The slope box of `g` holding 1 − [`BOX_TAIL`] of it: mean ± k (√Σxx, √Σyy), k = √(−2 ln tail).
+fn slope_box(g: &SlopeGaussian) -> [f32; 4] {
+    let k = (-2.0 * BOX_TAIL.ln()).sqrt() as f32;
+    let c = g.covariance();
+    let (hx, hy) = (k * c.x_axis.x.max(0.0).sqrt(), k * c.y_axis.y.max(0.0).sqrt());
+    let m = g.mean();
+    [m.x - hx, m.y - hy, m.x + hx, m.y + hy]
 }
 
 /// What a few-lobe patch holds: one lobe inline, or a set lent by the caller's scratch.
@@ -43,6 +60,7 @@ impl LobeSet {
         self.n = 0;
         self.w.clear();
         self.g.clear();
+        self.boxes.clear();
     }
 
     /// Adds a lobe of weight `w` (ignored unless `w` is positive and finite).
@@ -50,6 +68,7 @@ impl LobeSet {
         if w > 0.0 && w.is_finite() {
             self.w.push(w);
             self.g.push(g);
+            self.boxes.push(slope_box(&g));
             self.n += 1;
         }
     }
@@ -130,7 +149,17 @@ impl Ndf for LobeSet {
         if let Some(g) = self.single() {
             return g.d(m);
         }
-        self.iter().map(|(w, g)| w * g.d(m)).sum()
+        let Some(s) = crate::frame::normal_to_slope(m) else {
+            return 0.0;
+        };
+        let mut sum = 0.0;
+        for i in 0..self.n {
+            let b = &self.boxes[i];
+            if s.x >= b[0] && s.x <= b[2] && s.y >= b[1] && s.y <= b[3] {
+                sum += self.w[i] * self.g[i].d(m);
+            }
+        }
+        sum
     }
 
     fn lambda(&self, w: Vec3) -> f32 {

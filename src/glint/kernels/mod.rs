@@ -11,8 +11,10 @@
 //!   mixture's lobes, the position-normal elements).
 
 pub(crate) mod cdf;
+pub(crate) mod cut;
 pub(crate) mod filtered_error;
 pub(crate) mod gmm;
+pub(crate) mod gmm_residual;
 pub(crate) mod lobe_set;
 pub(crate) mod mip;
 pub(crate) mod slope_tree;

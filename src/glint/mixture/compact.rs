@@ -473,6 +473,10 @@ impl LobeStore for CompactStorage {
 
     /// Level 0's compact blocks in `block_bytes`, its quadtree (levels ≥ 2) and frame in
     /// `hierarchy_bytes`, the levels l ≥ 1 in `level_bytes`; no moments, no mip chain.
+    fn hierarchy(&self) -> Option<&crate::glint::kernels::gmm::GmmPyramid> {
+        None
+    }
+
     fn memory(&self) -> MixtureMemory {
         let l0 = &self.levels[0];
         MixtureMemory {

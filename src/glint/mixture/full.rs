@@ -133,6 +133,10 @@ impl LobeStore for FullStorage {
         true
     }
 
+    fn hierarchy(&self) -> Option<&GmmPyramid> {
+        Some(&self.gmm)
+    }
+
     fn memory(&self) -> MixtureMemory {
         let l0 = &self.levels[0];
         MixtureMemory {

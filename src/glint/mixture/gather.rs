@@ -16,6 +16,7 @@ use super::params::{PatchOptions, SeedKernel};
 use super::storage::{LevelView, LobeStore};
 use super::sub_texel;
 use crate::glint::Footprint;
+use crate::glint::kernels::cut::{self, CutKernel, CutStats};
 use crate::glint::kernels::filtered_error;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::scratch::{Home, Lent};
@@ -488,6 +489,8 @@ pub(super) struct Footprinted<'a, L> {
     /// mixture's measured TV to the full mixture, kernels/filtered_error.rs; 1 for the single lobes, which have
     /// none).
     pub set: Option<(Few<'a>, SetKind, f32)>,
+    /// What the cut did, when a cut of the hierarchy serves the patch.
+    pub cut: Option<CutStats>,
 }
 
 /// Which few-lobe patch a [`LobeSet`] is.
@@ -499,6 +502,8 @@ pub(super) enum SetKind {
     SubTexel,
     /// The filtered mixture (gmm.rs).
     FilteredMixture,
+    /// A cut of the filtered-mixture hierarchy (cut.rs).
+    Cut,
 }
 
 /// The per-footprint work of a patch of `store` (module docs): below `options.sub_texel_area` the
@@ -527,6 +532,7 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
             filtered: lobe,
             gathered: None,
             set: Some((Few::One(lobe), SetKind::SubTexel, 1.0)),
+            cut: None,
         };
     }
     let lod = 0.5 * area.max(1e-300).log2();
@@ -534,7 +540,7 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
     // The filtered mixture where the storage has one (with its measured error at this level),
     // else the filtered lobe.
     let error = filtered_error::error_at(filtered_error, lod);
-    let few = || {
+    let few = |sets: Option<Home<'a, LobeSet>>| {
         let mut set = Lent::new(sets);
         if store.filtered_mixture(fp.c, lod, &mut set) && set.len() > 0 {
             (Few::Set(set), SetKind::FilteredMixture, error)
@@ -548,7 +554,38 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
             level: store.level(0),
             filtered,
             gathered: None,
-            set: Some(few()),
+            set: Some(few(sets)),
+            cut: None,
+        };
+    }
+    // A cut of the hierarchy where the filtered mixture does not serve and the gather would cost
+    // more than the cut (full storage).
+    if options.cut_nodes > 0
+        && area >= options.cut_area as f64
+        && let Some(hierarchy) = store.hierarchy()
+    {
+        let k2 = fp.seed().0.weight_variance();
+        let kernel = CutKernel {
+            c: fp.c,
+            s: [fp.cov[0] + k2, fp.cov[1], fp.cov[2] + k2],
+            weight_sigmas: weight_sigmas as f64,
+        };
+        let mut set = Lent::new(sets);
+        let level0 = store.level(0);
+        let stats = cut::cut(
+            hierarchy,
+            |k| level0.lobe(k),
+            kernel,
+            options.cut_tolerance,
+            options.cut_nodes as usize,
+            &mut set,
+        );
+        return Footprinted {
+            level: store.level(0),
+            filtered,
+            gathered: None,
+            set: Some((Few::Set(set), SetKind::Cut, stats.max_error)),
+            cut: Some(stats),
         };
     }
     let res = resolution_index(options.lod_resolution);
@@ -557,7 +594,8 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
             level: store.level(0),
             filtered,
             gathered: None,
-            set: Some(few()),
+            set: Some(few(sets)),
+            cut: None,
         };
     };
     let mut bufs = Lent::new(slots);
@@ -583,6 +621,7 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
         filtered,
         gathered: Some(gather(weight_sigmas, level, &eff, res, bufs)),
         set: None,
+        cut: None,
     }
 }
 

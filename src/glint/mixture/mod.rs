@@ -71,8 +71,9 @@ mod sub_texel;
 
 pub use crate::glint::kernels::gmm::GMM_LOBES;
 pub use model::BeckmannMixture;
+pub use crate::glint::kernels::cut::{CutStats, MAX_CUT_NODES};
 pub use params::{
-    DEFAULT_FILTERED_AREA, DEFAULT_FILTERED_TOLERANCE, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES,
+    DEFAULT_CUT_AREA, DEFAULT_CUT_NODES, DEFAULT_CUT_TOLERANCE, DEFAULT_FILTERED_AREA, DEFAULT_FILTERED_TOLERANCE, DEFAULT_KERNEL_SIGMAS, DEFAULT_LOD_LOBES,
     DEFAULT_LOD_RESOLUTION, DEFAULT_LOD_TOLERANCE, DEFAULT_MASKING, DEFAULT_SAMPLES,
     DEFAULT_SIGMA_MIN, DEFAULT_SLOPE_TAIL, DEFAULT_SPACING, DEFAULT_SUB_TEXEL_AREA,
     DEFAULT_SUPERSAMPLING, DEFAULT_WEIGHT_SIGMAS, LOD_RESOLUTIONS, LobeStorage, MAX_SUPERSAMPLING,
@@ -112,13 +113,7 @@ impl BeckmannMixture {
 /// The options of the two patches compared: the full mixture, and the filtered mixture at any
 /// footprint (neither reads the measured errors).
 fn compared_options() -> (PatchOptions, PatchOptions) {
-    let full = PatchOptions {
-        lod_lobes: f32::INFINITY,
-        lod_tolerance: 0.0,
-        sub_texel_area: 0.0,
-        filtered_area: f32::INFINITY,
-        ..PatchOptions::default()
-    };
+    let full = PatchOptions::full();
     let filtered = PatchOptions {
         filtered_area: 0.0,
         filtered_tolerance: f32::INFINITY,

@@ -104,6 +104,30 @@ pub const DEFAULT_FILTERED_AREA: f32 = 4096.0;
 /// footprint. See docs/results.md, "Cost and error of a shading point against footprint".
 pub const DEFAULT_FILTERED_TOLERANCE: f32 = 0.15;
 
+/// Default largest cut of the filtered-mixture hierarchy, in nodes (src/glint/kernels/cut.rs): the
+/// cost bound of a footprint the cut serves (at least [`PatchOptions::cut_area`], where the filtered
+/// mixture does not serve), with at most this many nodes of [`GMM_LOBES`](super::GMM_LOBES) lobes
+/// whatever its size. 0 turns the cut off (the gathered levels then serve, with their cost cap).
+///
+/// Measured (docs/results.md, "The cut against the full mixture"): at 64 nodes the cut's TV to the
+/// full mixture is 0.03-0.11 on the bumpy, brushed and scratched maps and 0.12-0.26 on flakes from
+/// 1024 texels up; at 16 nodes it is up to twice that.
+pub const DEFAULT_CUT_NODES: u32 = 64;
+
+/// Default footprint area, in lobe cells (texels at the default spacing), from which a footprint
+/// that the filtered mixture does not serve is served by a cut of the hierarchy instead of the
+/// gathered lobes: where the gather's cost (which grows with the footprint) passes the cut's
+/// (bounded by [`DEFAULT_CUT_NODES`]); measured in docs/results.md, "The cut against the full
+/// mixture".
+pub const DEFAULT_CUT_AREA: f32 = 1024.0;
+
+/// Default error budget of a node of the cut: a node stays in the cut when its share of the
+/// footprint's kernel times its relative L2 residual (plus the error of weighting its children
+/// uniformly) is at most this (src/glint/kernels/cut.rs, gmm_residual.rs); the node of largest such
+/// error is split first, until every node meets it or the cut reaches
+/// [`PatchOptions::cut_nodes`].
+pub const DEFAULT_CUT_TOLERANCE: f32 = 0.05;
+
 /// The slope resolutions r at which the levels store their merge-error bounds (slope units, an
 /// isotropic Gaussian's standard deviation): a patch reads the bound at the largest of these ≤
 /// [`PatchOptions::lod_resolution`], which also bounds the error at that resolution (the TV of
@@ -348,6 +372,33 @@ pub struct PatchOptions {
     /// Gaussian of standard deviation r in slope space, read at the largest r of
     /// [`LOD_RESOLUTIONS`] not above this. 0: the continuous TV.
     pub lod_resolution: f32,
+    /// Largest cut of the filtered-mixture hierarchy, in nodes ([`DEFAULT_CUT_NODES`], at most
+    /// [`MAX_CUT_NODES`](super::MAX_CUT_NODES)); 0: no cut. A footprint of at least `cut_area`
+    /// that the filtered mixture does not serve is served by the cut (full storage), whatever
+    /// `lod_lobes` and `lod_tolerance`.
+    pub cut_nodes: u32,
+    /// Footprint area, in lobe cells, from which the cut serves ([`DEFAULT_CUT_AREA`]).
+    pub cut_area: f32,
+    /// Error budget of a node of the cut ([`DEFAULT_CUT_TOLERANCE`]; NaN or ≤ 0: split until
+    /// `cut_nodes`).
+    pub cut_tolerance: f32,
+}
+
+impl PatchOptions {
+    /// Every level of detail off: the full mixture gathered at level 0 for every footprint (no
+    /// sub-texel lobe, no cut, no filtered mixture, no merged level, no cost cap), masking as
+    /// [`DEFAULT_MASKING`]. The reference the levels of detail are measured against; its cost grows
+    /// with the footprint.
+    pub fn full() -> PatchOptions {
+        PatchOptions {
+            lod_lobes: f32::INFINITY,
+            lod_tolerance: 0.0,
+            sub_texel_area: 0.0,
+            filtered_area: f32::INFINITY,
+            cut_nodes: 0,
+            ..PatchOptions::default()
+        }
+    }
 }
 
 impl Default for PatchOptions {
@@ -360,6 +411,9 @@ impl Default for PatchOptions {
             filtered_tolerance: DEFAULT_FILTERED_TOLERANCE,
             lod_tolerance: DEFAULT_LOD_TOLERANCE,
             lod_resolution: DEFAULT_LOD_RESOLUTION,
+            cut_nodes: DEFAULT_CUT_NODES,
+            cut_area: DEFAULT_CUT_AREA,
+            cut_tolerance: DEFAULT_CUT_TOLERANCE,
         }
     }
 }

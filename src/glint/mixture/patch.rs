@@ -19,6 +19,7 @@ use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
 use crate::glint::kernels::cdf::invert_cdf;
+use crate::glint::kernels::cut::CutStats;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::kernels::view_memo::ViewMemo;
 use crate::math::{finite_f32, finite_or_zero};
@@ -122,6 +123,8 @@ pub struct MixturePatch<'a> {
     few: Few<'a>,
     few_kind: Option<SetKind>,
     few_error: f32,
+    /// What the cut did, when a cut serves the patch.
+    cut: Option<CutStats>,
     /// The compiled copy of the block loops the patch runs ([`Simd::detected`]).
     simd: Simd,
     /// The exact V_P of the last view direction (`pdf_visible`, `sample_visible`,
@@ -160,14 +163,14 @@ impl<'a> MixturePatch<'a> {
             &[]
         };
         // The storage is chosen here, once per patch.
-        let (level, filtered, gathered, set) = match mixture.lobe_storage() {
+        let (level, filtered, gathered, set, cut) = match mixture.lobe_storage() {
             Storage::Full(s) => {
                 let f = footprint_patch(s, &fp, &options, params, errors, slots, sets);
-                (PatchLevel::Full(f.level), f.filtered, f.gathered, f.set)
+                (PatchLevel::Full(f.level), f.filtered, f.gathered, f.set, f.cut)
             }
             Storage::Compact(s) => {
                 let f = footprint_patch(s, &fp, &options, params, errors, slots, sets);
-                (PatchLevel::Compact(f.level), f.filtered, f.gathered, f.set)
+                (PatchLevel::Compact(f.level), f.filtered, f.gathered, f.set, f.cut)
             }
         };
         MixturePatch {
@@ -179,6 +182,7 @@ impl<'a> MixturePatch<'a> {
             few_kind: set.as_ref().map(|(_, k, _)| *k),
             few_error: set.as_ref().map_or(0.0, |(_, _, e)| *e),
             few: set.map_or(Few::None, |(s, _, _)| s),
+            cut,
             simd: Simd::detected(),
             view: ViewMemo::default(),
         }
@@ -201,6 +205,13 @@ impl<'a> MixturePatch<'a> {
     /// [`PatchOptions::filtered_area`] (or beyond the cost cap), full storage.
     pub fn is_filtered_mixture(&self) -> bool {
         self.few_kind == Some(SetKind::FilteredMixture)
+    }
+
+    /// What the cut of the filtered-mixture hierarchy did when one serves the patch
+    /// ([`PatchOptions::cut_nodes`]; src/glint/kernels/cut.rs): its nodes, lobes, largest and
+    /// summed node error, start level and splits. `None` for the other forms.
+    pub fn cut(&self) -> Option<CutStats> {
+        self.cut
     }
 
     /// Whether the patch is the sub-texel limit lobe: one slope Gaussian at the interpolated slope

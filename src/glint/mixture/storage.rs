@@ -11,6 +11,7 @@
 
 use super::blocks::LobeBlock;
 use super::params::MixtureMemory;
+use crate::glint::kernels::gmm::GmmPyramid;
 use crate::glint::kernels::lobe_set::LobeSet;
 use crate::glint::kernels::slope_tree::SlopeTree;
 use crate::ndf::SlopeGaussian;
@@ -81,6 +82,10 @@ pub(super) trait LobeStore {
     /// `set`, or `false` (set untouched) when the storage holds no filtered-mixture chain (then
     /// the filtered lobe serves).
     fn filtered_mixture(&self, p: [f64; 2], lod: f64, set: &mut LobeSet) -> bool;
+
+    /// The filtered-mixture hierarchy a cut descends (gmm.rs, cut.rs), or `None` when the storage
+    /// holds none.
+    fn hierarchy(&self) -> Option<&GmmPyramid>;
 
     /// Bytes held.
     fn memory(&self) -> MixtureMemory;

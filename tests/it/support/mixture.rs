@@ -47,6 +47,7 @@ pub fn exact_options() -> PatchOptions {
         lod_tolerance: 0.0,
         sub_texel_area: 0.0,
         filtered_area: f32::INFINITY,
+        cut_nodes: 0,
         ..PatchOptions::default()
     }
 }

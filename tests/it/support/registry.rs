@@ -63,12 +63,16 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
         lod_resolution: 0.04,
         sub_texel_area: 0.0,
         filtered_area: f32::INFINITY,
+        cut_nodes: 0,
+        cut_tolerance: 0.0,
+        cut_area: 0.0,
         filtered_tolerance: 0.0,
     };
     let mut filtered = GlintOptions::default();
     filtered.mixture = PatchOptions {
         filtered_area: 0.0,
         filtered_tolerance: f32::INFINITY,
+        cut_nodes: 0,
         ..PatchOptions::default()
     };
     let mut capped = GlintOptions::default();
