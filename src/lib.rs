@@ -115,11 +115,13 @@
 //!   from measured errors (no setting by hand): the mixture ([`glint::BeckmannMixture`], exact
 //!   masking by default) a sub-texel lobe below 2 texels, its gathered lobes (merged levels within
 //!   a TV budget of 0.01, and a cost cap) and its filtered mixture from 4,096 texels where that
-//!   stays within 0.15 TV of the full mixture ([`glint::mixture::PatchOptions`]); the bin map
+//!   stays within 0.15 TV of the full mixture, and elsewhere from 1,024 texels a cut of at most 64
+//!   nodes of its filtered-mixture hierarchy, whose cost does not grow with the footprint
+//!   ([`glint::mixture::PatchOptions`]); the bin map
 //!   ([`glint::BinMap`]) its exact or moment-lobe masking; position-normal
 //!   ([`glint::PositionNormalMap`]) its element sum or filtered mixture. Which is first to a given
 //!   error depends on the pixel's footprint on the map (texels per pixel), as below.
-//! - **Memory** (docs/results.md, "Memory per model"): the mixture holds 119 B/texel at the
+//! - **Memory** (docs/results.md, "Memory per model"): the mixture holds 123 B/texel at the
 //!   defaults (at 512²-2048²: lobes, lobe blocks, quadtree, the moment and filtered-mixture mip
 //!   chains, levels of detail), 15.4 B/texel with `LobeStorage::Compact` (1.4-1.8× the query time);
 //!   the bin map 29.2 B/texel at 2048², position-normal 29.3 (and up to 32 more once a footprint

@@ -98,23 +98,30 @@ fn mixture_bytes_per_texel_match_the_docs() {
 #[test]
 fn crate_guide_states_the_mixture_defaults() {
     use brdf::glint::mixture::{
-        DEFAULT_FILTERED_AREA, DEFAULT_FILTERED_TOLERANCE, DEFAULT_LOD_TOLERANCE, DEFAULT_MASKING,
-        DEFAULT_SUB_TEXEL_AREA, MaskingMode,
+        DEFAULT_CUT_AREA, DEFAULT_CUT_NODES, DEFAULT_FILTERED_AREA, DEFAULT_FILTERED_TOLERANCE,
+        DEFAULT_LOD_TOLERANCE, DEFAULT_MASKING, DEFAULT_SUB_TEXEL_AREA, MaskingMode,
     };
     assert_eq!(DEFAULT_MASKING, MaskingMode::Exact);
     // Written with a thousands separator, as the docs write counts of texels.
-    let area = DEFAULT_FILTERED_AREA as u32;
-    let area = if area >= 1000 {
-        format!("{},{:03}", area / 1000, area % 1000)
-    } else {
-        area.to_string()
+    let thousands = |area: f32| {
+        let area = area as u32;
+        if area >= 1000 {
+            format!("{},{:03}", area / 1000, area % 1000)
+        } else {
+            area.to_string()
+        }
     };
+    let area = thousands(DEFAULT_FILTERED_AREA);
     let phrases = [
         "exact masking by default".to_string(),
         format!("a sub-texel lobe below {DEFAULT_SUB_TEXEL_AREA} texels"),
         format!("a TV budget of {DEFAULT_LOD_TOLERANCE}"),
         format!("from {area} texels"),
         format!("within {DEFAULT_FILTERED_TOLERANCE} TV of the full mixture"),
+        format!(
+            "from {} texels a cut of at most {DEFAULT_CUT_NODES}",
+            thousands(DEFAULT_CUT_AREA)
+        ),
     ];
     let lib = prose("src/lib.rs");
     for phrase in phrases {

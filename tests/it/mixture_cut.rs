@@ -49,7 +49,8 @@ fn full_options() -> PatchOptions {
 
 /// The cut against the full mixture over footprints and maps, printed (the table of
 /// docs/results.md, "The cut against the full mixture"):
-/// `cargo test --release --test it -- mixture_cut::sweep --ignored --nocapture`.
+/// `CUT_NODES=16,64 cargo test --release --test it -- mixture_cut::sweep --ignored --nocapture`
+/// (µs: one patch, V(wo) and 8 × (visible sample, D, visible pdf), the mean of 20 footprints).
 #[test]
 #[ignore]
 fn sweep() {
@@ -64,7 +65,7 @@ fn sweep() {
         .and_then(|v| v.parse().ok())
         .unwrap_or(PatchOptions::default().cut_tolerance);
     let mut configs = vec![(
-        "old".to_string(),
+        "before (cut off)".to_string(),
         PatchOptions {
             cut_nodes: 0,
             ..PatchOptions::default()
@@ -72,14 +73,25 @@ fn sweep() {
     )];
     for &c in &nodes {
         configs.push((
-            format!("cut{c}"),
+            format!("cut {c}"),
             PatchOptions {
                 cut_nodes: c,
                 cut_tolerance: tol,
+                cut_area: 0.0,
+                filtered_area: f32::INFINITY,
                 ..PatchOptions::default()
             },
         ));
     }
+    configs.push(("defaults".to_string(), PatchOptions::default()));
+    println!(
+        "| map | texels | full µs | {} |",
+        configs
+            .iter()
+            .map(|(l, _)| format!("{l}: TV, lobes, µs"))
+            .collect::<Vec<_>>()
+            .join(" | ")
+    );
     let areas = [4.0f32, 16.0, 64.0, 256.0, 1024.0, 4096.0, 16384.0, 65536.0];
     for (name, map) in support::procedural_maps(n) {
         let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
@@ -101,39 +113,7 @@ fn sweep() {
                 std::hint::black_box(acc);
                 t.elapsed().as_secs_f64() / 20.0 * 1e6
             };
-            let split = |o: &PatchOptions| {
-                let centre = Vec2::new(0.5, 0.5);
-                let fp = Footprint::isotropic_texels(centre, area, n, n);
-                let t = std::time::Instant::now();
-                for _ in 0..20 {
-                    std::hint::black_box(mix.patch_with(&fp, o, None));
-                }
-                let build = t.elapsed().as_secs_f64() / 20.0 * 1e6;
-                let p = mix.patch_with(&fp, o, None);
-                let wo = Vec3::new(0.3, 0.1, 0.95).normalize();
-                let ms: Vec<Vec3> = (0..64)
-                    .map(|k| p.sample_visible(wo, Vec2::new((k as f32 + 0.5) / 64.0, 0.3)))
-                    .collect();
-                let t = std::time::Instant::now();
-                let mut acc = 0.0;
-                for m in &ms {
-                    acc += p.d(*m);
-                }
-                let d = t.elapsed().as_secs_f64() / 64.0 * 1e6;
-                let t = std::time::Instant::now();
-                for m in &ms {
-                    acc += p.visible_area(*m);
-                }
-                let v = t.elapsed().as_secs_f64() / 64.0 * 1e6;
-                let t = std::time::Instant::now();
-                for k in 0..64 {
-                    acc += p.sample_visible(wo, Vec2::new((k as f32 + 0.5) / 64.0, 0.6)).x;
-                }
-                let smp = t.elapsed().as_secs_f64() / 64.0 * 1e6;
-                std::hint::black_box(acc);
-                format!("[b{build:.1} d{d:.2} v{v:.2} s{smp:.2}]")
-            };
-            let mut line = format!("{name:10} {area:6} full {:7.1}us", time(&full_options()));
+            let mut line = format!("| {name} | {area} | {:.0} |", time(&full_options()));
             for (label, o) in &configs {
                 let mut tv = 0.0f64;
                 let mut l2 = 0.0f64;
@@ -152,11 +132,13 @@ fn sweep() {
                         est = est.max(s.max_error);
                     }
                 }
-                line += &format!(
-                    " | {label} tv {tv:.3} l2 {l2:.3} {lobes:3}L e{est:.2} {:6.1}us {}",
-                    time(o),
-                    split(o)
-                );
+                let _ = (label, est, l2);
+                let lobes = if lobes > 0 {
+                    lobes.to_string()
+                } else {
+                    "–".to_string()
+                };
+                line += &format!(" {tv:.3}, {lobes}, {:.0} |", time(o));
             }
             println!("{line}");
         }

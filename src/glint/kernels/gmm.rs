@@ -20,7 +20,7 @@
 //! component weights (lobe_set.rs holds the result and evaluates it).
 //!
 //! Cost: ~20 ns of build per lobe (one reduction of ≤ 4 [`GMM_LOBES`] components per node), 96
-//! bytes per node of the levels ≥ 1 (≤ 32 bytes per lobe), and O(1) per query.
+//! bytes per node of the levels ≥ 1 and 12 of residuals (≤ 36 bytes per lobe), and O(1) per query.
 
 use super::gmm_residual::{Comp, Residual, node_residual};
 use super::lobe_set::LobeSet;
