@@ -269,9 +269,11 @@ impl<B: Bxdf> NormalMapMicrofacet<B> {
         let uc = below_one((uc - self.q_ms) / (1.0 - self.q_ms));
         let (bp, bt) = (self.beta(wo), self.beta(self.mirror_t(wo)));
         let weights = [lp * (1.0 - bp), lp * bp, lt * (1.0 - bt), lt * bt];
+        // The last strategy with a weight takes what rounding leaves above the weights' sum.
+        let last = weights.iter().rposition(|&w| w > 0.0)?;
         let mut start = 0.0;
         for (k, w) in weights.into_iter().enumerate() {
-            if w > 0.0 && uc < start + w {
+            if w > 0.0 && (uc < start + w || k == last) {
                 return Some((k as u8, below_one((uc - start) / w)));
             }
             start += w;
@@ -292,12 +294,14 @@ impl NormalMapMicrofacet<Lambert> {
     /// \[Schussler2017\] §4 (the random walk on the two facets), summed for a Lambertian facet.
     pub fn with_multiple_bounces(self) -> Self {
         let rho = self.inner.albedo();
-        let (c, s) = (self.cos_p, 1.0 - self.cos_p);
+        let (c, lost) = (self.cos_p, 1.0 - self.cos_p);
         // 1 − ρ (1 − c) ≥ c > 0 for ρ ≤ 1, formed as (1 − ρ) + ρ c to keep its digits.
         let denom = (Vec3::ONE - rho) + rho * c;
-        let f_ms = rho * rho * (c * s * FRAC_1_PI) / denom;
-        let q_ms = (rho.element_sum() / 3.0 * s).clamp(0.0, 1.0);
-        let ok = f_ms.is_finite() && q_ms < 1.0;
+        let f_ms = rho * rho * (c * lost * FRAC_1_PI) / denom;
+        // q = 1 (a shading normal within f32 rounding of the horizon) samples the lobe alone; the
+        // pdf stays positive wherever f is (it holds q cos θi / π).
+        let q_ms = (rho.element_sum() / 3.0 * lost).clamp(0.0, 1.0);
+        let ok = f_ms.is_finite() && f_ms.min_element() >= 0.0;
         NormalMapMicrofacet {
             f_ms: if ok { f_ms } else { Vec3::ZERO },
             q_ms: if ok { q_ms } else { 0.0 },
