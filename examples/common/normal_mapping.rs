@@ -5,7 +5,9 @@
 //!   estimated with each adapter's own sampler over a stratified 64 × 64 grid) against the signed
 //!   view angle in the plane of the lean (negative: the side the shading normal leans away from),
 //!   for shading normals tilted 30° and 60°, over a lossless Lambert (ρ = 1) and a GGX α = 0.2
-//!   with F = 1. Where the tilt adapter drops to 0 the view is below the shading horizon.
+//!   with F = 1, and the microfacet adapter over the white Lambert with the whole walk
+//!   (`with_multiple_bounces`, 1 everywhere). Where the tilt adapter drops to 0 the view is below
+//!   the shading horizon.
 //! - `normal_mapping_lobes.png`: f·cos θi over the projected hemisphere (x right along the lean),
 //!   for a view 70° on the side the normal leans away from, tilt 60°, GGX α = 0.2: tilt adapter
 //!   (left, black: the view is below the shading horizon) and microfacet adapter (right: light
@@ -64,6 +66,25 @@ fn curves<B: Bxdf + Copy>(inner: B, name: &str, n: u32) -> Res<Vec<Series>> {
     Ok(series)
 }
 
+/// The albedo curves of the microfacet adapter over a white Lambert with the whole walk
+/// (`with_multiple_bounces`): 1 at every view.
+fn walk_curves(n: u32) -> Res<Vec<Series>> {
+    let mut series = vec![];
+    for tilt in [30.0, 60.0] {
+        let sn = ShadingNormal::new(in_plane(tilt), None)?;
+        let b = NormalMapMicrofacet::new(Lambert::new(Vec3::ONE)?, sn).with_multiple_bounces();
+        let pts = (-89..=89)
+            .map(|t| t as f64)
+            .map(|t| (t, albedo(&b, in_plane(t), n)))
+            .collect();
+        series.push(Series::new(
+            format!("microfacet + whole walk, Lambert ρ=1, tilt {tilt}°"),
+            pts,
+        ));
+    }
+    Ok(series)
+}
+
 /// f·cos θi of `b` over the projected hemisphere (s × s pixels, x right, y up), 0 outside the disk.
 fn lobe(b: &dyn Bxdf, wo: Vec3, s: usize) -> Vec<f32> {
     let mut v = vec![0.0f32; s * s];
@@ -85,6 +106,7 @@ fn lobe(b: &dyn Bxdf, wo: Vec3, s: usize) -> Vec<f32> {
 pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
     let n = if quick { 32 } else { 64 };
     let mut series = curves(Lambert::new(Vec3::ONE)?, "Lambert ρ=1", n)?;
+    series.extend(walk_curves(n)?);
     series.extend(curves(
         MicrofacetBrdf::new(Ggx::isotropic(0.2)?, NoFresnel),
         "GGX α=0.2",
@@ -103,7 +125,8 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
         "Directional albedo of conventional (tilt) and microfacet-based (Schüssler 2017) normal \
          mapping against the view angle, shading normal tilted 30° and 60°, over Lambert ρ = 1 and \
          GGX α = 0.2 with F = 1: the tilt adapter goes black below the shading horizon, the \
-         microfacet adapter does not and stays ≤ 1.",
+         microfacet adapter does not and stays ≤ 1; over the white Lambert with the whole walk \
+         (with_multiple_bounces) it is 1 at every view.",
     )];
 
     let s = if quick { 128 } else { 256 };

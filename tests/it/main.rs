@@ -54,6 +54,7 @@ mod ndf_centred_integrals;
 mod ndf_centred_sampling;
 mod normal_map_io;
 mod normal_mapping;
+mod normal_mapping_energy;
 mod pdf_contract;
 mod position_normal_brdf;
 mod position_normal_filtered;

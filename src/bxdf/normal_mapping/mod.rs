@@ -9,7 +9,8 @@
 //! - [`NormalMapMicrofacet`], microfacet-based normal mapping (\[Schussler2017\]): the shading normal
 //!   becomes one facet ω_p of a two-facet microsurface whose other facet ω_t (perpendicular to ω_p,
 //!   vertical) makes the mean normal the geometric one; light reaches ω_p directly or after a mirror
-//!   bounce on ω_t. Reciprocal, energy conserving, no black regions.
+//!   bounce on ω_t. Reciprocal, energy conserving, no black regions; `eval` holds the walk's
+//!   single-scattering paths, and over a Lambertian inner the whole walk in closed form (opt-in).
 //!
 //! docs/bxdf.md, "Normal mapping", compares them and gives the energy figures.
 
