@@ -12,6 +12,7 @@ mod binmap_accuracy;
 mod binmap_bad_input;
 mod binmap_cost;
 mod binmap_furnace;
+mod binmap_masking_bound;
 mod binmap_masking_lod;
 mod binmap_sampling;
 mod binmap_structure;

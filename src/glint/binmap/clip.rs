@@ -80,6 +80,13 @@ impl Parallelogram {
         )
     }
 
+    /// The parallelogram with x scaled by `kx` and y by `ky` (an axis scaling keeps it a
+    /// parallelogram); `None` if that leaves it degenerate.
+    pub(crate) fn scaled(&self, kx: f64, ky: f64) -> Option<Parallelogram> {
+        let f = |p: [f64; 2]| [p[0] * kx, p[1] * ky];
+        Parallelogram::new(f(self.c), f(self.a), f(self.b))
+    }
+
     /// The same parallelogram translated by `d`.
     #[inline]
     pub(crate) fn translated(&self, d: [f64; 2]) -> Parallelogram {

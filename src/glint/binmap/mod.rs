@@ -21,6 +21,7 @@
 
 mod clip;
 mod facets;
+mod footprint_moments;
 mod forest;
 mod lookup;
 mod masking;

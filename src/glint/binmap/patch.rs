@@ -8,6 +8,7 @@
 //! \[Atanasov2020\] §2 (D_A^H), §2.2 (evaluation through 𝓑⁻¹).
 
 use super::clip::Parallelogram;
+use super::footprint_moments::footprint_moments;
 use super::forest::QueryStats;
 use super::masking::{Buf, ExactMasking, PatchBin};
 use super::{BinMap, PatchOptions};
@@ -57,7 +58,8 @@ const SMOOTH_TAIL: f64 = 1e-6;
 /// of bin j (the unsmoothed bins' V under-counted the smoothed D's visible area: white furnace up to
 /// 1.25 at grazing angles before). Larger footprints use the Smith terms of
 /// the footprint's filtered-moment Beckmann lobe ([`SlopeGaussian::from_moments`] of the map's
-/// moment mip chain at the footprint centre and radius ½√|A|, σ floored at `sigma_min`), whose
+/// moment mip chain read over the footprint's exact cell overlaps, at most 64 cells, σ floored at
+/// `sigma_min`; src/glint/binmap/footprint_moments.rs), whose
 /// first two slope moments approximate the footprint's (second moments raised by σ² for the
 /// smoothed variant). See docs/binmap.md and the white furnace in
 /// tests/it/binmap_furnace.rs. The lobe's V is replaced by Scarf's moment bound
@@ -165,7 +167,13 @@ impl<'a> BinMapPatch<'a> {
         let area_texels = para.area() / (sub * sub);
         let radius = 0.5 * (area_texels as f32).sqrt();
         let sigma = alpha.map(|a| a as f64 / std::f64::consts::SQRT_2);
-        let mut moments = map.moments.filtered(map.width, map.height, center, radius);
+        let mut moments = match para
+            .scaled(1.0 / sub, 1.0 / sub)
+            .and_then(|p| footprint_moments(&map.moments, map.width, map.height, &p))
+        {
+            Some(m) => m,
+            None => map.moments.filtered(map.width, map.height, center, radius),
+        };
         if let Some(s) = sigma {
             // Smoothing convolves the slope distribution with N(0, σ² I): the second moments grow
             // by σ².
