@@ -169,8 +169,16 @@ fn served_where_the_options_say() {
         filtered_area: f32::INFINITY,
         ..d
     };
-    assert!(mix.patch_with(&fp(d.cut_area), &no_filtered, None).cut().is_some());
-    assert!(mix.patch_with(&fp(0.9 * d.cut_area), &no_filtered, None).cut().is_none());
+    assert!(
+        mix.patch_with(&fp(d.cut_area), &no_filtered, None)
+            .cut()
+            .is_some()
+    );
+    assert!(
+        mix.patch_with(&fp(0.9 * d.cut_area), &no_filtered, None)
+            .cut()
+            .is_none()
+    );
     let forced_filtered = PatchOptions {
         filtered_area: 0.0,
         filtered_tolerance: f32::INFINITY,
@@ -191,7 +199,12 @@ fn served_where_the_options_say() {
         },
     )
     .unwrap();
-    assert!(compact.patch_with(&fp(4096.0), &no_filtered, None).cut().is_none());
+    assert!(
+        compact
+            .patch_with(&fp(4096.0), &no_filtered, None)
+            .cut()
+            .is_none()
+    );
 }
 
 /// Every cut holds at most `cut_nodes` nodes (never fewer than its starting cover, at most 3 × 3
@@ -203,7 +216,7 @@ fn cut_size_is_bounded() {
         let n = map.width();
         let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
         for &nodes in &[1u32, 4, 16, 64, 1000] {
-            let cap = (nodes as usize).min(brdf::glint::mixture::MAX_CUT_NODES).max(9);
+            let cap = (nodes as usize).clamp(9, brdf::glint::mixture::MAX_CUT_NODES);
             for &area in &[0.25f32, 4.0, 64.0, 1024.0, 16384.0, 1.0e6] {
                 for fp in [
                     Footprint::isotropic_texels(Vec2::new(0.41, 0.77), area, n, n),
@@ -211,7 +224,10 @@ fn cut_size_is_bounded() {
                 ] {
                     let p = mix.patch_with(&fp, &cut_options(nodes), None);
                     let s = p.cut().expect("a cut");
-                    assert!(s.nodes >= 1 && s.nodes <= cap, "{name} {area} {nodes}: {s:?}");
+                    assert!(
+                        s.nodes >= 1 && s.nodes <= cap,
+                        "{name} {area} {nodes}: {s:?}"
+                    );
                     assert!(s.lobes <= 4 * s.nodes, "{name} {area} {nodes}: {s:?}");
                     assert_eq!(p.few_lobes().count(), s.lobes);
                     let w: f32 = p.few_lobes().map(|(w, _)| w).sum();
@@ -260,7 +276,9 @@ fn close_to_the_full_mixture() {
                 let big = mix.patch_with(&fp, &cut_options(64), None);
                 let (tv9, _) = distances(&full, &small, 4096, 7 + c);
                 let (tv64, l2) = distances(&full, &big, 4096, 7 + c);
-                println!("{name} {area} centre {c}: tv 9 nodes {tv9:.3}, 64 nodes {tv64:.3} (l2 {l2:.3})");
+                println!(
+                    "{name} {area} centre {c}: tv 9 nodes {tv9:.3}, 64 nodes {tv64:.3} (l2 {l2:.3})"
+                );
                 assert!(tv64 <= bound, "{name} {area} {c}: {tv64}");
                 assert!(tv64 <= tv9 + 0.03, "{name} {area} {c}: {tv64} > {tv9}");
             }
@@ -277,7 +295,11 @@ fn chi_square_of_the_cut() {
     for area in [64.0f32, 4096.0] {
         let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.71), area, N, N);
         let patch = mix.patch_with(&fp, &cut_options(64), None);
-        assert!(patch.few_lobes().count() > 8, "{}", patch.few_lobes().count());
+        assert!(
+            patch.few_lobes().count() > 8,
+            "{}",
+            patch.few_lobes().count()
+        );
         support::chi2_few_lobe_samplers(&patch, &format!("cut {area}"), &[30.0, 75.0]);
     }
 }

@@ -206,8 +206,8 @@ impl Geometry<'_> {
             }
         } else {
             // Shares underflowed: uniform over the existing children.
-            for c in 0..4 {
-                e.child[c] = if exists[c] { 1.0 / count } else { 0.0 };
+            for (share, &ex) in e.child.iter_mut().zip(&exists) {
+                *share = if ex { 1.0 / count } else { 0.0 };
             }
         }
         let spread: f64 = (0..4)
@@ -236,7 +236,13 @@ pub(crate) fn cut(
     let top = sizes.len() - 1;
     let max_nodes = max_nodes.clamp(1, MAX_CUT_NODES);
     let [sxx, _, syy] = kernel.s;
-    let ok = kernel.c.iter().chain(kernel.s.iter()).all(|v| v.is_finite()) && sxx > 0.0 && syy > 0.0;
+    let ok = kernel
+        .c
+        .iter()
+        .chain(kernel.s.iter())
+        .all(|v| v.is_finite())
+        && sxx > 0.0
+        && syy > 0.0;
     let ws = if kernel.weight_sigmas.is_finite() && kernel.weight_sigmas > 0.0 {
         kernel.weight_sigmas
     } else {
@@ -315,17 +321,20 @@ pub(crate) fn cut(
         *e = geo.entry(start, e.i, e.j, mass);
     }
     let mut splits = 0;
-    loop {
-        let Some((worst, err)) = entries[..n]
-            .iter()
-            .enumerate()
-            .filter(|(_, e)| e.l > 0)
-            .map(|(k, e)| (k, e.err))
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-        else {
-            break;
-        };
-        if !(err > tolerance as f64) {
+    // NaN or non-positive tolerances split until the cap.
+    let tolerance = if tolerance > 0.0 {
+        tolerance as f64
+    } else {
+        0.0
+    };
+    while let Some((worst, err)) = entries[..n]
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.l > 0)
+        .map(|(k, e)| (k, e.err))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+    {
+        if err <= tolerance {
             break;
         }
         let e = entries[worst];

@@ -35,7 +35,6 @@ pub const GMM_LOBES: usize = 4;
 /// `[E x̃, E ỹ, E x̃², E ỹ², E x̃ỹ]` of its Gaussian.
 type Stored = [f32; 6];
 
-
 impl Comp {
     fn of_lobe(g: &SlopeGaussian) -> Comp {
         let (m, c) = (g.mean(), g.covariance());
@@ -211,8 +210,10 @@ impl GmmPyramid {
                 let children: Vec<&[Comp]> = served.iter().map(Vec::as_slice).collect();
                 (out, node_residual(&q, &children, &child_res))
             };
-            let (level, res): (Vec<[Stored; GMM_LOBES]>, Vec<Residual>) =
-                (0..w * h).into_par_iter().map(|k| node(k % w, k / w)).unzip();
+            let (level, res): (Vec<[Stored; GMM_LOBES]>, Vec<Residual>) = (0..w * h)
+                .into_par_iter()
+                .map(|k| node(k % w, k / w))
+                .unzip();
             levels.push(level);
             residuals.push(res);
         }

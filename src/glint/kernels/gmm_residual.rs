@@ -35,7 +35,11 @@ pub(crate) struct Comp {
 
 /// ∫ N(x; μ_a, Σ_a) N(x; μ_b, Σ_b) dx = N(μ_a − μ_b; 0, Σ_a + Σ_b) (weights not applied).
 pub(crate) fn overlap(a: &Comp, b: &Comp) -> f64 {
-    let s = [a.cov[0] + b.cov[0], a.cov[1] + b.cov[1], a.cov[2] + b.cov[2]];
+    let s = [
+        a.cov[0] + b.cov[0],
+        a.cov[1] + b.cov[1],
+        a.cov[2] + b.cov[2],
+    ];
     let det = (s[0] * s[2] - s[1] * s[1]).max(1e-300);
     let (dx, dy) = (a.mean[0] - b.mean[0], a.mean[1] - b.mean[1]);
     let q = (s[2] * dx * dx - 2.0 * s[1] * dx * dy + s[0] * dy * dy) / det;
@@ -78,7 +82,11 @@ pub(crate) fn node_residual(q: &[Comp], children: &[&[Comp]], child_res: &[Resid
             gram[d][c] = v;
         }
     }
-    let uu: f64 = gram[..k].iter().map(|r| r[..k].iter().sum::<f64>()).sum::<f64>() / (n * n);
+    let uu: f64 = gram[..k]
+        .iter()
+        .map(|r| r[..k].iter().sum::<f64>())
+        .sum::<f64>()
+        / (n * n);
     let qu: f64 = children.iter().map(|c| inner(q, c)).sum::<f64>() / n;
     let qq = inner(q, q);
     let norm = uu.max(0.0).sqrt();

@@ -38,7 +38,10 @@ pub(crate) const BOX_TAIL: f64 = 1.0e-6;
 fn slope_box(g: &SlopeGaussian) -> [f32; 4] {
     let k = (-2.0 * BOX_TAIL.ln()).sqrt() as f32;
     let c = g.covariance();
-    let (hx, hy) = (k * c.x_axis.x.max(0.0).sqrt(), k * c.y_axis.y.max(0.0).sqrt());
+    let (hx, hy) = (
+        k * c.x_axis.x.max(0.0).sqrt(),
+        k * c.y_axis.y.max(0.0).sqrt(),
+    );
     let m = g.mean();
     [m.x - hx, m.y - hy, m.x + hx, m.y + hy]
 }

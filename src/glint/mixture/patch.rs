@@ -166,11 +166,23 @@ impl<'a> MixturePatch<'a> {
         let (level, filtered, gathered, set, cut) = match mixture.lobe_storage() {
             Storage::Full(s) => {
                 let f = footprint_patch(s, &fp, &options, params, errors, slots, sets);
-                (PatchLevel::Full(f.level), f.filtered, f.gathered, f.set, f.cut)
+                (
+                    PatchLevel::Full(f.level),
+                    f.filtered,
+                    f.gathered,
+                    f.set,
+                    f.cut,
+                )
             }
             Storage::Compact(s) => {
                 let f = footprint_patch(s, &fp, &options, params, errors, slots, sets);
-                (PatchLevel::Compact(f.level), f.filtered, f.gathered, f.set, f.cut)
+                (
+                    PatchLevel::Compact(f.level),
+                    f.filtered,
+                    f.gathered,
+                    f.set,
+                    f.cut,
+                )
             }
         };
         MixturePatch {
