@@ -281,7 +281,7 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         m.prepare();
         m
     };
-    let mixture = timed_build(&["Beckmann mixture", "mixture coat"], &mut || {
+    let mixture = timed_build(&["Beckmann mixture", "mixture coat", "mixture (cut off)"], &mut || {
         Ok(prepared(
             BeckmannMixture::build(&map, MixtureParams::default())?.into(),
         ))
@@ -327,6 +327,14 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
             make: Box::new(move |_| Ok(Material::microfacet(Ggx::isotropic(alpha)?, silver))),
         }),
         entry("Beckmann mixture", &mixture),
+        mixture.as_ref().map(|m| {
+            let mut options = GlintOptions::default();
+            options.mixture.cut_nodes = 0;
+            Entry {
+                label: "mixture (cut off)",
+                make: glint(plain(m).with_options(options)),
+            }
+        }),
         entry("bin map", &bin_map),
         bin_map.as_ref().map(|m| {
             let mut options = GlintOptions::default();
