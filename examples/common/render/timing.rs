@@ -281,11 +281,14 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         m.prepare();
         m
     };
-    let mixture = timed_build(&["Beckmann mixture", "mixture coat", "mixture (cut off)"], &mut || {
-        Ok(prepared(
-            BeckmannMixture::build(&map, MixtureParams::default())?.into(),
-        ))
-    })?;
+    let mixture = timed_build(
+        &["Beckmann mixture", "mixture coat", "mixture (cut off)"],
+        &mut || {
+            Ok(prepared(
+                BeckmannMixture::build(&map, MixtureParams::default())?.into(),
+            ))
+        },
+    )?;
     let bin_map = timed_build(&["bin map", BIN_MAP_MOMENT], &mut || {
         Ok(prepared(
             BinMap::build(&map, BinMapParams::default())?.into(),
