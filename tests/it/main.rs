@@ -58,6 +58,7 @@ mod normal_mapping;
 mod normal_mapping_energy;
 mod pdf_contract;
 mod position_normal_brdf;
+mod position_normal_cut;
 mod position_normal_filtered;
 mod position_normal_pndf;
 mod position_normal_tables;

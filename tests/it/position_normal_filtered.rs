@@ -25,6 +25,7 @@ fn exact() -> PatchOptions {
     PatchOptions {
         filtered_area: f32::INFINITY,
         max_query_texels: f32::INFINITY,
+        cut_nodes: 0,
         ..PatchOptions::default()
     }
 }

@@ -366,6 +366,7 @@ fn query_cap_is_an_explicit_level_of_detail() {
         &fp,
         &brdf::glint::position_normal::PatchOptions {
             max_query_texels: PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS,
+            cut_nodes: 0,
             ..Default::default()
         },
         None,
@@ -379,6 +380,7 @@ fn query_cap_is_an_explicit_level_of_detail() {
         &fp,
         &brdf::glint::position_normal::PatchOptions {
             max_query_texels: 12.0,
+            cut_nodes: 0,
             ..Default::default()
         },
         None,
@@ -394,6 +396,7 @@ fn query_cap_is_an_explicit_level_of_detail() {
         &fp,
         &brdf::glint::position_normal::PatchOptions {
             max_query_texels: f32::INFINITY,
+            cut_nodes: 0,
             ..Default::default()
         },
         None,
@@ -405,6 +408,7 @@ fn query_cap_is_an_explicit_level_of_detail() {
             &fp,
             &brdf::glint::position_normal::PatchOptions {
                 max_query_texels: cap,
+                cut_nodes: 0,
                 ..Default::default()
             },
             None,

@@ -160,6 +160,7 @@ fn lod_table() {
                     &fp,
                     &brdf::glint::position_normal::PatchOptions {
                         max_query_texels: cap,
+                        cut_nodes: 0,
                         filtered_area: f32::INFINITY,
                         ..Default::default()
                     },
@@ -187,6 +188,7 @@ fn lod_table() {
                         std::hint::black_box(&fp),
                         &brdf::glint::position_normal::PatchOptions {
                             max_query_texels: cap,
+                            cut_nodes: 0,
                             filtered_area: f32::INFINITY,
                             ..Default::default()
                         },

@@ -235,6 +235,7 @@ fn position_normal_round_trip_is_exact() {
         assert_eq!(loaded.memory(), built.memory());
         let capped = position_normal::PatchOptions {
             max_query_texels: 8.0,
+            cut_nodes: 0,
             ..position_normal::PatchOptions::default()
         };
         for (k, f) in footprints(n).iter().enumerate() {

@@ -294,11 +294,14 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
             BinMap::build(&map, BinMapParams::default())?.into(),
         ))
     })?;
-    let position_normal = timed_build(&["position-normal"], &mut || {
-        Ok(prepared(
-            PositionNormalMap::build(&map, PositionNormalParams::default())?.into(),
-        ))
-    })?;
+    let position_normal = timed_build(
+        &["position-normal", "position-normal (cut off)"],
+        &mut || {
+            Ok(prepared(
+                PositionNormalMap::build(&map, PositionNormalParams::default())?.into(),
+            ))
+        },
+    )?;
     println!(
         "builds ({n}² scratched map, default parameters, wall time, with `prepare`: the measured \
          errors of the levels of detail):\n{builds}"
@@ -348,6 +351,14 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
             }
         }),
         entry("position-normal", &position_normal),
+        position_normal.as_ref().map(|m| {
+            let mut options = GlintOptions::default();
+            options.position_normal.cut_nodes = 0;
+            Entry {
+                label: "position-normal (cut off)",
+                make: glint(plain(m).with_options(options)),
+            }
+        }),
         Some(Entry {
             label: "normal mapping",
             make: Box::new(move |tiles| {

@@ -36,6 +36,31 @@ use crate::ndf::SlopeGaussian;
 /// Largest cut, in nodes.
 pub const MAX_CUT_NODES: usize = 64;
 
+/// Default largest cut of the filtered-mixture hierarchy, in nodes, for the mixture and
+/// position-normal (module docs): the
+/// cost bound of a footprint the cut serves (at least [`PatchOptions::cut_area`](crate::glint::mixture::PatchOptions::cut_area), where the filtered
+/// mixture does not serve), with at most this many nodes of [`GMM_LOBES`](super::gmm::GMM_LOBES) lobes
+/// whatever its size. 0 turns the cut off (the gathered levels then serve, with their cost cap).
+///
+/// Measured (docs/results.md, "The cut against the full mixture"): at 64 nodes the cut's TV to the
+/// full mixture is 0.03-0.11 on the bumpy, brushed and scratched maps and 0.12-0.26 on flakes from
+/// 1024 texels up; at 16 nodes it is up to twice that.
+pub const DEFAULT_CUT_NODES: u32 = 64;
+
+/// Default footprint area, in lobe cells (texels at the default spacing), from which a footprint
+/// that the filtered mixture does not serve is served by a cut of the hierarchy instead of the
+/// gathered lobes: where the gather's cost (which grows with the footprint) passes the cut's
+/// (bounded by [`DEFAULT_CUT_NODES`]); measured in docs/results.md, "The cut against the full
+/// mixture".
+pub const DEFAULT_CUT_AREA: f32 = 1024.0;
+
+/// Default error budget of a node of the cut: a node stays in the cut when its share of the
+/// footprint's kernel times its relative L2 residual (plus the error of weighting its children
+/// uniformly) is at most this (src/glint/kernels/cut.rs, gmm_residual.rs); the node of largest such
+/// error is split first, until every node meets it or the cut reaches
+/// [`PatchOptions::cut_nodes`](crate::glint::mixture::PatchOptions::cut_nodes).
+pub const DEFAULT_CUT_TOLERANCE: f32 = 0.05;
+
 /// The footprint's kernel in level-0 lobe units (module docs).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CutKernel {

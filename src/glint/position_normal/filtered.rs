@@ -17,6 +17,7 @@
 //! per map for the errors) and kept; a renderer whose footprints stay small pays neither.
 
 use super::{PatchOptions, PositionNormalMap, SIGMA_H_PER_SPACING};
+use crate::glint::kernels::cut::{self, CutKernel, CutStats};
 use crate::glint::kernels::filtered_error;
 use crate::glint::kernels::gmm::GmmPyramid;
 use crate::glint::kernels::lobe_set::LobeSet;
@@ -81,6 +82,7 @@ impl PositionNormalMap {
             let full = PatchOptions {
                 max_query_texels: f32::INFINITY,
                 filtered_area: f32::INFINITY,
+                cut_nodes: 0,
                 ..PatchOptions::default()
             };
             let filtered = PatchOptions {
@@ -127,5 +129,37 @@ impl PositionNormalMap {
         self.filtered_chain()
             .lookup(|k| self.element_marginal(k), c, lod, set);
         set.len() > 0
+    }
+
+    /// A cut of the filtered-mixture hierarchy for `footprint` (src/glint/kernels/cut.rs) into
+    /// `set`: the elements' position weights N(u_i; c_P, Σ_P + σ_h² I) in element units, leaves the
+    /// elements' slope marginals (as the chain's level 0).
+    pub(super) fn cut(
+        &self,
+        footprint: &Footprint,
+        options: &PatchOptions,
+        set: &mut LobeSet,
+    ) -> CutStats {
+        let (c, s) = footprint.gaussian_texels(self.width, self.height);
+        let h = self.spacing;
+        let h2 = h * h;
+        let sh2 = SIGMA_H_PER_SPACING * SIGMA_H_PER_SPACING;
+        let kernel = CutKernel {
+            c: [c.x as f64 / h, c.y as f64 / h],
+            s: [
+                s.x_axis.x as f64 / h2 + sh2,
+                s.x_axis.y as f64 / h2,
+                s.y_axis.y as f64 / h2 + sh2,
+            ],
+            weight_sigmas: self.params.weight_sigmas as f64,
+        };
+        cut::cut(
+            self.filtered_chain(),
+            |k| self.element_marginal(k),
+            kernel,
+            options.cut_tolerance,
+            options.cut_nodes as usize,
+            set,
+        )
     }
 }

@@ -135,14 +135,33 @@ pub struct PatchOptions {
     /// serves a footprint of at least `filtered_area`; above it the elements are summed (under
     /// the cap `max_query_texels`). `f32::INFINITY` always serves it, NaN never.
     pub filtered_tolerance: f32,
+    /// Largest cut of the filtered-mixture hierarchy, in nodes (the mixture's
+    /// [`DEFAULT_CUT_NODES`](crate::glint::mixture::DEFAULT_CUT_NODES), at most
+    /// [`MAX_CUT_NODES`](crate::glint::mixture::MAX_CUT_NODES)); 0: no cut. A footprint of at
+    /// least `cut_area` elements that the filtered mixture does not serve is served by the cut
+    /// (src/glint/kernels/cut.rs) instead of the capped element sum.
+    pub cut_nodes: u32,
+    /// Footprint area, in elements, from which the cut serves (the mixture's
+    /// [`DEFAULT_CUT_AREA`](crate::glint::mixture::DEFAULT_CUT_AREA); NaN never).
+    pub cut_area: f32,
+    /// Error budget of a node of the cut (the mixture's
+    /// [`DEFAULT_CUT_TOLERANCE`](crate::glint::mixture::DEFAULT_CUT_TOLERANCE); NaN or ≤ 0: split
+    /// until `cut_nodes`).
+    pub cut_tolerance: f32,
 }
 
 impl Default for PatchOptions {
     fn default() -> Self {
+        use crate::glint::kernels::cut::{
+            DEFAULT_CUT_AREA, DEFAULT_CUT_NODES, DEFAULT_CUT_TOLERANCE,
+        };
         PatchOptions {
             max_query_texels: PositionNormalParams::DEFAULT_MAX_QUERY_TEXELS,
             filtered_area: PositionNormalParams::DEFAULT_FILTERED_AREA,
             filtered_tolerance: PositionNormalParams::DEFAULT_FILTERED_TOLERANCE,
+            cut_nodes: DEFAULT_CUT_NODES,
+            cut_area: DEFAULT_CUT_AREA,
+            cut_tolerance: DEFAULT_CUT_TOLERANCE,
         }
     }
 }

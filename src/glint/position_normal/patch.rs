@@ -15,6 +15,7 @@ use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
 use crate::glint::kernels::cdf::{invert_cdf, pick_streaming};
+use crate::glint::kernels::cut::CutStats;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::kernels::slope_tree::contains;
 use crate::glint::kernels::view_memo::ViewMemo;
@@ -64,7 +65,9 @@ pub(crate) struct Slots {
 /// `filtered_tolerance` ([`PatchOptions`](super::PatchOptions)) is served by the filtered mixture
 /// instead (src/glint/position_normal/filtered.rs): at most 32 slope Gaussians, every term exact
 /// over them (src/glint/kernels/lobe_set.rs), O(1) per query; [`PositionNormalPatch::is_filtered_mixture`]
-/// tells which.
+/// tells which. Elsewhere a footprint of at least `cut_area` elements is served by a cut of the same
+/// hierarchy (src/glint/kernels/cut.rs): at most `cut_nodes` nodes of 4 lobes, chosen by their
+/// stored residuals; [`PositionNormalPatch::cut`] tells which.
 ///
 /// # Reference
 /// \[Yan2016\] §5 (P-NDF of a Gaussian footprint, truncation, hierarchy).
@@ -83,8 +86,11 @@ pub struct PositionNormalPatch<'a> {
     /// Built on the first call that needs every element (masking, samplers, densities), in buffers
     /// lent by the caller's scratch if any.
     slots: Loan<'a, Slots>,
-    /// The filtered mixture when it serves the footprint ([`Few::None`] for the element sum).
+    /// The filtered mixture or a cut when one serves the footprint ([`Few::None`] for the element
+    /// sum).
     few: Few<'a>,
+    /// What the cut did, when a cut serves the patch.
+    cut: Option<CutStats>,
     /// The exact V(wo) of the last view asked for (`view_visible_area`, `pdf_visible`,
     /// `sample_visible`): one pass per wo instead of one per query.
     view: ViewMemo,
@@ -110,7 +116,15 @@ impl<'a> PositionNormalPatch<'a> {
         if area >= options.filtered_area as f64 {
             let mut set: Lent<'a, LobeSet> = Lent::new(scratch.map(|s| s.home()));
             if map.filtered_mixture(c, area, options, &mut set) {
-                return Self::filtered(map, footprint, set);
+                return Self::filtered(map, footprint, set, None);
+            }
+        }
+        // NaN options compare false: no cut.
+        if options.cut_nodes > 0 && area >= options.cut_area as f64 {
+            let mut set: Lent<'a, LobeSet> = Lent::new(scratch.map(|s| s.home()));
+            let stats = map.cut(footprint, options, &mut set);
+            if set.len() > 0 {
+                return Self::filtered(map, footprint, set, Some(stats));
             }
         }
         Self::build(
@@ -120,8 +134,14 @@ impl<'a> PositionNormalPatch<'a> {
         )
     }
 
-    /// The patch served by the filtered mixture `set`: its moments from the lobes, no elements.
-    fn filtered(map: &'a PositionNormalMap, footprint: &Footprint, set: Lent<'a, LobeSet>) -> Self {
+    /// The patch served by the few-lobe `set` (the filtered mixture, or the cut `cut` did): its
+    /// moments from the lobes, no elements.
+    fn filtered(
+        map: &'a PositionNormalMap,
+        footprint: &Footprint,
+        set: Lent<'a, LobeSet>,
+        cut: Option<CutStats>,
+    ) -> Self {
         let mut acc = [0.0f64; 5];
         for (w, g) in set.iter() {
             let (m, c) = (g.mean(), g.covariance());
@@ -144,13 +164,26 @@ impl<'a> PositionNormalPatch<'a> {
             moments_lobe: SlopeGaussian::from_moments(moments, map.params.sigma_r),
             slots: Loan::new(None),
             few: Few::Set(set),
+            cut,
             view: ViewMemo::default(),
         }
     }
 
     /// Whether the filtered mixture serves the patch (module docs of
-    /// src/glint/position_normal/filtered.rs); else the elements are summed.
+    /// src/glint/position_normal/filtered.rs); else a cut of its hierarchy ([`Self::cut`]) or the
+    /// element sum.
     pub fn is_filtered_mixture(&self) -> bool {
+        self.few_serves() && self.cut.is_none()
+    }
+
+    /// What the cut of the filtered-mixture hierarchy did when one serves the patch
+    /// ([`PatchOptions::cut_nodes`](super::PatchOptions::cut_nodes), src/glint/kernels/cut.rs).
+    pub fn cut(&self) -> Option<CutStats> {
+        self.cut
+    }
+
+    /// Whether a few-lobe set (the filtered mixture or a cut) serves the patch.
+    fn few_serves(&self) -> bool {
         !matches!(self.few, Few::None)
     }
 
@@ -187,6 +220,7 @@ impl<'a> PositionNormalPatch<'a> {
             moments_lobe,
             slots: Loan::new(scratch.map(|s| s.home())),
             few: Few::None,
+            cut: None,
             view: ViewMemo::default(),
         }
     }
@@ -244,7 +278,7 @@ impl<'a> PositionNormalPatch<'a> {
     /// filtered mixture's lobes where it serves.
     pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
         let few = self.few.lobes();
-        let slots = (!self.is_filtered_mixture()).then(|| self.slots());
+        let slots = (!self.few_serves()).then(|| self.slots());
         few.into_iter().chain(
             slots
                 .into_iter()
@@ -327,7 +361,7 @@ impl<'a> PositionNormalPatch<'a> {
 
     /// Σ W_i D_i(m) over every kept element, in `f64`.
     fn untruncated_d(&self, m: Vec3) -> f64 {
-        if self.is_filtered_mixture() {
+        if self.few_serves() {
             return self.few.d(m) as f64;
         }
         let s = self.slots();
@@ -357,7 +391,7 @@ impl<'a> PositionNormalPatch<'a> {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
         }
-        if self.is_filtered_mixture() {
+        if self.few_serves() {
             return self.few.visible_area(w) as f64;
         }
         let s = self.slots();
@@ -400,7 +434,7 @@ impl Ndf for PositionNormalPatch<'_> {
     /// Λ = V/A − 1 with V from [`Ndf::visible_area`] (exact, or Scarf's bound for large patches) and A
     /// from the P-NDF's mean slope; 0 for invalid w, `f32::MAX` where A(w) = 0 < w_z.
     fn lambda(&self, w: Vec3) -> f32 {
-        if self.is_filtered_mixture() {
+        if self.few_serves() {
             return self.few.lambda(w);
         }
         crate::ndf::lambda_from_areas(self, w)
@@ -408,7 +442,7 @@ impl Ndf for PositionNormalPatch<'_> {
 
     /// A(w) of the moments lobe: max(cos θ − w_xy·μ_P, 0) with μ_P the P-NDF's mean slope.
     fn projected_area(&self, w: Vec3) -> f32 {
-        if self.is_filtered_mixture() {
+        if self.few_serves() {
             return self.few.projected_area(w);
         }
         self.moments_lobe.projected_area(w)
@@ -440,7 +474,7 @@ impl Ndf for PositionNormalPatch<'_> {
 
     /// m ~ D_P(m) cos θ_m (untruncated): element ∝ W_i with u.x (rescaled), then its slope Gaussian.
     fn sample_normal(&self, u: Vec2) -> Vec3 {
-        if self.is_filtered_mixture() {
+        if self.few_serves() {
             return self.few.sample_normal(u);
         }
         let s = self.slots();
@@ -458,7 +492,7 @@ impl Ndf for PositionNormalPatch<'_> {
     /// pdf 0, where D_P is 0 too, and `MicrofacetBrdf::sample` returns `None` for it. Inside the
     /// support the value differs from `d(m) cos θ_m` by at most the truncated tails. O(elements).
     fn pdf_normal(&self, m: Vec3) -> f32 {
-        if self.is_filtered_mixture() {
+        if self.few_serves() {
             return self.few.pdf_normal(m);
         }
         if !(m.z > 0.0 && m.is_finite() && self.d(m) > 0.0) {
@@ -472,7 +506,7 @@ impl Ndf for PositionNormalPatch<'_> {
     /// m ~ Σ W_i ⟨wo, m⟩⁺ D_i(m) / Σ W_i V_i(wo): element ∝ W_i V_i(wo), then its visible normal.
     /// Invalid wo: [`Ndf::sample_normal`].
     fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
-        if self.is_filtered_mixture() {
+        if self.few_serves() {
             return self.few.sample_visible(wo, u);
         }
         let s = self.slots();

@@ -78,6 +78,7 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
     let mut capped = GlintOptions::default();
     capped.position_normal = position_normal::PatchOptions {
         max_query_texels: 8.0,
+        cut_nodes: 0,
         filtered_area: f32::INFINITY,
         ..position_normal::PatchOptions::default()
     };
