@@ -51,9 +51,11 @@
 //! Cost of one renderer shading point at each footprint (every model at its defaults, against an
 //! analytic GGX one): docs/results.md, "Cost and error of a shading point against footprint". Each
 //! model chooses its own form per footprint by a measured error: the mixture its sub-texel lobe,
-//! gathered lobes or filtered mixture ([`mixture::PatchOptions`]), position-normal its element sum
-//! or filtered mixture ([`position_normal::PatchOptions`]), the bin map its exact or moment-lobe
-//! masking ([`binmap::PatchOptions`]); [`GlintNdf::prepare`] measures those errors at load.
+//! gathered lobes, filtered mixture or a cut of its filtered-mixture hierarchy
+//! ([`mixture::PatchOptions`]), position-normal its element sum, filtered mixture or the same cut
+//! ([`position_normal::PatchOptions`]), the bin map its exact or moment-lobe masking
+//! ([`binmap::PatchOptions`]); [`GlintNdf::prepare`] measures those errors at load. The cut
+//! (src/glint/kernels/cut.rs) chooses its nodes by residuals stored at build.
 //!
 //! ## Adding a model
 //!
