@@ -19,6 +19,9 @@ struct Input {
     compact: bool,
     gaussian_seed: bool,
     lod_lobes: f32,
+    cut_nodes: u32,
+    cut_area: f32,
+    cut_tolerance: f32,
     footprint: FootprintInput,
     probe: Probe,
 }
@@ -53,6 +56,9 @@ fuzz_target!(|input: Input| {
             MaskingMode::Exact
         },
         lod_lobes: input.lod_lobes,
+        cut_nodes: input.cut_nodes,
+        cut_area: input.cut_area,
+        cut_tolerance: input.cut_tolerance,
         ..PatchOptions::default()
     };
     let patch = mixture.patch_with(&input.footprint.build(), &options, None);

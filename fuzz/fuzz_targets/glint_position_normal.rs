@@ -1,6 +1,6 @@
 //! Position-normal Gaussians (Yan 2016): build on an arbitrary small map with arbitrary parameters,
-//! patch through an arbitrary footprint with an arbitrary footprint cap and filtered-mixture
-//! switch, query and sample the patch, the published BRDF and ours.
+//! patch through an arbitrary footprint with an arbitrary footprint cap, filtered-mixture switch
+//! and cut, query and sample the patch, the published BRDF and ours.
 #![no_main]
 
 use arbitrary::Arbitrary;
@@ -20,6 +20,9 @@ struct Input {
     max_query_texels: f32,
     filtered_area: f32,
     filtered_tolerance: f32,
+    cut_nodes: u32,
+    cut_area: f32,
+    cut_tolerance: f32,
     footprint: FootprintInput,
     probe: Probe,
 }
@@ -40,6 +43,9 @@ fuzz_target!(|input: Input| {
         max_query_texels: input.max_query_texels,
         filtered_area: input.filtered_area,
         filtered_tolerance: input.filtered_tolerance,
+        cut_nodes: input.cut_nodes,
+        cut_area: input.cut_area,
+        cut_tolerance: input.cut_tolerance,
     };
     let patch = model.patch_with(&input.footprint.build(), &options, None);
     check_ndf(&patch, &input.probe);
