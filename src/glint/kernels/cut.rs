@@ -37,14 +37,14 @@ use crate::ndf::SlopeGaussian;
 pub const MAX_CUT_NODES: usize = 64;
 
 /// Default largest cut of the filtered-mixture hierarchy, in nodes, for the mixture and
-/// position-normal (module docs): the
-/// cost bound of a footprint the cut serves (at least [`PatchOptions::cut_area`](crate::glint::mixture::PatchOptions::cut_area), where the filtered
-/// mixture does not serve), with at most this many nodes of [`GMM_LOBES`](super::gmm::GMM_LOBES) lobes
-/// whatever its size. 0 turns the cut off (the gathered levels then serve, with their cost cap).
+/// position-normal (module docs): the cost bound of a footprint the cut serves (at least
+/// [`PatchOptions::cut_area`](crate::glint::mixture::PatchOptions::cut_area), where the filtered
+/// mixture does not serve), at most this many nodes of [`GMM_LOBES`](super::gmm::GMM_LOBES) lobes
+/// whatever its size. 0 turns the cut off (the gathered levels or the element sum then serve).
 ///
-/// Measured (docs/results.md, "The cut against the full mixture"): at 64 nodes the cut's TV to the
-/// full mixture is 0.03-0.11 on the bumpy, brushed and scratched maps and 0.12-0.26 on flakes from
-/// 1024 texels up; at 16 nodes it is up to twice that.
+/// Measured (docs/results.md, "The cut against the full mixture", 256² maps): at 64 nodes the
+/// cut's TV to the full mixture is 0.02-0.11 on the bumpy, brushed and scratched maps and 0.12-0.26
+/// on flakes from 1,024 texels up; at 16 nodes up to 3× that.
 pub const DEFAULT_CUT_NODES: u32 = 64;
 
 /// Default footprint area, in lobe cells (texels at the default spacing), from which a footprint
