@@ -508,7 +508,9 @@ pub(super) enum SetKind {
 
 /// The per-footprint work of a patch of `store` (module docs): below `options.sub_texel_area` the
 /// sub-texel limit lobe; from `options.filtered_area`, where the filtered mixture's measured error
-/// meets `options.filtered_tolerance`, the filtered mixture (its lobes lent by `sets`); otherwise the
+/// meets `options.filtered_tolerance`, the filtered mixture (its lobes lent by `sets`); otherwise
+/// from `options.cut_area` (when `options.cut_nodes` > 0 and the storage holds the hierarchy) a cut
+/// of the filtered-mixture hierarchy (kernels/cut.rs, its lobes lent by `sets`); otherwise the
 /// filtered lobe, the level of detail (the coarsest whose weighted merge-error bound meets
 /// `options.lod_tolerance`, moved coarser by the cost cap, see [`level_range`]; past the cap the
 /// filtered mixture, or the filtered lobe without one) and the gather there, its buffers lent by

@@ -234,7 +234,7 @@ impl<'a> MixturePatch<'a> {
     }
 
     /// The lobes of the patch when it is one of the few-lobe forms (filtered lobe, sub-texel lobe,
-    /// filtered mixture): (weight, lobe) pairs, weights summing to 1; empty otherwise.
+    /// filtered mixture, cut): (weight, lobe) pairs, weights summing to 1; empty otherwise.
     pub fn few_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
         self.few.lobes().into_iter()
     }
@@ -250,8 +250,8 @@ impl<'a> MixturePatch<'a> {
     /// W_n spread evenly over its lobes, both blurred by an isotropic Gaussian of std r in slope
     /// space, r the largest of [`super::LOD_RESOLUTIONS`] not above `PatchOptions::lod_resolution`
     /// (0 at level 0; under the filtered mixture its measured TV to the full mixture instead,
-    /// [`BeckmannMixture::filtered_mixture_errors`]; 1 under the filtered lobe and the sub-texel
-    /// lobe, which have none). The difference between that
+    /// [`BeckmannMixture::filtered_mixture_errors`]; under a cut its largest node error e_n,
+    /// [`MixturePatch::cut`]; 1 under the filtered lobe and the sub-texel lobe, which have none). The difference between that
     /// even spread and the full mixture's own weights is not bounded (measured 0.0005-0.013 in TV,
     /// docs/mixture.md). See src/glint/mixture/levels.rs.
     pub fn lod_error(&self) -> f32 {
