@@ -115,7 +115,7 @@
 //!   from measured errors (no setting by hand): the mixture ([`glint::BeckmannMixture`], exact
 //!   masking by default) a sub-texel lobe below 2 texels, its gathered lobes (merged levels within
 //!   a TV budget of 0.01, and a cost cap) and its filtered mixture from 4,096 texels where that
-//!   stays within 0.15 TV of the full mixture, and elsewhere from 1,024 texels a cut of at most 64
+//!   stays within 0.15 TV of the full mixture, and where it does not, from 4,096 texels a cut of at most 64
 //!   nodes of its filtered-mixture hierarchy, whose cost does not grow with the footprint
 //!   ([`glint::mixture::PatchOptions`]); the bin map
 //!   ([`glint::BinMap`]) its exact or moment-lobe masking; position-normal

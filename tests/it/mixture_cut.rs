@@ -83,7 +83,13 @@ fn sweep() {
             },
         ));
     }
-    configs.push(("defaults".to_string(), PatchOptions::default()));
+    configs.push((
+        "cut from 1,024".to_string(),
+        PatchOptions {
+            cut_area: 1024.0,
+            ..PatchOptions::default()
+        },
+    ));
     println!(
         "| map | texels | full µs | {} |",
         configs

@@ -282,7 +282,12 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         m
     };
     let mixture = timed_build(
-        &["Beckmann mixture", "mixture coat", "mixture (cut off)"],
+        &[
+            "Beckmann mixture",
+            "mixture coat",
+            "mixture (cut off)",
+            "mixture (cut from 1024)",
+        ],
         &mut || {
             Ok(prepared(
                 BeckmannMixture::build(&map, MixtureParams::default())?.into(),
@@ -295,7 +300,11 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         ))
     })?;
     let position_normal = timed_build(
-        &["position-normal", "position-normal (cut off)"],
+        &[
+            "position-normal",
+            "position-normal (cut off)",
+            "position-normal (cut from 1024)",
+        ],
         &mut || {
             Ok(prepared(
                 PositionNormalMap::build(&map, PositionNormalParams::default())?.into(),
@@ -341,6 +350,14 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
                 make: glint(plain(m).with_options(options)),
             }
         }),
+        mixture.as_ref().map(|m| {
+            let mut options = GlintOptions::default();
+            options.mixture.cut_area = 1024.0;
+            Entry {
+                label: "mixture (cut from 1024)",
+                make: glint(plain(m).with_options(options)),
+            }
+        }),
         entry("bin map", &bin_map),
         bin_map.as_ref().map(|m| {
             let mut options = GlintOptions::default();
@@ -356,6 +373,14 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
             options.position_normal.cut_nodes = 0;
             Entry {
                 label: "position-normal (cut off)",
+                make: glint(plain(m).with_options(options)),
+            }
+        }),
+        position_normal.as_ref().map(|m| {
+            let mut options = GlintOptions::default();
+            options.position_normal.cut_area = 1024.0;
+            Entry {
+                label: "position-normal (cut from 1024)",
                 make: glint(plain(m).with_options(options)),
             }
         }),
