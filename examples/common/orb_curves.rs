@@ -120,14 +120,7 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
     built.filtered_mixture_errors();
     let mixture = Configured::new(Arc::new(built.into()));
     let mut full = mixture.clone();
-    full.options.mixture = PatchOptions {
-        lod_lobes: f32::INFINITY,
-        lod_tolerance: 0.0,
-        sub_texel_area: 0.0,
-        filtered_area: f32::INFINITY,
-        cut_nodes: 0,
-        ..PatchOptions::default()
-    };
+    full.options.mixture = PatchOptions::full();
     let mixture_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
     // The masking lobe's floor at σ_ε too.

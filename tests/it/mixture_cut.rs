@@ -3,45 +3,17 @@
 //! quarter texel to the whole map, the cut's size bounded by its option, and the physics of a cut
 //! patch (white furnace, samplers).
 //!
-//! Distances are between the normal densities f(m) = D(m) cos θ_m of the two patches, estimated with
-//! draws from their even mix r = (f + g)/2 (half from each patch's own `sample_normal`):
-//! TV = ½ E_r[|f − g| / r] and the relative L2 distance ‖f − g‖₂ / ‖f‖₂ with
-//! ‖h‖₂² = E_r[h² / r]. Both estimates are unbiased; with 4096 draws their relative standard error
-//! is a few per cent.
+//! Distances are the TV and relative L2 distance between the normal densities D cos θ of the two
+//! patches (`support::density_distances`).
 
 use crate::support;
 use brdf::bxdf::MicrofacetBrdf;
 use brdf::fresnel::NoFresnel;
 use brdf::glint::NormalMap;
 use brdf::glint::mixture::{LobeStorage, MixtureParams, PatchOptions};
-use brdf::glint::{BeckmannMixture, Footprint, GlintNdf, MixturePatch};
+use brdf::glint::{BeckmannMixture, Footprint, GlintNdf};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
-use rand::RngExt;
-
-/// TV and relative L2 distance between the normal densities of `full` and `cut` (module docs).
-fn distances(full: &MixturePatch, cut: &MixturePatch, draws: usize, seed: u64) -> (f64, f64) {
-    let mut rng = support::rng(seed);
-    let (mut tv, mut diff2, mut norm2) = (0.0, 0.0, 0.0);
-    for k in 0..draws {
-        let u = Vec2::new(rng.random(), rng.random());
-        let m: Vec3 = if k % 2 == 0 {
-            full.sample_normal(u)
-        } else {
-            cut.sample_normal(u)
-        };
-        let f = full.pdf_normal(m) as f64;
-        let g = cut.pdf_normal(m) as f64;
-        let r = 0.5 * (f + g);
-        if r > 0.0 {
-            tv += 0.5 * (f - g).abs() / r;
-            diff2 += (f - g).powi(2) / r;
-            norm2 += f * f / r;
-        }
-    }
-    let n = draws as f64;
-    (tv / n, (diff2 / norm2).sqrt())
-}
 
 fn full_options() -> PatchOptions {
     PatchOptions::full()
@@ -130,7 +102,7 @@ fn sweep() {
                     let fp = Footprint::isotropic_texels(centre, area, n, n);
                     let full = mix.patch_with(&fp, &full_options(), None);
                     let p = mix.patch_with(&fp, o, None);
-                    let (t, l) = distances(&full, &p, 4096, c as u64);
+                    let (t, l) = support::density_distances(&full, &p, 4096, c as u64);
                     tv = tv.max(t);
                     l2 = l2.max(l);
                     if let Some(s) = p.cut() {
@@ -258,7 +230,7 @@ fn identical_lobes_merge_at_once() {
         assert_eq!(s.splits, 0, "{area}: {s:?}");
         assert!(s.max_error < 1e-3, "{area}: {s:?}");
         let full = mix.patch_with(&fp, &PatchOptions::full(), None);
-        let (tv, l2) = distances(&full, &cut, 4096, 1);
+        let (tv, l2) = support::density_distances(&full, &cut, 4096, 1);
         assert!(tv < 0.01 && l2 < 0.01, "{area}: tv {tv} l2 {l2}");
     }
 }
@@ -280,8 +252,8 @@ fn close_to_the_full_mixture() {
                 let full = mix.patch_with(&fp, &PatchOptions::full(), None);
                 let small = mix.patch_with(&fp, &cut_options(9), None);
                 let big = mix.patch_with(&fp, &cut_options(64), None);
-                let (tv9, _) = distances(&full, &small, 4096, 7 + c);
-                let (tv64, l2) = distances(&full, &big, 4096, 7 + c);
+                let (tv9, _) = support::density_distances(&full, &small, 4096, 7 + c);
+                let (tv64, l2) = support::density_distances(&full, &big, 4096, 7 + c);
                 println!(
                     "{name} {area} centre {c}: tv 9 nodes {tv9:.3}, 64 nodes {tv64:.3} (l2 {l2:.3})"
                 );

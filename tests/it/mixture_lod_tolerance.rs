@@ -29,14 +29,7 @@ const SUB_TEXEL_SLACK: f64 = 0.02;
 fn check(n: usize, areas: &[f32], positions: usize) {
     let bins = HemisphereBins::new(63).unwrap();
     let sigma = brdf::ndf::DEFAULT_SIGMA_MIN as f64;
-    let full = PatchOptions {
-        lod_lobes: f32::INFINITY,
-        lod_tolerance: 0.0,
-        sub_texel_area: 0.0,
-        filtered_area: f32::INFINITY,
-        cut_nodes: 0,
-        ..PatchOptions::default()
-    };
+    let full = PatchOptions::full();
     for (name, map) in support::procedural_maps(n) {
         let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
         for &area in areas {

@@ -1,7 +1,7 @@
 //! Position-normal's cut of its filtered-mixture hierarchy (src/glint/kernels/cut.rs, the elements'
 //! slope marginals as leaves): served where its options say, bounded in size, its distance to the
 //! exact (uncapped) element sum, and the physics of a cut patch (samplers, white furnace).
-//! Distances as in mixture_cut.rs: TV and relative L2 between the normal densities D cos θ.
+//! Distances: TV and relative L2 between the normal densities D cos θ (`support::density_distances`).
 
 use crate::support;
 use brdf::Vec2;
@@ -9,32 +9,8 @@ use brdf::bxdf::MicrofacetBrdf;
 use brdf::fresnel::NoFresnel;
 use brdf::glint::position_normal::{PatchOptions, PositionNormalParams};
 use brdf::glint::{Footprint, GlintNdf, PositionNormalMap};
-use brdf::ndf::Ndf;
-use rand::RngExt;
 
 const N: usize = 128;
-
-fn distances(full: &impl Ndf, cut: &impl Ndf, draws: usize, seed: u64) -> (f64, f64) {
-    let mut rng = support::rng(seed);
-    let (mut tv, mut diff2, mut norm2) = (0.0, 0.0, 0.0);
-    for k in 0..draws {
-        let u = Vec2::new(rng.random(), rng.random());
-        let m = if k % 2 == 0 {
-            full.sample_normal(u)
-        } else {
-            cut.sample_normal(u)
-        };
-        let f = full.pdf_normal(m) as f64;
-        let g = cut.pdf_normal(m) as f64;
-        let r = 0.5 * (f + g);
-        if r > 0.0 {
-            tv += 0.5 * (f - g).abs() / r;
-            diff2 += (f - g).powi(2) / r;
-            norm2 += f * f / r;
-        }
-    }
-    (tv / draws as f64, (diff2 / norm2).sqrt())
-}
 
 /// The exact element sum: no cap, no filtered mixture, no cut.
 fn exact() -> PatchOptions {
@@ -103,7 +79,7 @@ fn close_to_the_element_sum() {
             let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.58), area, N, N);
             let full = pn.patch_with(&fp, &exact(), None);
             let cut = pn.patch_with(&fp, &cut_only(64), None);
-            let (tv, l2) = distances(&full, &cut, 4096, 3);
+            let (tv, l2) = support::density_distances(&full, &cut, 4096, 3);
             println!("{name} {area}: cut tv {tv:.3} l2 {l2:.3}");
             let bound = if name == "flakes" { 0.22 } else { 0.15 };
             assert!(tv <= bound, "{name} {area}: {tv}");

@@ -235,14 +235,7 @@ fn variants(map: &NormalMap) -> Res<Vec<Variant>> {
     )?;
     // Every level of detail off (the full mixture at every footprint), as the curves' "mixture (no
     // LOD)": no cap, no merged levels, no sub-texel lobe, no filtered mixture.
-    let no_lod = PatchOptions {
-        lod_lobes: f32::INFINITY,
-        lod_tolerance: 0.0,
-        sub_texel_area: 0.0,
-        filtered_area: f32::INFINITY,
-        cut_nodes: 0,
-        ..PatchOptions::default()
-    };
+    let no_lod = PatchOptions::full();
     let approx = PatchOptions {
         masking: MaskingMode::Approximate,
         ..PatchOptions::default()

@@ -43,12 +43,7 @@ pub fn procedural_maps() -> Vec<(&'static str, NormalMap)> {
 pub fn exact_options() -> PatchOptions {
     PatchOptions {
         masking: MaskingMode::Exact,
-        lod_lobes: f32::INFINITY,
-        lod_tolerance: 0.0,
-        sub_texel_area: 0.0,
-        filtered_area: f32::INFINITY,
-        cut_nodes: 0,
-        ..PatchOptions::default()
+        ..PatchOptions::full()
     }
 }
 
