@@ -11,8 +11,8 @@
 
 use brdf::fresnel::ConductorFresnel;
 use brdf::glint::{
-    BeckmannMixture, BinMap, GlintModel, GlintNdf, GlintScratch, PositionNormalMap,
-    ScratchedParams, scratched,
+    BeckmannMixture, BinMap, GlintModel, GlintScratch, PositionNormalMap, ScratchedParams,
+    scratched,
 };
 use brdf::material::{GlintMaterial, Material};
 use brdf::ndf::Ggx;
@@ -28,12 +28,7 @@ mod shading_points;
 fn shading_point(c: &mut Criterion) {
     let map = scratched(SIZE, SIZE, ScratchedParams::default(), 7).unwrap();
     let gold = ConductorFresnel::GOLD;
-    // What each model measures for its level of detail is measured once, at load, as a renderer
-    // that wants no first-frame hitch does.
-    let glint = |m: GlintModel| -> Material {
-        m.prepare();
-        GlintMaterial::new(Arc::new(m), gold).into()
-    };
+    let glint = |m: GlintModel| -> Material { GlintMaterial::new(Arc::new(m), gold).into() };
     let mixture = BeckmannMixture::build(&map, Default::default()).unwrap();
     let materials = [
         (

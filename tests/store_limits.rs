@@ -57,7 +57,7 @@ fn lying_sizes_allocate_no_more_than_the_file_holds() {
         .unwrap()
         .save(&mut file)
         .unwrap();
-    // Format version 5 (docs/format.md: lobe count at 72, lobes at 80). Declare a 40000² map (1.6·10⁹
+    // Format version 6 (docs/format.md: lobe count at 72, lobes at 80, as in version 5). Declare a 40000² map (1.6·10⁹
     // lobes, 32 GB) and a payload that claims it all; keep 1 MiB of
     // real lobe data (zeros are valid moments) so that the loader reads some before running out.
     file[24..32].copy_from_slice(&40000u64.to_le_bytes());

@@ -17,7 +17,7 @@ use super::{Artifact, Res, register_font, save_rgb};
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{MixtureParams, PatchOptions};
 use brdf::glint::position_normal::PositionNormalParams;
-use brdf::glint::{BeckmannMixture, BinMap, GlintModel, GlintNdf, PositionNormalMap};
+use brdf::glint::{BeckmannMixture, BinMap, GlintModel, PositionNormalMap};
 use glam::Vec2;
 use indicatif::ProgressBar;
 use plotters::prelude::*;
@@ -129,9 +129,6 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
         ..BinMapParams::default()
     };
     let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, binmap_params)?.into());
-    // What each model measures for its level of detail is part of its build here, as for the
-    // mixture above, so that no render (or its time projection) pays it.
-    binmap.prepare();
     let binmap_s = t.elapsed().as_secs_f64();
     let pn = |sigma_r| -> Res<(Configured, f64)> {
         let t = Instant::now();
@@ -140,7 +137,6 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
             ..PositionNormalParams::default()
         };
         let m = PositionNormalMap::build(map, params)?;
-        m.prepare();
         Ok((
             Configured::new(Arc::new(m.into())),
             t.elapsed().as_secs_f64(),

@@ -54,8 +54,9 @@
 //! gathered lobes, filtered mixture or a cut of its filtered-mixture hierarchy
 //! ([`mixture::PatchOptions`]), position-normal its element sum, filtered mixture or the same cut
 //! ([`position_normal::PatchOptions`]), the bin map its exact or moment-lobe masking
-//! ([`binmap::PatchOptions`]); [`GlintNdf::prepare`] measures those errors at load. The cut
-//! (src/glint/kernels/cut.rs) chooses its nodes by residuals stored at build.
+//! ([`binmap::PatchOptions`]). Those errors are measured by the build and stored in files (a
+//! model holds no state filled on first use). The cut (src/glint/kernels/cut.rs) chooses its nodes
+//! by residuals stored at build.
 //!
 //! ## Adding a model
 //!
@@ -253,10 +254,4 @@ pub trait GlintNdf {
     fn patch_in<'a>(&'a self, footprint: &Footprint, scratch: &'a GlintScratch) -> Self::Patch<'a> {
         self.patch_with(footprint, &Self::Options::default(), Some(scratch))
     }
-
-    /// Builds and measures now what the model otherwise builds on the first footprint that needs
-    /// it (the measured errors its level of detail is chosen by, the filtered chains), so that no
-    /// frame pays for it: a renderer calls it once after loading. Deterministic; never needed for
-    /// correctness. The default does nothing (a model with nothing deferred).
-    fn prepare(&self) {}
 }

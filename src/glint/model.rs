@@ -177,12 +177,6 @@ macro_rules! glint_models {
                     )+
                 }
             }
-
-            fn prepare(&self) {
-                match self {
-                    $( GlintModel::$variant(m) => m.prepare(), )+
-                }
-            }
         }
 
         /// Forwards one `Ndf` method to the variant's patch.

@@ -1,5 +1,6 @@
-//! `GlintNdf::prepare` builds and measures what each model otherwise defers to its first large
-//! footprint, and what it measures is what first use would (deterministic), through the registry.
+//! A model holds what its level of detail reads from the build on: the filtered chains and the
+//! measured errors exist before any footprint asks, and no query changes them (no state filled on
+//! first use; the same values after a footprint of every size and in a fresh build).
 
 use crate::support;
 
@@ -7,44 +8,46 @@ use brdf::Vec2;
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::MixtureParams;
 use brdf::glint::position_normal::PositionNormalParams;
-use brdf::glint::{BeckmannMixture, BinMap, Footprint, GlintModel, GlintNdf, PositionNormalMap};
+use brdf::glint::{BeckmannMixture, BinMap, Footprint, GlintNdf, PositionNormalMap};
+
+/// Footprints from one texel to the whole 128² map.
+fn footprints(n: usize) -> Vec<Footprint> {
+    [1.0f32, 64.0, 1024.0, 8192.0, 16384.0]
+        .iter()
+        .map(|&a| Footprint::isotropic_texels(Vec2::new(0.3, 0.6), a, n, n))
+        .collect()
+}
 
 #[test]
-fn prepare_measures_what_first_use_would() {
+fn the_build_measures_what_the_level_of_detail_reads() {
     let n = 128;
     let map = support::mixture::noise(n, 4);
-    let pn = || PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap();
-    let mix = || BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
-    let bm = || BinMap::build(&map, BinMapParams::default()).unwrap();
 
-    // Position-normal: nothing built before, the chain and the errors after.
-    let prepared = GlintModel::from(pn());
-    let GlintModel::PositionNormal(p) = &prepared else {
-        unreachable!()
-    };
-    assert_eq!(p.memory().filtered_bytes, 0);
-    prepared.prepare();
-    assert!(p.memory().filtered_bytes > 0);
-    let first_use = pn();
-    let fp = Footprint::isotropic_texels(Vec2::new(0.3, 0.6), 8192.0, n, n);
-    let _ = first_use.patch(&fp);
-    assert_eq!(
-        p.filtered_mixture_errors(),
-        first_use.filtered_mixture_errors()
-    );
+    let pn = PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap();
+    let (bytes, errors) = (pn.memory(), pn.filtered_mixture_errors().to_vec());
+    assert!(bytes.filtered_bytes > 0, "the chain is built with the map");
+    assert!(errors.iter().any(|&e| e < 1.0), "{errors:?}");
+    for fp in footprints(n) {
+        let _ = pn.patch(&fp);
+    }
+    assert_eq!(pn.memory(), bytes);
+    assert_eq!(pn.filtered_mixture_errors(), errors);
 
-    // The mixture and the bin map: the same errors as a fresh model's.
-    let prepared = GlintModel::from(mix());
-    prepared.prepare();
-    let GlintModel::Mixture(m) = &prepared else {
-        unreachable!()
-    };
-    assert_eq!(m.filtered_mixture_errors(), mix().filtered_mixture_errors());
-    let prepared = GlintModel::from(bm());
-    prepared.prepare();
-    let GlintModel::BinMap(b) = &prepared else {
-        unreachable!()
-    };
-    assert_eq!(b.moment_masking_errors(), bm().moment_masking_errors());
-    assert!(b.moment_masking_errors().iter().any(|&e| e < 1.0));
+    let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
+    let errors = mix.filtered_mixture_errors().to_vec();
+    assert!(errors.iter().any(|&e| e < 1.0), "{errors:?}");
+    for fp in footprints(n) {
+        let _ = mix.patch(&fp);
+    }
+    assert_eq!(mix.filtered_mixture_errors(), errors);
+    let again = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
+    assert_eq!(again.filtered_mixture_errors(), errors, "deterministic");
+
+    let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
+    let errors = bm.moment_masking_errors().to_vec();
+    assert!(errors.iter().any(|&e| e < 1.0), "{errors:?}");
+    for fp in footprints(n) {
+        let _ = bm.patch(&fp);
+    }
+    assert_eq!(bm.moment_masking_errors(), errors);
 }

@@ -10,8 +10,9 @@ use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{BeckmannMixture, NormalMap, PositionNormalMap};
 use support::format::{reseal, reseal_v1};
 use support::store::{
-    as_version_2, at, is_flip_error, load_mixture, map, mixture_as_version_3, mixture_as_version_4,
-    position_normal_as_version_3, saved, small_files, small_mixture_file,
+    as_version_2, at, bin_map_as_version_5, is_flip_error, load_mixture, map, mixture_as_version_3,
+    mixture_as_version_4, mixture_as_version_5, position_normal_as_version_3,
+    position_normal_as_version_5, saved, small_files, small_mixture_file,
 };
 
 #[test]
@@ -27,12 +28,16 @@ fn every_truncation_is_an_error() {
     }
 }
 
-/// A version-5 file of `kind` (of [`small_files`]) as format `version` (2, 3 or 4) wrote it: no
-/// seed kernel in the mixtures; in versions 2 and 3 the patch options that the mixtures and the
-/// position-normal map stored then (at their defaults), and for a full mixture of version 2 no merge
-/// errors.
+/// A version-6 file of `kind` (of [`small_files`]) as format `version` (2 to 5) wrote it: no
+/// filtered-mixture chain or measured errors; no seed kernel in the mixtures before version 5; in
+/// versions 2 and 3 the patch options that the mixtures and the position-normal map stored then (at
+/// their defaults), and for a full mixture of version 2 no merge errors.
 fn as_version(kind: &str, file: &[u8], version: u32) -> Vec<u8> {
     let mut f = match (kind, version) {
+        ("mixture" | "compact mixture", 5) => return mixture_as_version_5(file),
+        ("position-normal", 4 | 5) => position_normal_as_version_5(file),
+        // The 6² map is too small for any measured masking error: an empty array.
+        ("bin map", _) => bin_map_as_version_5(file, 0),
         ("mixture" | "compact mixture", 4) => return mixture_as_version_4(file),
         ("mixture", 2) => return as_version_2(file),
         ("mixture" | "compact mixture", _) => mixture_as_version_3(file, 0, 16384.0),
@@ -73,14 +78,14 @@ fn header_errors_name_what_is_wrong() {
     let e = load_mixture(&f).unwrap_err();
     assert!(e.to_string().contains("BRDFGLNT"), "{e}");
     let mut f = file.clone();
-    f[8..12].copy_from_slice(&6u32.to_le_bytes());
+    f[8..12].copy_from_slice(&7u32.to_le_bytes());
     let e = load_mixture(&reseal(f)).unwrap_err();
     assert!(
         matches!(
             e,
             Error::UnsupportedVersion {
-                found: 6,
-                supported: 5
+                found: 7,
+                supported: 6
             }
         ),
         "{e}"
@@ -91,7 +96,7 @@ fn header_errors_name_what_is_wrong() {
     // patch options, read and ignored; mixtures before version 5 are Gaussian-seeded); older
     // versions are not.
     for (kind, file, load) in small_files() {
-        for version in [2u32, 3, 4] {
+        for version in [2u32, 3, 4, 5] {
             let old = as_version(kind, &file, version);
             let r = load(&old);
             if kind == "bin map" && version == 2 {
@@ -100,7 +105,7 @@ fn header_errors_name_what_is_wrong() {
                         r,
                         Err(Error::UnsupportedVersion {
                             found: 2,
-                            supported: 5
+                            supported: 6
                         })
                     ),
                     "{kind}: {r:?}"
@@ -167,9 +172,12 @@ fn values_in_later_chunks_are_checked_after_the_checksum() {
     type Case = (&'static str, Vec<u8>, usize, usize, usize, usize, f32, Load);
     let count = 64 * 64;
     let pn_file = saved(|w| pn.save(w));
-    // The position-normal elements end the payload; the lobes start it (the merge errors follow).
-    let pn_start = pn_file.len() - 8 - count * 24;
-    let cases: [Case; 2] = [
+    // The position-normal elements follow the header (24), the size and rate (3 u64), three f32
+    // and their count; then the filtered mixture: its level count, level 1's node count and its
+    // 32² nodes of 108 bytes (a 64 KiB chunk holds 606). The lobes start the mixture's payload.
+    let pn_start = 24 + 24 + 12 + 8;
+    let chain_nodes = pn_start + count * 24 + 16;
+    let cases: [Case; 3] = [
         (
             "lobes[4000][2]",
             saved(|w| mixture.save(w)),
@@ -182,12 +190,22 @@ fn values_in_later_chunks_are_checked_after_the_checksum() {
         ),
         (
             "elements[3000][4]",
-            pn_file,
+            pn_file.clone(),
             pn_start,
             24,
             3000,
             4,
             1e30,
+            |f| PositionNormalMap::load(&mut &f[..]).map(|_| ()),
+        ),
+        (
+            "filtered-mixture nodes[900][0]",
+            pn_file.clone(),
+            chain_nodes,
+            108,
+            900,
+            0,
+            2.0,
             |f| PositionNormalMap::load(&mut &f[..]).map(|_| ()),
         ),
     ];

@@ -170,7 +170,7 @@ fn inconsistent_bin_maps_are_errors() {
 }
 
 /// Offsets in the compact mixture file of a 6² map (docs/format.md, kind 5; lobe grid 6², levels of
-/// detail 6² and 3²; format version 5): the parameters as kind 2 up to 72, level count 72; level 0:
+/// detail 6² and 3²; format versions 5 and 6): the parameters as kind 2 up to 72, level count 72; level 0:
 /// frame count 80, 4 frames 88..152, block count 152, 4 blocks 160..800, error count 800 (0); level
 /// 1: frame count 808, 1 frame 816..832, block count 832, 1 block 840..1000, error count 1000, 9
 /// codes 1008..1017.
@@ -459,4 +459,53 @@ fn version_3_option_fields_are_read_and_ignored() {
             "max_query_texels {cap}"
         );
     }
+}
+
+/// A stored filtered mixture that no build writes, with a valid checksum, is refused with what is
+/// wrong: a node whose weights do not sum to 1, a level count or an error count that does not
+/// match the chain, an error that is not a total variation (docs/format.md, "The filtered mixture
+/// in a file").
+#[test]
+fn inconsistent_filtered_mixtures_are_errors() {
+    use brdf::glint::PositionNormalMap;
+    let pn = PositionNormalMap::build(&map(8), Default::default()).unwrap();
+    let file = saved(|w| pn.save(w));
+    let load = |f: Vec<u8>| PositionNormalMap::load(&mut reseal(f).as_slice()).unwrap_err();
+    let word = |f: &[u8], at: usize| u64::from_le_bytes(f[at..at + 8].try_into().unwrap());
+    // Header 24, size and rate 24, three f32, the element count and 64 elements of 24 bytes; then
+    // the level count, level 1's node count and its first node (weight first).
+    let chain = 24 + 24 + 12 + 8 + 64 * 24;
+    assert_eq!(
+        word(&file, chain),
+        3,
+        "levels 4², 2², 1² above the 8² elements"
+    );
+    let node = chain + 16;
+    let mut f = file.clone();
+    let w = f32::from_le_bytes(f[node..node + 4].try_into().unwrap());
+    f[node..node + 4].copy_from_slice(&(0.5 * w).to_le_bytes());
+    let e = load(f);
+    assert!(e.to_string().contains("weights sum to"), "{e}");
+    // One level fewer than the grid has.
+    let mut f = file.clone();
+    f[chain..chain + 8].copy_from_slice(&2u64.to_le_bytes());
+    let e = load(f);
+    assert!(e.to_string().contains("filtered-mixture levels = 2"), "{e}");
+    // The errors end the payload: their count (one per level of the chain, 4 here) and values.
+    let count = file.len() - 8 - 4 * 4 - 8;
+    assert_eq!(word(&file, count), 4);
+    let mut f = file.clone();
+    let last = file.len() - 8 - 4;
+    f[last..last + 4].copy_from_slice(&1.5f32.to_le_bytes());
+    let e = load(f);
+    assert!(e.to_string().contains("not a total variation"), "{e}");
+    // Three errors for a chain of four levels.
+    let mut f = file[..count].to_vec();
+    f.extend_from_slice(&3u64.to_le_bytes());
+    f.extend_from_slice(&file[count + 8..count + 8 + 12]);
+    f.extend_from_slice(&[0u8; 8]);
+    let payload = word(&f, 16) - 4;
+    f[16..24].copy_from_slice(&payload.to_le_bytes());
+    let e = load(f);
+    assert!(e.to_string().contains("3 filtered-mixture errors"), "{e}");
 }

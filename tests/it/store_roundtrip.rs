@@ -13,8 +13,8 @@ use brdf::glint::{BeckmannMixture, BinMap, Footprint, GlintNdf, NormalMap, Posit
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
 use support::store::{
-    as_version_2, dirs, map, mixture_as_version_3, mixture_as_version_4,
-    position_normal_as_version_3, saved,
+    as_version_2, bin_map_as_version_5, dirs, map, mixture_as_version_3, mixture_as_version_4,
+    mixture_as_version_5, position_normal_as_version_3, position_normal_as_version_5, saved,
 };
 
 /// Asserts that two patches answer every query with the same bits.
@@ -108,10 +108,16 @@ fn mixture_round_trip(seed: SeedKernel) {
     };
     let built = BeckmannMixture::build(&m, params).unwrap();
     let file = saved(|w| built.save(w));
-    assert_eq!(&file[8..12], &5u32.to_le_bytes());
+    assert_eq!(&file[8..12], &6u32.to_le_bytes());
     let loaded = BeckmannMixture::load(&mut file.as_slice()).unwrap();
     assert_eq!(loaded.params(), built.params());
     assert_eq!(loaded.memory(), built.memory());
+    // The measured errors are read, not measured again (the 32² grid measures 64 to 1024 lobes).
+    assert!(!built.filtered_mixture_errors().is_empty());
+    assert_eq!(
+        loaded.filtered_mixture_errors(),
+        built.filtered_mixture_errors()
+    );
     for (masking, lod) in [
         (MaskingMode::Exact, f32::INFINITY),
         (MaskingMode::Approximate, 64.0),
@@ -135,7 +141,7 @@ fn mixture_round_trip(seed: SeedKernel) {
         return;
     }
     // An older file of the same mixture loads to it (same parameters, bit-identical patches) and,
-    // for versions 3 and 4, re-saves as the version-5 file.
+    // for versions 3 to 5, re-saves as the version-6 file.
     let same_as_built = |old_file: Vec<u8>, version: u32| {
         let old = BeckmannMixture::load(&mut old_file.as_slice()).unwrap();
         assert_eq!(old.params(), built.params());
@@ -148,6 +154,14 @@ fn mixture_round_trip(seed: SeedKernel) {
         }
         old
     };
+    // Version 5: no filtered-mixture chain or errors (built and measured on load, as the build
+    // does: the same values).
+    let old = same_as_built(mixture_as_version_5(&file), 5);
+    assert_eq!(
+        old.filtered_mixture_errors(),
+        built.filtered_mixture_errors()
+    );
+    assert_eq!(saved(|w| old.save(w)), file);
     // Version 4: no seed kernel (Gaussian).
     let old = same_as_built(mixture_as_version_4(&file), 4);
     assert_eq!(saved(|w| old.save(w)), file);
@@ -233,6 +247,19 @@ fn position_normal_round_trip_is_exact() {
         let loaded = PositionNormalMap::load(&mut file.as_slice()).unwrap();
         assert_eq!(loaded.params(), built.params());
         assert_eq!(loaded.memory(), built.memory());
+        assert!(!built.filtered_mixture_errors().is_empty());
+        assert_eq!(
+            loaded.filtered_mixture_errors(),
+            built.filtered_mixture_errors()
+        );
+        // As format version 5 wrote it (no chain, no errors): built and measured on load.
+        let v5 =
+            PositionNormalMap::load(&mut position_normal_as_version_5(&file).as_slice()).unwrap();
+        assert_eq!(
+            v5.filtered_mixture_errors(),
+            built.filtered_mixture_errors()
+        );
+        assert_eq!(saved(|w| v5.save(w)), file);
         let capped = position_normal::PatchOptions {
             max_query_texels: 8.0,
             cut_nodes: 0,
@@ -280,6 +307,16 @@ fn bin_map_round_trip_is_exact() {
         let loaded = BinMap::load(&mut file.as_slice()).unwrap();
         assert_eq!(loaded.params(), built.params());
         assert_eq!(loaded.memory(), built.memory());
+        let errors = built.moment_masking_errors();
+        assert!(
+            !errors.is_empty(),
+            "the 48² map measures 256 to 2,304 texels"
+        );
+        assert_eq!(loaded.moment_masking_errors(), errors);
+        // As format version 5 wrote it (no errors): measured on load, as the build does.
+        let v5 = BinMap::load(&mut bin_map_as_version_5(&file, errors.len()).as_slice()).unwrap();
+        assert_eq!(v5.moment_masking_errors(), errors);
+        assert_eq!(saved(|w| v5.save(w)), file);
         assert_eq!(loaded.inverse_bin_map(), built.inverse_bin_map());
         assert_eq!(loaded.forest(), built.forest());
         // 𝓑 is derived on load, not stored: the same bin for every sub-texel.

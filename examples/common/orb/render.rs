@@ -382,9 +382,7 @@ pub fn build_methods(opts: &OrbOptions, map: &NormalMap) -> Res<Vec<OrbMethod>> 
     };
     let mixture: Arc<GlintModel> =
         Arc::new(BeckmannMixture::build_with_progress(map, params, Some(&progress))?.into());
-    // What each model measures for its level of detail is part of its build time, so that no
-    // render pays it.
-    mixture.prepare();
+    // What each model measures for its level of detail is part of its build (and build time).
     build_bar.finish();
     let mixture_build = t.elapsed().as_secs_f64();
     let variant = |masking, lod_lobes| {
@@ -404,7 +402,6 @@ pub fn build_methods(opts: &OrbOptions, map: &NormalMap) -> Res<Vec<OrbMethod>> 
         ..BinMapParams::default()
     };
     let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, binmap_params)?.into());
-    binmap.prepare();
     let binmap_build = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let pn = |sigma_r| {
@@ -415,10 +412,7 @@ pub fn build_methods(opts: &OrbOptions, map: &NormalMap) -> Res<Vec<OrbMethod>> 
                 ..PositionNormalParams::default()
             },
         )
-        .map(|m| {
-            m.prepare();
-            Configured::new(Arc::new(m.into()))
-        })
+        .map(|m| Configured::new(Arc::new(m.into())))
     };
     let position_normal = pn(sigma)?;
     let position_normal_build = t.elapsed().as_secs_f64();

@@ -32,8 +32,8 @@ use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::MixtureParams;
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, Footprint, GlintModel, GlintNdf, GlintOptions, NormalMap,
-    PositionNormalMap, ScratchedParams, scratched,
+    BeckmannMixture, BinMap, Footprint, GlintModel, GlintOptions, NormalMap, PositionNormalMap,
+    ScratchedParams, scratched,
 };
 use brdf::material::{NormalMappedMaterial, NormalMapping};
 use brdf::{Ggx, GlintMaterial, Material, Vec2, Vec3};
@@ -274,13 +274,7 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
             let _ = writeln!(builds, "  {}: {s:.2} s", labels[0]);
             Ok(Some(model))
         };
-    // What a model measures for its level of detail is measured on first use; a renderer that
-    // wants no hitch in its first frame asks for it at load (`GlintNdf::prepare`), as here (timed
-    // with the build).
-    let prepared = |m: GlintModel| {
-        m.prepare();
-        m
-    };
+    // What a model measures for its level of detail is part of its build (timed with it).
     let mixture = timed_build(
         &[
             "Beckmann mixture",
@@ -288,16 +282,10 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
             "mixture (cut off)",
             "mixture (cut from 1024)",
         ],
-        &mut || {
-            Ok(prepared(
-                BeckmannMixture::build(&map, MixtureParams::default())?.into(),
-            ))
-        },
+        &mut || Ok(BeckmannMixture::build(&map, MixtureParams::default())?.into()),
     )?;
     let bin_map = timed_build(&["bin map", BIN_MAP_MOMENT], &mut || {
-        Ok(prepared(
-            BinMap::build(&map, BinMapParams::default())?.into(),
-        ))
+        Ok(BinMap::build(&map, BinMapParams::default())?.into())
     })?;
     let position_normal = timed_build(
         &[
@@ -305,15 +293,11 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
             "position-normal (cut off)",
             "position-normal (cut from 1024)",
         ],
-        &mut || {
-            Ok(prepared(
-                PositionNormalMap::build(&map, PositionNormalParams::default())?.into(),
-            ))
-        },
+        &mut || Ok(PositionNormalMap::build(&map, PositionNormalParams::default())?.into()),
     )?;
     println!(
-        "builds ({n}² scratched map, default parameters, wall time, with `prepare`: the measured \
-         errors of the levels of detail):\n{builds}"
+        "builds ({n}² scratched map, default parameters, wall time, with the measured errors of \
+         the levels of detail):\n{builds}"
     );
     let plain = |m: &Arc<GlintModel>| GlintMaterial::new(m.clone(), silver);
     let glint = |m: GlintMaterial| -> Box<dyn Fn(Vec2) -> Res<Material>> {

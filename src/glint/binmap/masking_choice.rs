@@ -8,8 +8,8 @@
 //! |1 − G1_lobe(wo) / G1_bins(wo)|, G1 = 1/(1 + Λ): the relative error of the masking term the
 //! renderer multiplies its radiance by at those views (the albedo's error follows it, docs/results.md
 //! "Inverse bin map: the masking level of detail"). Per level l of the map (footprints of 4^l
-//! texels, 256-4096 measured, four fixed centres; src/glint/kernels/filtered_error.rs), on the
-//! map's first footprint that asks (~10-50 ms for a 1024² map) and kept. Footprints of 128-256
+//! texels, 256-4096 measured, four fixed centres; src/glint/kernels/filtered_error.rs), by the
+//! build (~10-50 ms for a 1024² map) and stored in files. Footprints of 128-256
 //! texels read the 256-texel level: the error varies little between levels (on the 256² procedural
 //! maps it moves by at most 0.005 between 256 and 4096 texels, tests/it/binmap_masking_lod.rs), and
 //! below 128 texels the moments are not the footprint's (the floor).
@@ -33,10 +33,27 @@ fn views() -> impl Iterator<Item = Vec3> {
 impl BinMap {
     /// The moment-lobe masking's measured G1 error per level (index l: footprints of 4^l texels;
     /// 1 where not measured, below 256 texels): what [`PatchOptions::moment_masking_tolerance`] is
-    /// compared with. Measured on first use (deterministic) and kept; see
+    /// compared with. Measured by the build (deterministic) and stored in files; see
     /// src/glint/binmap/masking_choice.rs.
     pub fn moment_masking_errors(&self) -> &[f32] {
-        self.moment_masking_error.get_or_init(|| {
+        &self.moment_masking_error
+    }
+
+    /// The map with its moment-lobe masking's errors: `stored` when given (read from a file),
+    /// else measured (the build's last step).
+    pub(super) fn with_masking_errors(mut self, stored: Option<Vec<f32>>) -> Self {
+        self.moment_masking_error = stored.unwrap_or_else(|| self.measure_masking_errors());
+        self
+    }
+
+    /// The map with its moment-lobe masking's errors measured.
+    pub(super) fn measured(self) -> Self {
+        self.with_masking_errors(None)
+    }
+
+    /// Measures [`BinMap::moment_masking_errors`] (module docs).
+    fn measure_masking_errors(&self) -> Vec<f32> {
+        {
             let area = (self.width * self.height) as f64;
             let levels = (0..)
                 .take_while(|&l| (1u64 << (2 * l)) as f64 <= area)
@@ -73,7 +90,7 @@ impl BinMap {
                     (n > 0).then(|| (sum / n as f64).min(1.0))
                 },
             )
-        })
+        }
     }
 
     /// Whether a footprint of `area` texels (after the footprint's clamps) takes its masking terms

@@ -50,7 +50,6 @@ use forest::{NO_TREE, TreeView};
 use glam::Vec2;
 use lookup::Table;
 use rayon::prelude::*;
-use std::sync::OnceLock;
 
 /// Bytes held by a [`BinMap`], per part.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -109,8 +108,9 @@ pub struct BinMap {
     /// non-empty bins (`BinFacet::empty` otherwise).
     facets: Vec<BinFacet>,
     moments: MomentPyramid,
-    /// The moment-lobe masking's measured error per level (masking_choice.rs), on first use.
-    moment_masking_error: OnceLock<Vec<f32>>,
+    /// The moment-lobe masking's measured error per level (masking_choice.rs), measured by the
+    /// build (or read from a file).
+    moment_masking_error: Vec<f32>,
 }
 
 /// 𝓑, one bin index per sub-texel, in the narrowest integer type that holds every bin.
@@ -318,8 +318,9 @@ impl BinMap {
             center_slope,
             facets,
             moments,
-            moment_masking_error: OnceLock::new(),
-        })
+            moment_masking_error: Vec::new(),
+        }
+        .measured())
     }
 
     /// Map width in texels.
@@ -441,11 +442,6 @@ impl GlintNdf for BinMap {
         let alpha = (alpha.is_finite() && alpha > 0.0)
             .then(|| alpha.clamp(crate::ndf::MIN_ALPHA, crate::ndf::MAX_ALPHA));
         BinMapPatch::new(self, footprint, alpha, options, scratch)
-    }
-
-    /// Measures the moment-lobe masking's errors ([`BinMap::moment_masking_errors`]).
-    fn prepare(&self) {
-        self.moment_masking_errors();
     }
 }
 

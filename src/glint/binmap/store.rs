@@ -94,7 +94,8 @@ impl BinMap {
                 e.len(l.height)?;
                 e.array(l.data.iter().copied())?;
             }
-            Ok(())
+            // The moment-lobe masking's measured errors (since version 6).
+            e.array(self.moment_masking_errors().iter().map(|&v| [v]))
         })
     }
 
@@ -185,12 +186,26 @@ impl BinMap {
                     )?))
                 };
                 let levels = read_moments(&mut d, &sizes[first..], first)?;
+                // Format version 6 holds the moment-lobe masking's measured errors (at most one
+                // per level of the map); older files get them measured, as a build does.
+                let errors = if d.version() >= 6 {
+                    Some(d.array_up_to::<f32, 1>("masking errors", sizes.len() + 1)?)
+                } else {
+                    None
+                };
                 d.finish()?;
-                Ok((bin_map, levels, assigned.finish()))
+                Ok((bin_map, levels, errors, assigned.finish()))
             })?;
             Ok::<_, crate::Error>((inverse, rest))
         });
-        let (inverse, (bin_map, levels, assigned)) = read?;
+        let (inverse, (bin_map, levels, errors, assigned)) = read?;
+        let errors: Option<Vec<f32>> = errors.map(|e| e.into_iter().map(|[v]| v).collect());
+        // Relative G1 errors, capped at 1 when measured.
+        if let Some(e) = errors.iter().flatten().find(|e| !(0.0..=1.0).contains(*e)) {
+            return Err(invalid(format!(
+                "moment masking error {e} is not in [0, 1]"
+            )));
+        }
         let m = 2.0 * MAX_SLOPE;
         for l in &levels {
             format::check_range(&l.data, "moments", |c| match c {
@@ -219,8 +234,9 @@ impl BinMap {
             center_slope,
             facets,
             moments: MomentPyramid::from_parts(first, levels),
-            moment_masking_error: std::sync::OnceLock::new(),
-        })
+            moment_masking_error: Vec::new(),
+        }
+        .with_masking_errors(errors))
     }
 }
 

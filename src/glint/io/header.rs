@@ -27,13 +27,15 @@ use std::io::Read;
 /// The first 8 bytes of every file.
 pub(crate) const MAGIC: [u8; 8] = *b"BRDFGLNT";
 
-/// The format version written. Version 5 adds the mixture's seed kernel (files of older versions
+/// The format version written. Version 6 adds the filtered mixture's chain (with its residuals) and
+/// measured errors to the full mixture's and the position-normal map's payloads, and the moment
+/// masking's measured errors to the bin map's, so that a loader reads what a build measured. Version 5 adds the mixture's seed kernel (files of older versions
 /// hold Gaussian-seeded mixtures). Version 4 holds no per-query options (the mixture's masking mode and
 /// cost cap, the position-normal map's footprint cap: read and ignored in older files, since options
 /// are per query); version 3 added 𝓑 to the bin map's payload and the levels' merge errors to the
 /// full mixture's; version 2 files of every kind but the bin map are still read ([`OLDEST_READ`]; a
 /// version-2 full mixture gets its merge errors recomputed).
-pub(crate) const VERSION: u32 = 5;
+pub(crate) const VERSION: u32 = 6;
 
 /// The oldest format version read (for every kind but the bin map, whose loader needs version 3).
 pub(crate) const OLDEST_READ: u32 = 2;

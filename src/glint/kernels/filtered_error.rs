@@ -10,8 +10,8 @@
 //! by its `sample_normal` on a fixed R2 sequence (deterministic), at [`CENTRES`] fixed footprint
 //! centres, averaged. The standard error of the mean is ≤ ½ / √(SAMPLES · CENTRES) ≈ 0.016.
 //!
-//! Measured on a model's first footprint that needs it (a renderer whose footprints stay small
-//! never pays for it).
+//! Measured by each model's build (the mixture's and position-normal's `measured` step, the bin
+//! map's) and stored in its file, so that no frame pays for it.
 //!
 //! **Which levels.** Measured for footprints of 4^l lobe cells with 4^l in [[`FIRST_AREA`],
 //! [`LAST_AREA`]]; the full mixture's `d` costs ~0.1 ms at the last one, which bounds the

@@ -35,6 +35,10 @@ pub const GMM_LOBES: usize = 4;
 /// `[E x̃, E ỹ, E x̃², E ỹ², E x̃ỹ]` of its Gaussian.
 type Stored = [f32; 6];
 
+/// One node as a file holds it (gmm_store.rs): its [`GMM_LOBES`] components ([`Stored`], weight 0
+/// pads) then its residual ρ, η, ‖u‖₂ (gmm_residual.rs).
+pub(crate) type NodeRecord = [f32; 6 * GMM_LOBES + 3];
+
 impl Comp {
     fn of_lobe(g: &SlopeGaussian) -> Comp {
         let (m, c) = (g.mean(), g.covariance());
@@ -206,7 +210,7 @@ fn reduce_uncached(comps: &mut Vec<Comp>, k: usize) {
 }
 
 /// The filtered-mixture mip chain (module docs): levels l ≥ 1, [`GMM_LOBES`] components per node.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub(crate) struct GmmPyramid {
     sizes: Vec<[usize; 2]>,
     /// `levels[l - 1]`: level l's nodes, row major, each [`GMM_LOBES`] components (weight 0 pads).
@@ -293,6 +297,94 @@ impl GmmPyramid {
             levels,
             residuals,
             sigma_min,
+        }
+    }
+
+    /// Level l ≥ 1's nodes as records (row major): what a file stores of the chain.
+    pub fn records(&self, l: usize) -> impl ExactSizeIterator<Item = NodeRecord> + '_ {
+        let (nodes, res) = (&self.levels[l - 1], &self.residuals[l - 1]);
+        nodes.iter().zip(res).map(|(n, r)| {
+            let mut out = [0.0f32; 6 * GMM_LOBES + 3];
+            out[..6 * GMM_LOBES].copy_from_slice(n.as_flattened());
+            out[6 * GMM_LOBES..].copy_from_slice(&[r.rho, r.eta, r.norm]);
+            out
+        })
+    }
+
+    /// The chain over an `nx × ny` lobe grid from its levels' records (`levels[l - 1]`: level l's
+    /// nodes, row major, as [`GmmPyramid::records`] gives them), read back with standard deviations
+    /// floored at `sigma_min`: the chain [`GmmPyramid::build`] made, bit for bit, when the records
+    /// are the ones it wrote.
+    ///
+    /// # Errors
+    /// A reason if the level count or a level's node count does not match the grid, or a node's
+    /// weights are negative or do not sum to 1 (within 10⁻³: they are written as `f32` from an `f64`
+    /// sum of 1). The components' moments and the residuals are the caller's to bound (the loader
+    /// checks their ranges as it reads).
+    pub fn from_records(
+        nx: usize,
+        ny: usize,
+        records: Vec<Vec<NodeRecord>>,
+        sigma_min: f32,
+    ) -> std::result::Result<GmmPyramid, String> {
+        let sizes = level_sizes(nx, ny);
+        if records.len() + 1 != sizes.len() {
+            return Err(format!(
+                "{} filtered-mixture levels but the grid {nx}×{ny} has {} above the lobes",
+                records.len(),
+                sizes.len() - 1
+            ));
+        }
+        let mut levels = Vec::with_capacity(records.len());
+        let mut residuals = Vec::with_capacity(records.len());
+        for (l, level) in records.into_iter().enumerate() {
+            let [w, h] = sizes[l + 1];
+            if level.len() != w * h {
+                return Err(format!(
+                    "filtered-mixture level {} holds {} nodes but its grid {w}×{h} needs {}",
+                    l + 1,
+                    level.len(),
+                    w * h
+                ));
+            }
+            let mut nodes = Vec::with_capacity(level.len());
+            let mut res = Vec::with_capacity(level.len());
+            for (k, r) in level.iter().enumerate() {
+                let node: [Stored; GMM_LOBES] =
+                    std::array::from_fn(|c| std::array::from_fn(|i| r[6 * c + i]));
+                let sum: f64 = node.iter().map(|c| c[0] as f64).sum();
+                if node.iter().any(|c| c[0].is_nan() || c[0] < 0.0) || (sum - 1.0).abs() > 1e-3 {
+                    return Err(format!(
+                        "filtered-mixture node {k} of level {}: weights sum to {sum}, not 1",
+                        l + 1
+                    ));
+                }
+                nodes.push(node);
+                let t = &r[6 * GMM_LOBES..];
+                res.push(Residual {
+                    rho: t[0],
+                    eta: t[1],
+                    norm: t[2],
+                });
+            }
+            levels.push(nodes);
+            residuals.push(res);
+        }
+        Ok(GmmPyramid {
+            sizes,
+            levels,
+            residuals,
+            sigma_min,
+        })
+    }
+
+    /// A chain of no levels (a placeholder while its model is assembled).
+    pub fn empty() -> GmmPyramid {
+        GmmPyramid {
+            sizes: Vec::new(),
+            levels: Vec::new(),
+            residuals: Vec::new(),
+            sigma_min: 0.0,
         }
     }
 

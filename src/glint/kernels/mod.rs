@@ -3,7 +3,8 @@
 //! - cdf.rs: inverting a cumulative table, the first step of every glint sampler.
 //! - filtered_error.rs: the filtered mixture's measured distance to a model's full P-NDF, per
 //!   level (what the models' `filtered_tolerance` is compared with).
-//! - gmm.rs: the filtered mixture, a mip chain of few-lobe Gaussian mixtures over a lobe grid.
+//! - gmm.rs: the filtered mixture, a mip chain of few-lobe Gaussian mixtures over a lobe grid;
+//!   gmm_residual.rs its nodes' residuals, gmm_store.rs the chain in a model's file.
 //! - lobe_set.rs: a small weighted set of slope Gaussians, the few-lobe patches' P-NDF.
 //! - mip.rs: trilinear addressing of mip chains over a lobe grid.
 //! - view_memo.rs: a patch's V(wo) kept for the queries of one shading point (lock-free).
@@ -15,6 +16,7 @@ pub(crate) mod cut;
 pub(crate) mod filtered_error;
 pub(crate) mod gmm;
 pub(crate) mod gmm_residual;
+pub(crate) mod gmm_store;
 pub(crate) mod lobe_set;
 pub(crate) mod mip;
 pub(crate) mod slope_tree;

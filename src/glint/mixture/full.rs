@@ -5,9 +5,10 @@
 //! lobes for the filtered lobe (hierarchy.rs) and the filtered mixture's chain (gmm.rs): ~119 bytes
 //! per lobe, the fastest queries.
 //!
-//! Only the moments (and the merge errors) are stored in files; everything else is derived from them
-//! by the same code at build and at load ([`derive_blocks_and_tree`], `build_levels`), so loaded
-//! and built mixtures answer bit-identically.
+//! Files store the moments, the merge errors and the filtered mixture's chain (its Runnalls
+//! reductions and residuals are most of a build's derived work); everything else is derived from
+//! them by the same code at build and at load ([`derive_blocks_and_tree`], `build_levels`), so
+//! loaded and built mixtures answer bit-identically.
 
 use super::blocks::{LobeBlocks, SIDE};
 use super::hierarchy::{LobePyramid, lobe_box};
@@ -43,7 +44,9 @@ impl FullStorage {
     /// The storage of the lobes `moments` (row major over `nx × ny`): level 0's blocks and quadtree,
     /// the mip chain and the levels of detail, with the levels' merge errors computed or, when
     /// given, taken from `errors` (one entry per level l ≥ 1; the loader checks their sizes and
-    /// range). `box_k` is the slope-box half-width in lobe standard deviations.
+    /// range), and the filtered mixture's chain built or, when given, `gmm` (read from a file and
+    /// checked against this grid by the loader). `box_k` is the slope-box half-width in lobe
+    /// standard deviations.
     pub fn new(
         nx: usize,
         ny: usize,
@@ -51,16 +54,19 @@ impl FullStorage {
         sigma_min: f32,
         box_k: f32,
         errors: Option<Vec<[Vec<f32>; N_RES]>>,
+        gmm: Option<GmmPyramid>,
     ) -> FullStorage {
         // Blocks and tree in one streaming pass (no whole-grid temporaries), then the mip chain.
         let (blocks, tree) = derive_blocks_and_tree(nx, ny, &moments, sigma_min, box_k);
         let pyramid = LobePyramid::build(nx, ny, &moments);
-        let gmm = GmmPyramid::build(
-            nx,
-            ny,
-            |k| SlopeGaussian::from_moments(moments[k], sigma_min),
-            sigma_min,
-        );
+        let gmm = gmm.unwrap_or_else(|| {
+            GmmPyramid::build(
+                nx,
+                ny,
+                |k| SlopeGaussian::from_moments(moments[k], sigma_min),
+                sigma_min,
+            )
+        });
         let pad = SlopeGaussian::from_moments([0.0; 5], sigma_min);
         let merged = build_levels(nx, ny, &moments, sigma_min, box_k, &pad, errors);
         let mut levels = Vec::with_capacity(1 + merged.len());
@@ -84,6 +90,11 @@ impl FullStorage {
     /// The lobes' raw moments, row major.
     pub fn moments(&self) -> &[[f32; 5]] {
         &self.levels[0].moments
+    }
+
+    /// The filtered mixture's chain.
+    pub fn gmm(&self) -> &GmmPyramid {
+        &self.gmm
     }
 
     /// The levels l ≥ 1 (`merged()[l - 1]`).

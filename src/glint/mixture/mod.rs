@@ -41,12 +41,13 @@
 //! 5. `storage.rs` (the crate-private storage interface `LobeStore` / `LevelView`), `sub_texel.rs`
 //!    (the sub-texel limit lobe), `full.rs` and `compact.rs` (its two implementations),
 //!    `compact_encode.rs` (the compact encoder);
-//! 6. `model.rs` ([`BeckmannMixture`]: build and accessors), `store.rs` (save and load);
+//! 6. `model.rs` ([`BeckmannMixture`]: the build's derived parts and accessors);
 //! 7. `gather.rs` (per-footprint work: level choice, weights), `passes.rs` (the per-query loops over
 //!    blocks, generic over the storage), `patch.rs` ([`MixturePatch`]);
-//! 8. this file: the re-exports, `impl GlintNdf` and the filtered mixture's measured errors
-//!    ([`BeckmannMixture::filtered_mixture_errors`], which builds patches); and the unit
-//!    test of the runtime dispatch (`dispatch_tests.rs`).
+//! 8. `measured.rs` (the public build, whose last step measures the filtered mixture's errors with
+//!    patches: [`BeckmannMixture::filtered_mixture_errors`]), `store.rs` (save and load);
+//! 9. this file: the re-exports and `impl GlintNdf`; and the unit test of the runtime dispatch
+//!    (`dispatch_tests.rs`).
 
 mod blocks;
 mod build;
@@ -60,6 +61,7 @@ mod gather;
 mod hierarchy;
 mod lanes;
 mod levels;
+mod measured;
 mod model;
 mod params;
 mod passes;
@@ -82,45 +84,7 @@ pub use params::{
 };
 pub use patch::MixturePatch;
 
-use crate::glint::kernels::filtered_error;
 use crate::glint::{Footprint, GlintNdf, GlintScratch};
-
-impl BeckmannMixture {
-    /// The filtered mixture's measured TV to the full mixture per level of its mip chain (index l:
-    /// footprints of 4^l lobe cells; 1 below the first measured level), empty under compact
-    /// storage: what [`PatchOptions::filtered_tolerance`] is compared with. Measured on first use
-    /// (~0.1-0.3 s, deterministic) and kept. See src/glint/kernels/filtered_error.rs.
-    pub fn filtered_mixture_errors(&self) -> &[f32] {
-        self.filtered_error_cell().get_or_init(|| {
-            let (nx, ny) = self.grid();
-            let (full, filtered) = compared_options();
-            filtered_error::errors_per_level(
-                self.filtered_mixture_levels(),
-                (nx * ny) as f64,
-                self.spacing_f64(),
-                self.map_size(),
-                |fp| {
-                    let exact = MixturePatch::new(self, fp, full, None);
-                    let few = MixturePatch::new(self, fp, filtered, None);
-                    few.is_filtered_mixture()
-                        .then(|| filtered_error::tv(&exact, &few))
-                },
-            )
-        })
-    }
-}
-
-/// The options of the two patches compared: the full mixture, and the filtered mixture at any
-/// footprint (neither reads the measured errors).
-fn compared_options() -> (PatchOptions, PatchOptions) {
-    let full = PatchOptions::full();
-    let filtered = PatchOptions {
-        filtered_area: 0.0,
-        filtered_tolerance: f32::INFINITY,
-        ..full
-    };
-    (full, filtered)
-}
 
 impl GlintNdf for BeckmannMixture {
     type Patch<'a> = MixturePatch<'a>;
@@ -135,11 +99,5 @@ impl GlintNdf for BeckmannMixture {
         scratch: Option<&'a GlintScratch>,
     ) -> MixturePatch<'a> {
         MixturePatch::new(self, footprint, *options, scratch)
-    }
-
-    /// Measures the filtered mixture's errors ([`BeckmannMixture::filtered_mixture_errors`]; ~0.1-0.3
-    /// s, nothing under compact storage).
-    fn prepare(&self) {
-        self.filtered_mixture_errors();
     }
 }

@@ -13,6 +13,7 @@ use super::params::{LobeStorage, MixtureMemory, MixtureParams, MomentMethod};
 use super::storage::{LevelView, LobeStore};
 use crate::error::{Error, Result};
 use crate::glint::NormalMap;
+use crate::glint::kernels::gmm::GmmPyramid;
 use crate::ndf::SlopeGaussian;
 
 /// The lobes of a mixture in one of the two storages of [`LobeStorage`].
@@ -66,8 +67,9 @@ pub struct BeckmannMixture {
     /// Half-width of the slope boxes in lobe standard deviations, k = √(−2 ln tail).
     box_k: f32,
     /// The filtered mixture's measured TV to the full mixture per level of its mip chain
-    /// (src/glint/kernels/filtered_error.rs), measured on first use; empty without a filtered mixture (compact storage).
-    filtered_error: std::sync::OnceLock<Vec<f32>>,
+    /// (src/glint/kernels/filtered_error.rs), measured by the build (or read from a file); empty
+    /// without a filtered mixture (compact storage) or on a map too small to measure one.
+    filtered_error: Vec<f32>,
 }
 
 /// The lobe grid (nx, ny) = max(1, round(size / spacing)) and the spacing actually used per axis.
@@ -98,23 +100,9 @@ pub(super) fn box_sigmas(slope_tail: f32) -> f32 {
 }
 
 impl BeckmannMixture {
-    /// Builds the mixture of `map` (parallel, deterministic whatever the thread count).
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] naming the field of `params` that is invalid (`spacing`,
-    /// `sigma_min`, `samples` (under [`MomentMethod::Qmc`]), `supersampling`, `kernel_sigmas`,
-    /// `weight_sigmas`, `slope_tail`);
-    /// [`Error::InvalidSize`] if the lobe grid would exceed 2³¹ lobes.
-    pub fn build(map: &NormalMap, params: MixtureParams) -> Result<Self> {
-        Self::build_with_progress(map, params, None)
-    }
-
-    /// [`BeckmannMixture::build`] reporting progress: `progress` receives fractions in (0, 1] as rows
-    /// of lobes complete (possibly from several threads).
-    ///
-    /// # Errors
-    /// As [`BeckmannMixture::build`].
-    pub fn build_with_progress(
+    /// The mixture of `map` without its filtered mixture's errors (measured.rs measures them:
+    /// [`BeckmannMixture::build_with_progress`]).
+    pub(super) fn build_unmeasured(
         map: &NormalMap,
         params: MixtureParams,
         progress: Option<&(dyn Fn(f32) + Sync)>,
@@ -149,6 +137,7 @@ impl BeckmannMixture {
                 params.sigma_min,
                 box_k,
                 None,
+                None,
             )),
             LobeStorage::Compact => Storage::Compact(CompactStorage::new(
                 compact_encode::build(nx, ny, &lobes, params.sigma_min, box_k),
@@ -164,13 +153,16 @@ impl BeckmannMixture {
     /// `params`, derives the lobe grid as [`BeckmannMixture::build`] does and checks the lobe count
     /// against it, then derives the storage exactly as the build does, except that the levels' merge
     /// errors are `errors` when given (one entry per level l ≥ 1; the loader checks their sizes and
-    /// range). The moments themselves are not checked here (the loader bounds them).
+    /// range), and the filtered mixture's chain and measured errors are `chain` when given (read
+    /// from a file, checked by the loader against this grid). The moments themselves are not
+    /// checked here (the loader bounds them).
     pub(super) fn from_moments(
         width: usize,
         height: usize,
         params: MixtureParams,
         lobes: Vec<[f32; 5]>,
         errors: Option<Vec<[Vec<f32>; N_RES]>>,
+        chain: Option<(GmmPyramid, Vec<f32>)>,
     ) -> Result<Self> {
         params.validate()?;
         crate::glint::surface::texel_count(width, height, width.saturating_mul(height))?;
@@ -184,15 +176,12 @@ impl BeckmannMixture {
             });
         }
         let box_k = box_sigmas(params.slope_tail);
-        let storage = FullStorage::new(nx, ny, lobes, params.sigma_min, box_k, errors);
-        Ok(Self::from_storage(
-            width,
-            height,
-            grid,
-            spacing,
-            params,
-            Storage::Full(storage),
-        ))
+        let (gmm, filtered_errors) = chain.unzip();
+        let storage = FullStorage::new(nx, ny, lobes, params.sigma_min, box_k, errors, gmm);
+        Ok(
+            Self::from_storage(width, height, grid, spacing, params, Storage::Full(storage))
+                .with_filtered_errors(filtered_errors.unwrap_or_default()),
+        )
     }
 
     /// A mixture of a map size, valid parameters, their lobe grid and spacing ([`lobe_grid`]) and
@@ -213,12 +202,19 @@ impl BeckmannMixture {
             storage,
             params,
             box_k: box_sigmas(params.slope_tail),
-            filtered_error: std::sync::OnceLock::new(),
+            filtered_error: Vec::new(),
         }
     }
 
-    /// The cell of the filtered mixture's measured errors (filled on first use, patch.rs).
-    pub(super) fn filtered_error_cell(&self) -> &std::sync::OnceLock<Vec<f32>> {
+    /// The mixture with its filtered mixture's measured errors (measured.rs measures them, a
+    /// loader reads them).
+    pub(super) fn with_filtered_errors(mut self, errors: Vec<f32>) -> Self {
+        self.filtered_error = errors;
+        self
+    }
+
+    /// The filtered mixture's measured errors ([`BeckmannMixture::filtered_mixture_errors`]).
+    pub(super) fn filtered_errors(&self) -> &[f32] {
         &self.filtered_error
     }
 

@@ -335,7 +335,7 @@ pub struct PatchOptions {
     /// ([`DEFAULT_FILTERED_AREA`]; `f32::INFINITY` never).
     pub filtered_area: f32,
     /// Largest measured TV between the filtered mixture and the full mixture at the footprint's
-    /// level ([`DEFAULT_FILTERED_TOLERANCE`]; measured per mixture on first use,
+    /// level ([`DEFAULT_FILTERED_TOLERANCE`]; measured per mixture by its build,
     /// src/glint/kernels/filtered_error.rs) at which the filtered mixture serves a footprint of at
     /// least `filtered_area`; above it the footprint is gathered (the level of detail and the
     /// cost cap `lod_lobes` decide). `f32::INFINITY` always serves it.

@@ -1,12 +1,15 @@
 //! Saving and loading a built [`BeckmannMixture`] (format: docs/format.md, kinds 2 and 5).
 //!
 //! Full storage (kind 2) stores the map size, the build parameters (with the seed kernel since format
-//! version 5; no per-query options: those are passed with each query), the lobes' moments (20 bytes per lobe) and the merge-error bounds of the
+//! version 5; no per-query options: those are passed with each query), the lobes' moments (20 bytes
+//! per lobe) and the merge-error bounds of the
 //! levels of detail (N_RES `f32` per node of every level l ≥ 1: 4 bytes per lobe; files of format
-//! version 2 do not hold them, and get them recomputed). The
+//! version 2 do not hold them, and get them recomputed), and since format version 6 the filtered
+//! mixture's chain with its residuals and measured errors (kernels/gmm_store.rs: 108 bytes per node
+//! of the levels ≥ 1, ~36 per lobe; older files get them derived and measured as a build does). The
 //! lobe blocks, the slope boxes' hierarchy, the moment mip chain and the levels' merged lobes are
 //! rebuilt on load by the same code as the build (`FullStorage::new`, O(lobes), parallel): this keeps
-//! files at 24 bytes per lobe and every query of a loaded mixture bit-identical to the built one.
+//! files at ~60 bytes per lobe and every query of a loaded mixture bit-identical to the built one.
 //! The merge errors are stored because their χ² bounds are most of the cost of a build's levels
 //! (recomputing them takes ~80 % of a build at 2048²); a loader checks only that each is a finite
 //! value in [0, 1] (the range of a total variation). They steer the level-of-detail choice and nothing else, so a
@@ -20,6 +23,7 @@ use super::params::{LobeStorage, MixtureParams, SeedKernel};
 use crate::Result;
 use crate::glint::MAX_SLOPE;
 use crate::glint::io::format::{self, Decoder, Kind, Stored};
+use crate::glint::kernels::gmm_store::{self, ChainBounds};
 use crate::glint::kernels::slope_tree::level_sizes;
 use std::io::{Read, Write};
 
@@ -65,6 +69,8 @@ impl BeckmannMixture {
                             (0..n).map(|i| std::array::from_fn::<f32, N_RES, _>(|r| l.error[r][i])),
                         )?;
                     }
+                    // The filtered mixture's chain and its measured errors (since version 6).
+                    gmm_store::save_chain(e, s.gmm(), self.filtered_mixture_errors())?;
                 }
                 Storage::Compact(s) => {
                     e.len(s.levels().len())?;
@@ -182,8 +188,29 @@ impl BeckmannMixture {
         } else {
             None
         };
+        // Format version 6 holds the filtered mixture's chain and measured errors; older files get
+        // them derived and measured, as a build does.
+        let chain = if d.version() >= 6 {
+            let bounds = ChainBounds {
+                mean: MEAN_BOUND,
+                second: m2,
+            };
+            Some(gmm_store::load_chain(&mut d, nx, ny, bounds)?)
+        } else {
+            None
+        };
         d.finish()?;
-        BeckmannMixture::from_moments(width, height, params, lobes, errors).map_err(refused)
+        let chain = chain
+            .map(|c| c.into_chain(nx, ny, params.sigma_min))
+            .transpose()?;
+        let measured = chain.is_some();
+        let mixture = BeckmannMixture::from_moments(width, height, params, lobes, errors, chain)
+            .map_err(refused)?;
+        Ok(if measured {
+            mixture
+        } else {
+            mixture.measured()
+        })
     }
 }
 

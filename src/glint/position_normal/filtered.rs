@@ -13,8 +13,8 @@
 //! 12 √det Σ_P in element units) whose level's measured TV to the exact element sum
 //! (src/glint/kernels/filtered_error.rs) is at most
 //! [`PatchOptions::filtered_tolerance`](super::PatchOptions::filtered_tolerance). The chain and the
-//! errors are built on the first footprint that asks (~20 ns per element for the chain, ~0.1-0.5 s
-//! per map for the errors) and kept; a renderer whose footprints stay small pays neither.
+//! errors are made by the build (~20 ns per element for the chain, ~0.1-0.5 s per map for the
+//! errors) and stored in files, so that a map holds no state filled on first use.
 
 use super::{PatchOptions, PositionNormalMap, SIGMA_H_PER_SPACING};
 use crate::glint::kernels::cut::{self, CutKernel, CutStats};
@@ -43,7 +43,7 @@ pub(super) fn footprint_in_elements(
 impl PositionNormalMap {
     /// Element k's slope marginal over its own position Gaussian, N(ñ_k, σ_h² J_k J_kᵀ + σ_r² I)
     /// (module docs), as a [`SlopeGaussian`].
-    fn element_marginal(&self, k: usize) -> SlopeGaussian {
+    pub(super) fn element_marginal(&self, k: usize) -> SlopeGaussian {
         let e = &self.elements[k];
         let sh = SIGMA_H_PER_SPACING * self.spacing;
         let j = Mat2::from_cols(Vec2::new(e[2], e[4]), Vec2::new(e[3], e[5])) * sh as f32;
@@ -64,45 +64,46 @@ impl PositionNormalMap {
         })
     }
 
-    /// The filtered-mixture chain over the elements, built on first use.
-    fn filtered_chain(&self) -> &GmmPyramid {
-        self.filtered.get_or_init(|| {
-            let [nx, ny] = self.grid;
-            GmmPyramid::build(nx, ny, |k| self.element_marginal(k), self.params.sigma_r)
-        })
+    /// The filtered-mixture chain over the elements.
+    pub(super) fn filtered_chain(&self) -> &GmmPyramid {
+        &self.filtered
     }
 
     /// The filtered mixture's measured TV to the exact element sum per level of its chain (index
-    /// l: footprints of 4^l elements; 1 where not measured, below the first measured level): what
-    /// [`PatchOptions::filtered_tolerance`] is compared with. Measured on first use (deterministic)
-    /// and kept; see src/glint/kernels/filtered_error.rs.
+    /// l: footprints of 4^l elements; 1 where not measured, below the first measured level; empty
+    /// on maps too small to measure any level): what [`PatchOptions::filtered_tolerance`] is
+    /// compared with. Measured by the build (deterministic) and stored in files; see
+    /// src/glint/kernels/filtered_error.rs.
     pub fn filtered_mixture_errors(&self) -> &[f32] {
-        self.filtered_error.get_or_init(|| {
-            let [nx, ny] = self.grid;
-            let full = PatchOptions {
-                max_query_texels: f32::INFINITY,
-                filtered_area: f32::INFINITY,
-                cut_nodes: 0,
-                ..PatchOptions::default()
-            };
-            let filtered = PatchOptions {
-                filtered_area: 0.0,
-                filtered_tolerance: f32::INFINITY,
-                ..full
-            };
-            filtered_error::errors_per_level(
-                self.filtered_chain().levels(),
-                (nx * ny) as f64,
-                [self.spacing, self.spacing],
-                (self.width, self.height),
-                |fp| {
-                    let exact = self.patch_with(fp, &full, None);
-                    let few = self.patch_with(fp, &filtered, None);
-                    few.is_filtered_mixture()
-                        .then(|| filtered_error::tv(&exact, &few))
-                },
-            )
-        })
+        &self.filtered_error
+    }
+
+    /// Measures [`PositionNormalMap::filtered_mixture_errors`] (the build's last step).
+    pub(super) fn measure_filtered_errors(&self) -> Vec<f32> {
+        let [nx, ny] = self.grid;
+        let full = PatchOptions {
+            max_query_texels: f32::INFINITY,
+            filtered_area: f32::INFINITY,
+            cut_nodes: 0,
+            ..PatchOptions::default()
+        };
+        let filtered = PatchOptions {
+            filtered_area: 0.0,
+            filtered_tolerance: f32::INFINITY,
+            ..full
+        };
+        filtered_error::errors_per_level(
+            self.filtered_chain().levels(),
+            (nx * ny) as f64,
+            [self.spacing, self.spacing],
+            (self.width, self.height),
+            |fp| {
+                let exact = self.patch_with(fp, &full, None);
+                let few = self.patch_with(fp, &filtered, None);
+                few.is_filtered_mixture()
+                    .then(|| filtered_error::tv(&exact, &few))
+            },
+        )
     }
 
     /// Whether `options` serve a footprint centred at `c` of `area` elements (as

@@ -33,7 +33,6 @@ use crate::glint::kernels::slope_tree::SlopeTree;
 use crate::glint::{Footprint, GlintNdf, GlintScratch, NormalMap};
 use glam::{Mat2, Vec2};
 use params::SIGMA_H_PER_SPACING;
-use std::sync::OnceLock;
 
 /// Memory held by a [`PositionNormalMap`], in bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -76,10 +75,10 @@ pub struct PositionNormalMap {
     elements: Vec<[f32; 6]>,
     tree: SlopeTree,
     params: PositionNormalParams,
-    /// The filtered mixture's chain (filtered.rs), built on the first footprint that needs it.
-    filtered: OnceLock<GmmPyramid>,
-    /// Its measured error per level, measured on first use.
-    filtered_error: OnceLock<Vec<f32>>,
+    /// The filtered mixture's chain (filtered.rs), built with the elements (or read from a file).
+    filtered: GmmPyramid,
+    /// Its measured error per level, measured by the build (or read from a file).
+    filtered_error: Vec<f32>,
 }
 
 /// The element grid (width, height) × sampling rate, at most 2³¹ elements.
@@ -114,18 +113,21 @@ impl PositionNormalMap {
         let grid = element_grid(width, height, &params)?;
         let spacing = 1.0 / params.sampling_rate as f64;
         let elements = build::elements(map, grid, spacing);
-        Ok(Self::assemble(width, height, grid, params, elements))
+        Ok(Self::assemble(width, height, grid, params, elements, None).measured())
     }
 
     /// The representation of stored parts (crate-private; see `store.rs`): validates `params`,
     /// derives the element grid as [`PositionNormalMap::build`] does and checks the element count
-    /// against it, then rebuilds the slope-box hierarchy exactly as the build does. The elements
+    /// against it, then rebuilds the slope-box hierarchy exactly as the build does; the filtered
+    /// mixture's chain and measured errors are `chain` when given (read from a file, checked
+    /// against the grid by the loader), else built and measured as the build does. The elements
     /// themselves are not checked here (the loader bounds them).
     pub(crate) fn from_parts(
         width: usize,
         height: usize,
         params: PositionNormalParams,
         elements: Vec<[f32; 6]>,
+        chain: Option<(GmmPyramid, Vec<f32>)>,
     ) -> Result<Self> {
         params.validate()?;
         crate::glint::surface::texel_count(width, height, width.saturating_mul(height))?;
@@ -137,16 +139,31 @@ impl PositionNormalMap {
                 reason: "the element count does not match the element grid of the map size and rate",
             });
         }
-        Ok(Self::assemble(width, height, grid, params, elements))
+        Ok(match chain {
+            Some((gmm, errors)) => {
+                let mut map = Self::assemble(width, height, grid, params, elements, Some(gmm));
+                map.filtered_error = errors;
+                map
+            }
+            None => Self::assemble(width, height, grid, params, elements, None).measured(),
+        })
     }
 
-    /// The derived parts (slope boxes and their hierarchy) of given elements.
+    /// The map with its filtered mixture's errors measured (filtered.rs).
+    fn measured(mut self) -> Self {
+        self.filtered_error = self.measure_filtered_errors();
+        self
+    }
+
+    /// The derived parts (slope boxes and their hierarchy, the filtered mixture's chain unless
+    /// given) of given elements; no measured errors yet.
     fn assemble(
         width: usize,
         height: usize,
         grid: [usize; 2],
         params: PositionNormalParams,
         elements: Vec<[f32; 6]>,
+        filtered: Option<GmmPyramid>,
     ) -> Self {
         let spacing = 1.0 / params.sampling_rate as f64;
         let sigma_h = SIGMA_H_PER_SPACING * spacing;
@@ -155,7 +172,7 @@ impl PositionNormalMap {
         let tree = SlopeTree::build_with(grid[0], grid[1], |k| {
             build::slope_box(&elements[k], sigma_h, &params)
         });
-        PositionNormalMap {
+        let mut map = PositionNormalMap {
             width,
             height,
             grid,
@@ -163,9 +180,19 @@ impl PositionNormalMap {
             elements,
             tree,
             params,
-            filtered: OnceLock::new(),
-            filtered_error: OnceLock::new(),
-        }
+            filtered: GmmPyramid::empty(),
+            filtered_error: Vec::new(),
+        };
+        let chain = filtered.unwrap_or_else(|| {
+            GmmPyramid::build(
+                grid[0],
+                grid[1],
+                |k| map.element_marginal(k),
+                params.sigma_r,
+            )
+        });
+        map.filtered = chain;
+        map
     }
 
     /// The parameters the representation was built with.
@@ -217,7 +244,7 @@ impl PositionNormalMap {
             elements: self.elements.len(),
             element_bytes: self.elements.len() * 24,
             hierarchy_bytes: self.tree.bytes(),
-            filtered_bytes: self.filtered.get().map_or(0, GmmPyramid::bytes),
+            filtered_bytes: self.filtered.bytes(),
         }
     }
 }
@@ -236,11 +263,5 @@ impl GlintNdf for PositionNormalMap {
         scratch: Option<&'a GlintScratch>,
     ) -> PositionNormalPatch<'a> {
         PositionNormalPatch::new(self, footprint, options, scratch)
-    }
-
-    /// Builds the filtered mixture's chain and measures its errors
-    /// ([`PositionNormalMap::filtered_mixture_errors`]).
-    fn prepare(&self) {
-        self.filtered_mixture_errors();
     }
 }

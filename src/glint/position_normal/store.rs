@@ -1,13 +1,17 @@
 //! Saving and loading a built [`PositionNormalMap`] (format: docs/format.md, kind 3).
 //!
-//! Stored: the map size, the build parameters (no per-query options) and the elements (slope and Jacobian, 24 bytes each).
-//! The slope boxes and their hierarchy are rebuilt on load by the same code as the build (O(elements)),
-//! so every query of a loaded map is bit-identical to the built one.
+//! Stored: the map size, the build parameters (no per-query options), the elements (slope and
+//! Jacobian, 24 bytes each) and, since format version 6, the filtered mixture's chain with its
+//! residuals and measured errors (kernels/gmm_store.rs, ~36 bytes per element; older files get them
+//! built and measured as a build does). The slope boxes and their hierarchy are rebuilt on load by
+//! the same code as the build (O(elements)), so every query of a loaded map is bit-identical to the
+//! built one.
 
 use super::{PositionNormalMap, PositionNormalParams};
 use crate::Result;
 use crate::glint::MAX_SLOPE;
 use crate::glint::io::format::{self, Decoder, Kind, Stored};
+use crate::glint::kernels::gmm_store::{self, ChainBounds};
 use std::io::{Read, Write};
 
 impl PositionNormalMap {
@@ -25,7 +29,9 @@ impl PositionNormalMap {
             e.put(p.sigma_r)?;
             e.put(p.weight_sigmas)?;
             e.put(p.slope_sigmas)?;
-            e.array(self.elements.iter().copied())
+            e.array(self.elements.iter().copied())?;
+            // The filtered mixture's chain and its measured errors (since version 6).
+            gmm_store::save_chain(e, self.filtered_chain(), self.filtered_mixture_errors())
         })
     }
 
@@ -74,8 +80,26 @@ impl PositionNormalMap {
                     if c < 2 { (-s, s) } else { (-j, j) }
                 },
             )?;
+        // Format version 6 holds the filtered mixture's chain and measured errors; older files get
+        // them built and measured, as a build does. The chain's components are element marginals
+        // N(ñ_i, σ_h² J_i J_iᵀ + σ_r² I) and their moment-matched merges, whose raw second moments
+        // average those of the marginals: below s² + 2 (σ_h j)² + σ_r² (σ_h j ≤ 1.7 · MAX_SLOPE for
+        // the bounds above); twice that to spare.
+        let chain = if d.version() >= 6 {
+            let sh_j = 1.7 * MAX_SLOPE;
+            let bounds = ChainBounds {
+                mean: s,
+                second: 2.0 * (s * s + 2.0 * sh_j * sh_j + params.sigma_r * params.sigma_r),
+            };
+            Some(gmm_store::load_chain(&mut d, nx, ny, bounds)?)
+        } else {
+            None
+        };
         d.finish()?;
-        PositionNormalMap::from_parts(width, height, params, elements).map_err(refused)
+        let chain = chain
+            .map(|c| c.into_chain(nx, ny, params.sigma_r))
+            .transpose()?;
+        PositionNormalMap::from_parts(width, height, params, elements, chain).map_err(refused)
     }
 }
 

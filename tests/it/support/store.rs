@@ -119,9 +119,9 @@ pub fn is_flip_error(
     match k {
         // One damaged byte of the magic (7 of 8 still right).
         0..8 => matches!(e, Error::CorruptHeader { field: "magic", .. }),
-        // A flip that lands on another version this build reads (5 ^ 0x01 = 4): the payload is
-        // read in that version's layout, and its checks or the checksum catch the damage.
-        8..12 if (2..=5).contains(&word(8)) => payload_error,
+        // A flip that lands on another version this build reads: the payload is read in that
+        // version's layout, and its checks or the checksum catch the damage.
+        8..12 if (2..=6).contains(&word(8)) => payload_error,
         8..12 => matches!(
             e,
             Error::CorruptHeader {
@@ -157,9 +157,77 @@ fn with_fields(file: &[u8], offset: usize, fields: &[u8], version: u32) -> Vec<u
     reseal(f)
 }
 
-/// A mixture's file (full or compact, format version 5, Gaussian seed kernel) as version 4 wrote
-/// it: without the seed kernel's code after `slope_tail` (docs/format.md), re-sealed.
+/// Reads the `u64` at byte `at`.
+fn u64_at(file: &[u8], at: usize) -> usize {
+    u64::from_le_bytes(file[at..at + 8].try_into().unwrap()) as usize
+}
+
+/// The end of a filtered-mixture chain written at byte `start` (docs/format.md, "The filtered
+/// mixture in a file"): its level count, per level a node count and 108-byte nodes, then the error
+/// count and 4-byte errors.
+fn chain_end(file: &[u8], start: usize) -> usize {
+    let mut at = start + 8;
+    for _ in 0..u64_at(file, start) {
+        at += 8 + 108 * u64_at(file, at);
+    }
+    at + 8 + 4 * u64_at(file, at)
+}
+
+/// `file` without its bytes [start, end), the header's version set to `version` and its payload
+/// length shrunk, re-sealed.
+fn without(file: &[u8], start: usize, end: usize, version: u32) -> Vec<u8> {
+    let mut f = file[..start].to_vec();
+    f.extend_from_slice(&file[end..]);
+    f[8..12].copy_from_slice(&version.to_le_bytes());
+    let payload = u64_at(&f, 16) - (end - start);
+    f[16..24].copy_from_slice(&(payload as u64).to_le_bytes());
+    reseal(f)
+}
+
+/// A mixture's file (full or compact, format version 6) as version 5 wrote it: a full mixture
+/// without the filtered mixture's chain and errors after the merge errors (docs/format.md); a
+/// compact one (whose payload did not change) with the version alone set. Re-sealed.
+pub fn mixture_as_version_5(file: &[u8]) -> Vec<u8> {
+    let word = |at: usize| u32::from_le_bytes(file[at..at + 4].try_into().unwrap());
+    if word(8) != 6 {
+        return file.to_vec();
+    }
+    let kind = word(12);
+    if kind == 5 {
+        let mut f = file.to_vec();
+        f[8..12].copy_from_slice(&5u32.to_le_bytes());
+        return reseal(f);
+    }
+    // The merge errors: a level count, then per level a count of records of N_RES = 3 `f32`.
+    let mut at = at::LOBES + 20 * u64_at(file, at::LOBE_COUNT);
+    let levels = u64_at(file, at);
+    at += 8;
+    for _ in 0..levels {
+        at += 8 + 12 * u64_at(file, at);
+    }
+    without(file, at, chain_end(file, at), 5)
+}
+
+/// A position-normal map's file (format version 6) as version 5 wrote it: without the filtered
+/// mixture's chain and errors after the elements, re-sealed.
+pub fn position_normal_as_version_5(file: &[u8]) -> Vec<u8> {
+    // Header 24, width, height, sampling_rate (u64), three f32, the element count, 24-byte elements.
+    let count = 24 + 24 + 12;
+    let start = count + 8 + 24 * u64_at(file, count);
+    without(file, start, chain_end(file, start), 5)
+}
+
+/// A bin map's file (format version 6) as version 5 wrote it: without the `errors` moment-masking
+/// errors (and their count) that end its payload, re-sealed.
+pub fn bin_map_as_version_5(file: &[u8], errors: usize) -> Vec<u8> {
+    let end = file.len() - 8;
+    without(file, end - 8 - 4 * errors, end, 5)
+}
+
+/// A mixture's file (full or compact, format version 6 or 5, Gaussian seed kernel) as version 4
+/// wrote it: without the seed kernel's code after `slope_tail` (docs/format.md), re-sealed.
 pub fn mixture_as_version_4(file: &[u8]) -> Vec<u8> {
+    let file = &mixture_as_version_5(file)[..];
     assert_eq!(
         &file[at::SEED..at::SEED + 4],
         &0u32.to_le_bytes(),
@@ -173,7 +241,7 @@ pub fn mixture_as_version_4(file: &[u8]) -> Vec<u8> {
     reseal(f)
 }
 
-/// A mixture's file (full or compact, format version 5, Gaussian seed kernel) as version 3 wrote
+/// A mixture's file (full or compact, format version 6, Gaussian seed kernel) as version 3 wrote
 /// it: no seed kernel, and the patch options `masking` (`u32`) and `lod_lobes` (`f32`) stored after
 /// `slope_tail` (docs/format.md).
 pub fn mixture_as_version_3(file: &[u8], masking: u32, lod_lobes: f32) -> Vec<u8> {
@@ -182,14 +250,15 @@ pub fn mixture_as_version_3(file: &[u8], masking: u32, lod_lobes: f32) -> Vec<u8
     with_fields(&mixture_as_version_4(file), at::SEED, &fields, 3)
 }
 
-/// A position-normal map's file (format version 5) as version 3 wrote it: the footprint cap
-/// `max_query_texels` (`f32`) stored after `slope_sigmas` (docs/format.md).
+/// A position-normal map's file (format version 6) as version 3 wrote it: no filtered mixture, and
+/// the footprint cap `max_query_texels` (`f32`) stored after `slope_sigmas` (docs/format.md).
 pub fn position_normal_as_version_3(file: &[u8], max_query_texels: f32) -> Vec<u8> {
     // Header 24, width, height, sampling_rate (u64), sigma_r, weight_sigmas, slope_sigmas (f32).
-    with_fields(file, 24 + 24 + 12, &max_query_texels.to_le_bytes(), 3)
+    let file = position_normal_as_version_5(file);
+    with_fields(&file, 24 + 24 + 12, &max_query_texels.to_le_bytes(), 3)
 }
 
-/// A full mixture's file (format version 5, Gaussian seed kernel) as version 2 wrote it: no seed
+/// A full mixture's file (format version 6, Gaussian seed kernel) as version 2 wrote it: no seed
 /// kernel, the default patch options stored after `slope_tail` (masking 0, lod_lobes 16384), the
 /// payload cut after the lobes (no merge errors), the header's version and payload length set,
 /// re-sealed.
@@ -208,7 +277,7 @@ pub fn as_version_2(file: &[u8]) -> Vec<u8> {
     with_fields(&f, at::SEED, &fields, 2)
 }
 
-/// Offsets in a mixture file of format version 5 (docs/format.md): header 24, width 24, height 32,
+/// Offsets in a mixture file of format version 6 (as in version 5; docs/format.md): header 24, width 24, height 32,
 /// spacing 40, sigma_min 44, samples 48, kernel_sigmas 56, weight_sigmas 60, slope_tail 64, seed
 /// kernel 68, lobe count 72, lobes 80.
 pub mod at {
