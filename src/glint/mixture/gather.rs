@@ -1,5 +1,5 @@
 //! The per-footprint work of a patch (done once, when it is made): the footprint's Gaussian in lobe
-//! units, the choice of the level of detail, and the gather at that level: the rectangle of nodes
+//! units, the level of detail's error pass and the gather at a level (choice.rs chooses the form): the rectangle of nodes
 //! within `weight_sigmas` of the effective Gaussian k_i ∗ k_P, their normalised weights W_i (stored
 //! densely per "slot" of the rectangle, with a cdf for sampling, and again in the lobe blocks'
 //! layout), the patch mean slope and covariance and the level's error bound. An axis of the
@@ -11,16 +11,10 @@
 
 use super::blocks::SIDE;
 use super::lanes::LANES;
-use super::levels::resolution_index;
 use super::params::{PatchOptions, SeedKernel};
 use super::storage::{LevelView, LobeStore};
-use super::sub_texel;
 use crate::glint::Footprint;
-use crate::glint::kernels::cut::{self, CutKernel, CutStats};
-use crate::glint::kernels::filtered_error;
-use crate::glint::kernels::lobe_set::{Few, LobeSet};
-use crate::glint::scratch::{Home, Lent};
-use crate::ndf::SlopeGaussian;
+use crate::glint::scratch::Lent;
 use glam::Vec2;
 
 /// The slots of one axis of the weight rectangle.
@@ -175,7 +169,7 @@ pub(super) struct Gathered<'a> {
 }
 
 /// The effective Gaussian k_i ∗ k_P in lobe units: centre and inverse covariance.
-struct Effective {
+pub(super) struct Effective {
     c: [f64; 2],
     /// Σ_eff = [[a, b], [b, d]].
     cov: [f64; 3],
@@ -245,7 +239,7 @@ impl Effective {
     /// a node spans along each axis, so a node's weight is the moment-matched Gaussian of the sum of
     /// its lobes' weights (exact at l = 0, where the formula is the level-0 effective Gaussian
     /// k_i ∗ k_P).
-    fn at_level(fp: &FootprintLobes, l: usize) -> Effective {
+    pub(super) fn at_level(fp: &FootprintLobes, l: usize) -> Effective {
         let n2 = (1u64 << (2 * l)) as f64;
         let k2 = fp.seed.0.weight_variance() + (n2 - 1.0) / 12.0;
         let scale = 1.0 / (1u64 << l) as f64;
@@ -292,7 +286,7 @@ impl Effective {
 ///   texels, docs/results.md) among the built levels; 0 when the tolerance is 0;
 /// - finest: the smallest l whose node count (area / 4^l) is within the cost cap `lod_lobes`;
 ///   if that exceeds the built levels, the filtered lobe.
-fn level_range<S: LobeStore>(
+pub(super) fn level_range<S: LobeStore>(
     store: &S,
     fp: &FootprintLobes,
     area: f64,
@@ -349,7 +343,7 @@ fn slot_weights<L: LevelView>(
 /// Σ W_n e_r(n) of the level over the footprint at the resolution of index `res` (what
 /// [`gather`] reports as `lod_error`), from the weights alone: the error-only pass of the
 /// level-of-detail search.
-fn lod_error_of<L: LevelView>(
+pub(super) fn lod_error_of<L: LevelView>(
     weight_sigmas: f32,
     lv: L,
     eff: &Effective,
@@ -372,7 +366,7 @@ fn lod_error_of<L: LevelView>(
 /// The normalised weights of the level's nodes over the footprint (`eff`), their cdf and block
 /// layout, the patch mean slope and covariance and the level-of-detail bound at the resolution of
 /// index `res`, in `bufs`.
-fn gather<'b, L: LevelView>(
+pub(super) fn gather<'b, L: LevelView>(
     weight_sigmas: f32,
     lv: L,
     eff: &Effective,
@@ -475,156 +469,6 @@ fn block_weights(axes: &[AxisSlots; 2], bufs: &mut SlotBuffers) -> ([BlockRect; 
         }
     }
     (rects, n)
-}
-
-/// What a patch holds of its footprint: the level it reads, the filtered lobe of the footprint
-/// (\[Chermain2019\] §4.2.2) and the gathered nodes (`None` when the level of detail serves the
-/// filtered lobe alone).
-pub(super) struct Footprinted<'a, L> {
-    pub level: L,
-    pub filtered: SlopeGaussian,
-    pub gathered: Option<Gathered<'a>>,
-    /// What serves the patch when `gathered` is `None`: the filtered lobe, the sub-texel limit
-    /// lobe (sub_texel.rs) or the filtered mixture (gmm.rs), with its error (the filtered
-    /// mixture's measured TV to the full mixture, kernels/filtered_error.rs; 1 for the single lobes, which have
-    /// none).
-    pub set: Option<(Few<'a>, SetKind, f32)>,
-    /// What the cut did, when a cut of the hierarchy serves the patch.
-    pub cut: Option<CutStats>,
-}
-
-/// Which few-lobe patch a [`LobeSet`] is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum SetKind {
-    /// The footprint's moment-matched lobe (\[Chermain2019\] §4.2.2).
-    FilteredLobe,
-    /// The sub-texel limit lobe (sub_texel.rs).
-    SubTexel,
-    /// The filtered mixture (gmm.rs).
-    FilteredMixture,
-    /// A cut of the filtered-mixture hierarchy (cut.rs).
-    Cut,
-}
-
-/// The per-footprint work of a patch of `store` (module docs): below `options.sub_texel_area` the
-/// sub-texel limit lobe; from `options.filtered_area`, where the filtered mixture's measured error
-/// meets `options.filtered_tolerance`, the filtered mixture (its lobes lent by `sets`); otherwise
-/// from `options.cut_area` (when `options.cut_nodes` > 0 and the storage holds the hierarchy) a cut
-/// of the filtered-mixture hierarchy (kernels/cut.rs, its lobes lent by `sets`); otherwise the
-/// filtered lobe, the level of detail (the coarsest whose weighted merge-error bound meets
-/// `options.lod_tolerance`, moved coarser by the cost cap, see [`level_range`]; past the cap the
-/// filtered mixture, or the filtered lobe without one) and the gather there, its buffers lent by
-/// `slots`.
-/// `weight_sigmas` and `sigma_min` are the mixture's parameters,
-/// `filtered_error` the filtered mixture's measured error per level (kernels/filtered_error.rs).
-pub(super) fn footprint_patch<'a, S: LobeStore>(
-    store: &'a S,
-    fp: &FootprintLobes,
-    options: &PatchOptions,
-    [weight_sigmas, sigma_min]: [f32; 2],
-    filtered_error: &[f32],
-    slots: Option<Home<'a, SlotBuffers>>,
-    sets: Option<Home<'a, LobeSet>>,
-) -> Footprinted<'a, S::Level<'a>> {
-    let area = fp.area();
-    if area < options.sub_texel_area as f64 {
-        let lobe = sub_texel::limit_lobe(store, fp.c, fp.cov, fp.seed(), sigma_min);
-        return Footprinted {
-            level: store.level(0),
-            filtered: lobe,
-            gathered: None,
-            set: Some((Few::One(lobe), SetKind::SubTexel, 1.0)),
-            cut: None,
-        };
-    }
-    let lod = 0.5 * area.max(1e-300).log2();
-    let filtered = SlopeGaussian::from_moments(store.filtered_moments(fp.c, lod), sigma_min);
-    // The filtered mixture where the storage has one (with its measured error at this level),
-    // else the filtered lobe.
-    let error = filtered_error::error_at(filtered_error, lod);
-    let few = |sets: Option<Home<'a, LobeSet>>| {
-        let mut set = Lent::new(sets);
-        if store.filtered_mixture(fp.c, lod, &mut set) && set.len() > 0 {
-            (Few::Set(set), SetKind::FilteredMixture, error)
-        } else {
-            (Few::One(filtered), SetKind::FilteredLobe, 1.0)
-        }
-    };
-    let tolerance = options.filtered_tolerance;
-    if area >= options.filtered_area as f64 && (error <= tolerance || tolerance == f32::INFINITY) {
-        return Footprinted {
-            level: store.level(0),
-            filtered,
-            gathered: None,
-            set: Some(few(sets)),
-            cut: None,
-        };
-    }
-    // A cut of the hierarchy where the filtered mixture does not serve and the gather would cost
-    // more than the cut (full storage).
-    if options.cut_nodes > 0
-        && area >= options.cut_area as f64
-        && let Some(hierarchy) = store.hierarchy()
-    {
-        let k2 = fp.seed().0.weight_variance();
-        let kernel = CutKernel {
-            c: fp.c,
-            s: [fp.cov[0] + k2, fp.cov[1], fp.cov[2] + k2],
-            weight_sigmas: weight_sigmas as f64,
-        };
-        let mut set = Lent::new(sets);
-        let level0 = store.level(0);
-        let stats = cut::cut(
-            hierarchy,
-            |k| level0.lobe(k),
-            kernel,
-            options.cut_tolerance,
-            options.cut_nodes as usize,
-            &mut set,
-        );
-        return Footprinted {
-            level: store.level(0),
-            filtered,
-            gathered: None,
-            set: Some((Few::Set(set), SetKind::Cut, stats.max_error)),
-            cut: Some(stats),
-        };
-    }
-    let res = resolution_index(options.lod_resolution);
-    let Some((finest, coarsest)) = level_range(store, fp, area, options) else {
-        return Footprinted {
-            level: store.level(0),
-            filtered,
-            gathered: None,
-            set: Some(few(sets)),
-            cut: None,
-        };
-    };
-    let mut bufs = Lent::new(slots);
-    // From the finest allowed level up while the next level's Σ W_n e(n) meets the tolerance (an
-    // error-only pass: weights, no moments, no block layout), then one gather at the level chosen.
-    // The bound grows with the level (a node's e(n) includes the mean of its children's; up to the
-    // per-level weight approximation), so this stops where a coarse-to-fine search would; a
-    // footprint that merges nothing pays one error pass at level finest + 1 (a quarter of the
-    // nodes) instead of a gather per level.
-    let mut l = finest;
-    while l < coarsest {
-        let eff = Effective::at_level(fp, l + 1);
-        let e = lod_error_of(weight_sigmas, store.level(l + 1), &eff, res, &mut bufs);
-        if e > options.lod_tolerance as f64 {
-            break;
-        }
-        l += 1;
-    }
-    let level = store.level(l);
-    let eff = Effective::at_level(fp, l);
-    Footprinted {
-        level,
-        filtered,
-        gathered: Some(gather(weight_sigmas, level, &eff, res, bufs)),
-        set: None,
-        cut: None,
-    }
 }
 
 #[cfg(test)]

@@ -29,7 +29,7 @@
 //! caps it for well-separated children. Both are upper bounds; docs/mixture.md ("Levels of detail
 //! chosen by error") compares the patch-level bound with the measured TV. A patch made of level-l nodes with weights W_n has
 //! TV(Σ W_n G_n, Σ W_n M_n) ≤ Σ W_n e(n) (convexity), which is what the patch compares with its
-//! tolerance (src/glint/mixture/gather.rs).
+//! tolerance (src/glint/mixture/choice.rs).
 //!
 //! **At a slope resolution r.** The same bound holds for the lobes convolved with an isotropic
 //! Gaussian N(0, r² I) in slope space: convolution adds r² I to every covariance, the convolved

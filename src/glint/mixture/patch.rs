@@ -7,9 +7,10 @@
 //! loop over blocks, and runs the block pass (passes.rs) compiled for that pair.
 
 use super::blocks;
+use super::choice::{SetKind, footprint_patch};
 use super::compact::CompactView;
 use super::full::FullLevel;
-use super::gather::{FootprintLobes, Gathered, SetKind, SlotBuffers, footprint_patch};
+use super::gather::{FootprintLobes, Gathered, SlotBuffers};
 use super::model::{BeckmannMixture, Storage};
 use super::params::{MaskingMode, PatchOptions};
 use super::passes::{SumP22, UntruncatedSum, VisiblePick, VisibleSum};
