@@ -270,7 +270,7 @@ fn main() {
                 |f| PositionNormalMap::load(&mut &f[..]).unwrap(),
                 |m| {
                     let b = m.memory();
-                    b.element_bytes + b.hierarchy_bytes
+                    b.element_bytes + b.hierarchy_bytes + b.filtered_bytes
                 },
             )
         }),

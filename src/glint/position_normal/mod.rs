@@ -43,8 +43,8 @@ pub struct PositionNormalMemory {
     pub element_bytes: usize,
     /// The slope-box quadtree (levels ≥ 1, 16 bytes per node).
     pub hierarchy_bytes: usize,
-    /// The filtered mixture's chain (96 bytes per node of levels ≥ 1, ≤ 32 bytes per element),
-    /// 0 until a footprint first needs it.
+    /// The filtered mixture's chain, built with the map (108 bytes per node of levels ≥ 1 with its
+    /// residual, ≤ 36 bytes per element).
     pub filtered_bytes: usize,
 }
 
