@@ -12,7 +12,7 @@
 
 use std::any::Any;
 use std::marker::PhantomData;
-use std::sync::{Mutex, OnceLock};
+use std::sync::Mutex;
 
 /// Reusable buffers for the patches of every glint model (see the module docs).
 ///
@@ -106,74 +106,6 @@ impl<T: Default + Send + 'static> Home<'_, T> {
     /// Puts `buffer` back into the pool.
     pub(crate) fn give(self, buffer: T) {
         self.scratch.with_pool(|pool| pool.push(buffer));
-    }
-}
-
-/// Buffers `T` lent to one patch: taken from the caller's scratch (or fresh) at construction,
-/// filled on first use through a shared reference, given back to the scratch when the patch drops.
-/// Cloning a patch clones the filled buffers and detaches the clone from the scratch.
-pub(crate) struct Loan<'a, T: Default + Send + 'static> {
-    home: Option<Home<'a, T>>,
-    /// The empty buffers (with their capacity) until the first use.
-    spare: Mutex<T>,
-    filled: OnceLock<T>,
-}
-
-impl<'a, T: Default + Send + 'static> Loan<'a, T> {
-    /// Takes buffers from `home` (if any) for the patch's lifetime.
-    pub(crate) fn new(home: Option<Home<'a, T>>) -> Self {
-        let spare = home.map(Home::take).unwrap_or_default();
-        Loan {
-            home,
-            spare: Mutex::new(spare),
-            filled: OnceLock::new(),
-        }
-    }
-
-    /// The filled buffers; `fill` receives the lent (stale, to be cleared) buffers on the first call.
-    #[inline]
-    pub(crate) fn get_or_init(&self, fill: impl FnOnce(T) -> T) -> &T {
-        self.filled.get_or_init(|| {
-            let spare = match self.spare.lock() {
-                Ok(mut g) => std::mem::take(&mut *g),
-                Err(poisoned) => std::mem::take(&mut *poisoned.into_inner()),
-            };
-            fill(spare)
-        })
-    }
-}
-
-impl<T: Default + Send + 'static> Drop for Loan<'_, T> {
-    fn drop(&mut self) {
-        if let Some(home) = self.home.take() {
-            home.give(match self.filled.take() {
-                Some(t) => t,
-                None => std::mem::take(self.spare.get_mut().unwrap_or_else(|p| p.into_inner())),
-            });
-        }
-    }
-}
-
-impl<T: Default + Send + 'static + Clone> Clone for Loan<'_, T> {
-    fn clone(&self) -> Self {
-        let filled = OnceLock::new();
-        if let Some(t) = self.filled.get() {
-            let _ = filled.set(t.clone());
-        }
-        Loan {
-            home: None,
-            spare: Mutex::new(T::default()),
-            filled,
-        }
-    }
-}
-
-impl<T: Default + Send + 'static + std::fmt::Debug> std::fmt::Debug for Loan<'_, T> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Loan")
-            .field("lent", &self.home.is_some())
-            .field("filled", &self.filled.get())
-            .finish()
     }
 }
 

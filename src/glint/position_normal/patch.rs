@@ -19,7 +19,7 @@ use crate::glint::kernels::cut::CutStats;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::kernels::slope_tree::contains;
 use crate::glint::kernels::view_memo::ViewMemo;
-use crate::glint::scratch::{Lent, Loan};
+use crate::glint::scratch::Lent;
 use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
@@ -83,9 +83,9 @@ pub struct PositionNormalPatch<'a> {
     mean_slope: Vec2,
     moments: [f32; 5],
     moments_lobe: SlopeGaussian,
-    /// Built on the first call that needs every element (masking, samplers, densities), in buffers
-    /// lent by the caller's scratch if any.
-    slots: Loan<'a, Slots>,
+    /// Every kept element's weight and lobe (masking, samplers, densities), built with the patch in
+    /// buffers lent by the caller's scratch if any; empty when a few-lobe set serves.
+    slots: Lent<'a, Slots>,
     /// The filtered mixture or a cut when one serves the footprint ([`Few::None`] for the element
     /// sum).
     few: Few<'a>,
@@ -162,7 +162,7 @@ impl<'a> PositionNormalPatch<'a> {
             mean_slope: Vec2::new(moments[0], moments[1]),
             moments,
             moments_lobe: SlopeGaussian::from_moments(moments, map.params.sigma_r),
-            slots: Loan::new(None),
+            slots: Lent::new(None),
             few: Few::Set(set),
             cut,
             view: ViewMemo::default(),
@@ -196,6 +196,18 @@ impl<'a> PositionNormalPatch<'a> {
         let mut total = 0.0f64;
         let mut count = 0usize;
         let mut acc = [0.0f64; 5];
+        // One pass: the totals and moments, and every kept element's weight and lobe (normalised
+        // below) for the masking terms, the samplers and the densities.
+        let mut slots = Lent::new(scratch.map(|s| s.home::<Slots>()));
+        let Slots {
+            weights,
+            cdf,
+            lobes,
+        } = &mut *slots;
+        weights.clear();
+        lobes.clear();
+        cdf.clear();
+        let sigma_r = map.params.sigma_r;
         Self::for_each_kept(map, &geo, rect, |w, mean, cov| {
             total += w;
             count += 1;
@@ -204,9 +216,17 @@ impl<'a> PositionNormalPatch<'a> {
             acc[2] += w * (cov[0] + mean[0] * mean[0]);
             acc[3] += w * (cov[2] + mean[1] * mean[1]);
             acc[4] += w * (cov[1] + mean[0] * mean[1]);
+            weights.push(w);
+            lobes.push(lobe_of(mean, cov, sigma_r));
         });
         // total ≥ the nearest element's weight ≥ e^{−1.39} (weight_sigmas ≥ 2 keeps it).
         let inv_total = if total > 0.0 { 1.0 / total } else { 0.0 };
+        let mut sum = 0.0;
+        for w in weights.iter_mut() {
+            *w *= inv_total;
+            sum += *w;
+            cdf.push(sum);
+        }
         let moments = acc.map(|v| (v * inv_total) as f32);
         let moments_lobe = SlopeGaussian::from_moments(moments, map.params.sigma_r);
         PositionNormalPatch {
@@ -218,7 +238,7 @@ impl<'a> PositionNormalPatch<'a> {
             mean_slope: Vec2::new(moments[0], moments[1]),
             moments,
             moments_lobe,
-            slots: Loan::new(scratch.map(|s| s.home())),
+            slots,
             few: Few::None,
             cut: None,
             view: ViewMemo::default(),
@@ -287,26 +307,7 @@ impl<'a> PositionNormalPatch<'a> {
     }
 
     fn slots(&self) -> &Slots {
-        self.slots.get_or_init(|mut slots| {
-            let Slots {
-                weights,
-                cdf,
-                lobes,
-            } = &mut slots;
-            weights.clear();
-            lobes.clear();
-            cdf.clear();
-            Self::for_each_kept(self.map, &self.geo, self.rect, |w, mean, cov| {
-                weights.push(w * self.inv_total);
-                lobes.push(lobe_of(mean, cov, self.map.params.sigma_r));
-            });
-            let mut acc = 0.0;
-            cdf.extend(weights.iter().map(|w| {
-                acc += w;
-                acc
-            }));
-            slots
-        })
+        &self.slots
     }
 
     /// D_P(m) and the number of elements whose contribution was evaluated.
