@@ -151,23 +151,32 @@
 //!
 //! Any of them as one run-time type: [`Material`] (module [`material`]).
 
+#![cfg_attr(not(feature = "std"), no_std)]
+
 pub mod bxdf;
 mod error;
+#[cfg(not(feature = "std"))]
+mod float;
 pub mod frame;
 pub mod fresnel;
+#[cfg(feature = "std")]
 pub mod glint;
+#[cfg(feature = "std")]
 pub mod material;
 mod math;
 pub mod ndf;
 pub mod warp;
 
+#[cfg(feature = "std")]
+pub use bxdf::LayeredBrdf;
 pub use bxdf::{
-    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet,
-    NormalMapTilt, OriginalPhong, Phong, PhongNormalization, ShadingNormal, SpecularReflection,
+    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, MicrofacetBrdf, NormalMapMicrofacet, NormalMapTilt,
+    OriginalPhong, Phong, PhongNormalization, ShadingNormal, SpecularReflection,
 };
 pub use error::{Error, Result};
 pub use fresnel::Fresnel;
 pub use glam::{Mat2, Vec2, Vec3};
+#[cfg(feature = "std")]
 pub use material::{Bsdf, GlintMaterial, Material};
 pub use ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
 
