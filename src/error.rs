@@ -6,6 +6,9 @@ use std::path::PathBuf;
 /// Everything that can go wrong when building a model or loading data.
 ///
 /// Evaluation (`d`, `eval`, `pdf`, `sample`, …) never returns an error: degenerate input gives 0 / `None`.
+///
+/// The variants that hold a `String`, a path or an `io::Error` (files, decoding, texels) exist with
+/// the `std` feature only; the analytic core raises none of them.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
