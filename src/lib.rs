@@ -174,7 +174,7 @@
 
 pub mod bxdf;
 mod error;
-#[cfg(not(feature = "std"))]
+#[cfg(any(not(feature = "std"), test))]
 mod float;
 pub mod frame;
 pub mod fresnel;

@@ -73,8 +73,8 @@ impl TabulatedAlbedo for Beckmann {
 }
 
 /// The directional albedo E(wo) and E_avg the compensation reads: the isotropic table at α, or the
-/// anisotropic table's slice at (αx, αy) (1.2 kB, boxed so that isotropic materials stay small).
-// Without std the slice is inline: there is no heap to box it into.
+/// anisotropic table's slice at (αx, αy) (1.2 kB; with `std` boxed so that isotropic materials stay
+/// small, without it inline, for there is no heap).
 #[cfg_attr(not(feature = "std"), allow(clippy::large_enum_variant))]
 #[derive(Clone, Debug)]
 enum Albedo {
@@ -82,8 +82,8 @@ enum Albedo {
     Anisotropic(SliceStorage),
 }
 
-/// Where the anisotropic slice lives: on the heap with `std`, inline without it (the core does not
-/// allocate; the BRDF is then 1.2 kB larger).
+/// Where the anisotropic slice lives: on the heap with `std`, inline without it (the `no_std` core
+/// does not allocate; the BRDF is then 1.2 kB larger).
 #[cfg(feature = "std")]
 type SliceStorage = Box<AnisotropicAlbedo>;
 #[cfg(not(feature = "std"))]
