@@ -171,6 +171,9 @@
 //! `io::Error`).
 
 #![cfg_attr(not(feature = "std"), no_std)]
+// The docs describe the whole crate; without `std` their links to the glint layer, `material` and
+// `LayeredBrdf` have no target (CI checks every link in the default build).
+#![cfg_attr(not(feature = "std"), allow(rustdoc::broken_intra_doc_links))]
 
 pub mod bxdf;
 mod error;
