@@ -10,7 +10,8 @@
 //! slower on x86-64 Linux: glibc picks FMA variants of `expf`,
 //! `logf` and `sincosf` at load time (≈ 3.5–4 ns per call here against 6–7 ns for the inlined
 //! SSE2 polynomials, whose Horner chains cannot use FMA without `target-cpu` flags). Only `atan2`
-//! is replaced, by [`atan2_pos`], where an approximation is enough (≈ 4 ns against 12 ns).
+//! is replaced, by [`atan2_pos`], where an approximation is enough (≈ 4 ns against 12 ns). Without
+//! the `std` feature they are libm's (`src/float.rs`).
 
 // Coefficients are kept exactly as published; f32 rounds them.
 #![allow(clippy::excessive_precision)]
