@@ -1,10 +1,14 @@
 //! The crate's one error type. Errors happen only at construction and I/O; evaluation never fails.
 
+#[cfg(feature = "std")]
 use std::path::PathBuf;
 
 /// Everything that can go wrong when building a model or loading data.
 ///
 /// Evaluation (`d`, `eval`, `pdf`, `sample`, …) never returns an error: degenerate input gives 0 / `None`.
+///
+/// The variants that hold a `String`, a path or an `io::Error` (files, decoding, texels) exist with
+/// the `std` feature only; the analytic core raises none of them.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
@@ -38,6 +42,7 @@ pub enum Error {
         /// Why it is rejected.
         reason: &'static str,
     },
+    #[cfg(feature = "std")]
     /// One texel of a normal map / height field holds unusable data.
     #[error("{source_name}: texel ({x}, {y}): {reason}")]
     InvalidTexel {
@@ -50,6 +55,7 @@ pub enum Error {
         /// What is wrong with it.
         reason: String,
     },
+    #[cfg(feature = "std")]
     /// A file could not be read.
     #[error("cannot read {path}: {source}")]
     Io {
@@ -58,6 +64,7 @@ pub enum Error {
         /// The underlying error.
         source: std::io::Error,
     },
+    #[cfg(feature = "std")]
     /// A file was read but could not be decoded as a usable image.
     #[error("cannot decode image {path}: {reason}")]
     Image {
@@ -66,6 +73,7 @@ pub enum Error {
         /// What went wrong.
         reason: String,
     },
+    #[cfg(feature = "std")]
     /// A decoded normal map is implausible as a whole: most of its vectors are far from unit length
     /// or below the horizon (usually a file decoded with the wrong encoding), or the encoding could
     /// not be detected.
@@ -93,6 +101,7 @@ pub enum Error {
         /// The newest version this build reads (the one it writes).
         supported: u32,
     },
+    #[cfg(feature = "std")]
     /// A stored model's file header is damaged: a field holds a value that an intact file cannot
     /// have, and nothing vouches for it (docs/format.md, "Damaged or unsupported"). The magic bytes
     /// are at most two bytes off `BRDFGLNT`; or the version or kind is not one this loader reads and
@@ -106,6 +115,7 @@ pub enum Error {
         /// What was found and why it is taken for damage.
         reason: String,
     },
+    #[cfg(feature = "std")]
     /// A stored model's file holds another kind of model than the one asked for.
     #[error("the file holds a {found}, not a {expected}")]
     WrongModelKind {
@@ -130,6 +140,7 @@ pub enum Error {
         /// The checksum of the bytes read.
         computed: u64,
     },
+    #[cfg(feature = "std")]
     /// A stored model's file is well formed but its contents are inconsistent: lengths that do not
     /// match the parameters, invalid parameters or values, sizes beyond what the file holds.
     #[error("invalid file: {reason}")]
@@ -150,6 +161,7 @@ pub enum Error {
         /// What the valid range is.
         reason: &'static str,
     },
+    #[cfg(feature = "std")]
     /// Reading or writing a stream failed (other than by ending early).
     #[error("stream error: {source}")]
     Stream {
@@ -159,7 +171,7 @@ pub enum Error {
 }
 
 /// `Result` with this crate's [`Error`].
-pub type Result<T, E = Error> = std::result::Result<T, E>;
+pub type Result<T, E = Error> = core::result::Result<T, E>;
 
 /// Checks that a scalar parameter is finite and strictly positive.
 pub(crate) fn positive(name: &'static str, value: f32) -> Result<f32> {

@@ -6,6 +6,8 @@
 //! length unless a function says otherwise. Functions here are total: they never panic, and the ones that
 //! can meet a degenerate configuration return an `Option` or a documented 0.
 
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
 use glam::{Vec2, Vec3};
 
 /// The geometric normal ω_g of the local frame.

@@ -12,8 +12,10 @@
 //! 0, as documented on each function; the constructors of the [`Fresnel`] types reject them instead.
 
 use crate::error::{Error, Result, finite, non_negative, positive};
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
+use core::hint::select_unpredictable;
 use glam::{BVec3A, Vec3, Vec3A};
-use std::hint::select_unpredictable;
 
 /// Schlick's approximation of Fresnel reflectance: F = F0 + (1 − F0)(1 − cos θ)⁵.
 ///
@@ -146,7 +148,7 @@ pub fn conductor(cos_theta_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
 fn sqrt3(v: Vec3A) -> Vec3A {
     #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
     {
-        use std::arch::x86_64::{__m128, _mm_sqrt_ps};
+        use core::arch::x86_64::{__m128, _mm_sqrt_ps};
         // SAFETY: the cfg guarantees SSE2 (part of the x86-64 baseline), all `_mm_sqrt_ps` needs.
         Vec3A::from(unsafe { _mm_sqrt_ps(__m128::from(v)) })
     }
@@ -212,6 +214,7 @@ impl<T: Fresnel + ?Sized> Fresnel for &T {
     }
 }
 
+#[cfg(feature = "std")]
 impl<T: Fresnel + ?Sized> Fresnel for Box<T> {
     #[inline]
     fn eval(&self, cos_theta: f32) -> Vec3 {

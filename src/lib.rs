@@ -150,24 +150,55 @@
 //! <!-- which-model:end -->
 //!
 //! Any of them as one run-time type: [`Material`] (module [`material`]).
+//!
+//! ## Features and `no_std`
+//!
+//! - `std` (default): the standard library, the glint layer ([`glint`]), [`material`] and
+//!   [`LayeredBrdf`].
+//! - `image` (default, implies `std`): `NormalMap::from_image_file` / `from_image_bytes` (PNG, EXR).
+//! - `serde` (implies `std`): serde for built glint models and normal maps, as their file bytes.
+//!
+//! With `default-features = false` the crate is `#![no_std]` and allocates nothing: the analytic
+//! core, [`frame`], [`warp`], [`fresnel`], [`ndf`] (Beckmann, GGX, Blinn-Phong, [`SlopeGaussian`],
+//! masking, samplers, Phong lobe integrals) and [`bxdf`] but [`LayeredBrdf`] (Lambert, the Phong
+//! family, [`MicrofacetBrdf`], [`bxdf::EnergyCompensated`] with its static tables,
+//! [`SpecularReflection`], the normal-mapping adapters), for GPU shaders (rust-gpu) and other
+//! `no_std` code. Its float functions (`sqrt`, `exp`, `ln`, …) are then `libm`'s instead of std's
+//! (glam's through its `nostd-libm` feature), which may change results in the last bits; no feature
+//! needs naming. Not in the core, for they need std or a heap: [`glint`] (maps, parallel builds,
+//! files, `Vec`-backed models), [`material`], [`LayeredBrdf`] (a `Mutex` cache), `Fresnel` for
+//! `Box<T>`, and the [`Error`] variants of files and decoding (they hold a `String`, a path or an
+//! `io::Error`).
+
+#![cfg_attr(not(feature = "std"), no_std)]
+// The docs describe the whole crate; without `std` their links to the glint layer, `material` and
+// `LayeredBrdf` have no target (CI checks every link in the default build).
+#![cfg_attr(not(feature = "std"), allow(rustdoc::broken_intra_doc_links))]
 
 pub mod bxdf;
 mod error;
+#[cfg(any(not(feature = "std"), test))]
+mod float;
 pub mod frame;
 pub mod fresnel;
+#[cfg(feature = "std")]
 pub mod glint;
+#[cfg(feature = "std")]
 pub mod material;
 mod math;
 pub mod ndf;
 pub mod warp;
 
+#[cfg(feature = "std")]
+pub use bxdf::LayeredBrdf;
 pub use bxdf::{
-    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet,
-    NormalMapTilt, OriginalPhong, Phong, PhongNormalization, ShadingNormal, SpecularReflection,
+    BlinnPhongLobe, Bxdf, BxdfSample, Lambert, MicrofacetBrdf, NormalMapMicrofacet, NormalMapTilt,
+    OriginalPhong, Phong, PhongNormalization, ShadingNormal, SpecularReflection,
 };
 pub use error::{Error, Result};
 pub use fresnel::Fresnel;
 pub use glam::{Mat2, Vec2, Vec3};
+#[cfg(feature = "std")]
 pub use material::{Bsdf, GlintMaterial, Material};
 pub use ndf::{Beckmann, BlinnPhong, Ggx, Ndf, SlopeGaussian};
 

@@ -10,12 +10,16 @@
 //! slower on x86-64 Linux: glibc picks FMA variants of `expf`,
 //! `logf` and `sincosf` at load time (≈ 3.5–4 ns per call here against 6–7 ns for the inlined
 //! SSE2 polynomials, whose Horner chains cannot use FMA without `target-cpu` flags). Only `atan2`
-//! is replaced, by [`atan2_pos`], where an approximation is enough (≈ 4 ns against 12 ns).
+//! is replaced, by [`atan2_pos`], where an approximation is enough (≈ 4 ns against 12 ns). Without
+//! the `std` feature they are libm's (`src/float.rs`).
 
 // Coefficients are kept exactly as published; f32 rounds them.
 #![allow(clippy::excessive_precision)]
 // `!(x <= y)` is the intended NaN-rejecting comparison throughout.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
 
 /// 1/√π.
 pub(crate) const INV_SQRT_PI: f32 = 0.564_189_6;
@@ -62,7 +66,7 @@ pub(crate) fn atan2_pos(y: f32, x: f32) -> f32 {
                 + r2 * (0.193_543_46
                     + r2 * (-0.116_432_87 + r2 * (0.052_653_32 + r2 * -0.011_721_2)))));
     if y > x {
-        std::f32::consts::FRAC_PI_2 - p
+        core::f32::consts::FRAC_PI_2 - p
     } else {
         p
     }
@@ -189,7 +193,7 @@ fn erf_impl(x: f32, e: impl FnOnce() -> f32) -> f32 {
     if ax < 0.5 {
         let x2 = x * x;
         // Coefficients (−1)ⁿ / (n! (2n+1)) · 2/√π, n = 0..7.
-        let p = std::f32::consts::FRAC_2_SQRT_PI
+        let p = core::f32::consts::FRAC_2_SQRT_PI
             + x2 * (-0.376_126_4
                 + x2 * (0.112_837_92
                     + x2 * (-0.026_866_17

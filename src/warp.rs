@@ -12,8 +12,10 @@
 //! The equal-area square ↔ hemisphere map ([`square_to_hemisphere_equal_area`]) is the one to use when
 //! cells of a grid on the square must be regions of equal solid angle (hemisphere bins).
 
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
+use core::f32::consts::{FRAC_1_PI, FRAC_PI_4, TAU};
 use glam::{Vec2, Vec3};
-use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, TAU};
 
 /// The largest `f32` below 1 (1 − 2⁻²⁴): the upper end of a random number in [0, 1).
 pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
@@ -444,6 +446,7 @@ pub fn pdf_hemisphere_equal_area(w: Vec3) -> f32 {
 /// [x0, x1] × [y0, y1] ⊂ [0, 1]², in `f64`, exact up to rounding: with (a, b) = 2u − 1 the map gives
 /// z = 1 − max(a², b²) (the concentric radius is max(|a|, |b|)), so the mean is 1 − the mean of
 /// max(a², b²) over the rectangle in (a, b). An empty rectangle gives 1 (the value at its corner).
+#[cfg(feature = "std")]
 pub(crate) fn equal_area_mean_cos(x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
     1.0 - mean_max_square(
         2.0 * x0 - 1.0,
@@ -454,6 +457,7 @@ pub(crate) fn equal_area_mean_cos(x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
 }
 
 /// Mean of max(a², b²) over the rectangle [a0, a1] × [b0, b1] (exact up to rounding).
+#[cfg(feature = "std")]
 fn mean_max_square(a0: f64, a1: f64, b0: f64, b1: f64) -> f64 {
     // g(a) = ∫_{b0}^{b1} max(a², b²) db in closed form: b² outside |b| < |a|, a² inside.
     let g = |a: f64| {

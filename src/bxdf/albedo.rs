@@ -19,6 +19,8 @@
 //! [0, 1] and α to [α_min, 1] and are total (non-finite input reads the μ = 0 or α_min node).
 
 use super::albedo_tables::{BECKMANN_E, BECKMANN_E_AVG, GGX_E, GGX_E_AVG};
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
 
 /// Nodes per axis of the albedo tables (μ and √α).
 pub const ALBEDO_GRID: usize = 64;

@@ -23,8 +23,10 @@
 //! the exact average of that bilinear interpolant (closed-form weights, [`AnisotropicAlbedo::average`]),
 //! so the energy the compensation lobe returns is exactly what its normalisation assumes.
 
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
+use core::f32::consts::FRAC_PI_2;
 use glam::Vec3;
-use std::f32::consts::FRAC_PI_2;
 
 /// μ nodes of the anisotropic tables (uniform in √μ).
 pub const ANISO_MU_NODES: usize = 17;

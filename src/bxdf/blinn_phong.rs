@@ -9,10 +9,12 @@ use super::lambert::unit_rgb;
 use super::lobe::{cosine_power, lobe_probability, sample_cosine_power};
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::{Error, Result, non_negative};
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
 use crate::frame::{half_vector, half_vector_cos, is_upper, reflect};
 use crate::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
+use core::f32::consts::{FRAC_1_PI, PI, TAU};
 use glam::{Vec2, Vec3};
-use std::f32::consts::{FRAC_1_PI, PI, TAU};
 
 /// Normalisation N of the Blinn-Phong lobe ρ_s N cos^γ θ_h.
 ///

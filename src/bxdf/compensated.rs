@@ -23,8 +23,8 @@ use crate::frame::is_upper;
 use crate::fresnel::Fresnel;
 use crate::ndf::{Beckmann, Ggx, Ndf};
 use crate::warp::square_to_cosine_hemisphere;
+use core::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
-use std::f32::consts::FRAC_1_PI;
 
 /// Midpoints of the rule for F_avg = 2 ∫₀¹ F(μ) μ dμ: the midpoint rule's error is below
 /// 10⁻⁶ for the crate's Fresnel terms (smooth in μ; Schlick's (1 − μ)⁵ has |(F μ)''| ≤ 20).
@@ -73,12 +73,21 @@ impl TabulatedAlbedo for Beckmann {
 }
 
 /// The directional albedo E(wo) and E_avg the compensation reads: the isotropic table at α, or the
-/// anisotropic table's slice at (αx, αy) (1.2 kB, boxed so that isotropic materials stay small).
+/// anisotropic table's slice at (αx, αy) (1.2 kB; with `std` boxed so that isotropic materials stay
+/// small, without it inline, for there is no heap).
+#[cfg_attr(not(feature = "std"), allow(clippy::large_enum_variant))]
 #[derive(Clone, Debug)]
 enum Albedo {
     Isotropic(&'static AlbedoTable, f32),
-    Anisotropic(Box<AnisotropicAlbedo>),
+    Anisotropic(SliceStorage),
 }
+
+/// Where the anisotropic slice lives: on the heap with `std`, inline without it (the `no_std` core
+/// does not allocate; the BRDF is then 1.2 kB larger).
+#[cfg(feature = "std")]
+type SliceStorage = Box<AnisotropicAlbedo>;
+#[cfg(not(feature = "std"))]
+type SliceStorage = AnisotropicAlbedo;
 
 impl Albedo {
     #[inline]
@@ -136,8 +145,9 @@ pub fn multiple_scattering_fresnel(f_avg: Vec3, e_avg: f32) -> Vec3 {
 /// A microfacet BRDF with Kulla-Conty multiple-scattering energy compensation:
 /// f = f_ss + F_ms (1 − E(wo)) (1 − E(wi)) / (π (1 − E_avg)) (module docs).
 ///
-/// Anisotropic NDFs read the anisotropic table's slice at (αx, αy), built in `new` (a 1.2 kB boxed
-/// slice; the type is `Clone`, not `Copy`); isotropic ones read the isotropic table.
+/// Anisotropic NDFs read the anisotropic table's slice at (αx, αy), built in `new` (a 1.2 kB
+/// slice, boxed with the `std` feature and inline without it; the type is `Clone`, not `Copy`);
+/// isotropic ones read the isotropic table.
 ///
 /// Opt-in: [`MicrofacetBrdf`] stays the single-scattering model that matches pbrt-v4 and Mitsuba 3;
 /// wrap it to give back the energy its masking removes (white furnace 1 within 0.5 % for
@@ -212,7 +222,7 @@ impl<D: TabulatedAlbedo, F: Fresnel> EnergyCompensated<D, F> {
         let albedo = if alpha_x == alpha_y {
             Albedo::Isotropic(brdf.ndf().albedo_table(), alpha_x)
         } else {
-            Albedo::Anisotropic(Box::new(
+            Albedo::Anisotropic(SliceStorage::from(
                 brdf.ndf()
                     .anisotropic_albedo_table()
                     .slice(alpha_x, alpha_y),

@@ -7,8 +7,8 @@ use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::{Error, Result};
 use crate::frame::is_upper;
 use crate::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
+use core::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
-use std::f32::consts::FRAC_1_PI;
 
 /// Checks that every channel of an RGB reflectance is finite and in [0, 1].
 pub(crate) fn unit_rgb(name: &'static str, v: Vec3) -> Result<Vec3> {
@@ -43,6 +43,7 @@ pub struct Lambert {
 
 impl Lambert {
     /// The black BRDF (ρ = 0): a total stand-in where a valid material cannot be formed.
+    #[cfg(feature = "std")] // used by `material`
     pub(crate) const BLACK: Lambert = Lambert { albedo: Vec3::ZERO };
 
     /// A Lambertian BRDF with RGB albedo ρ; every channel must be finite and in [0, 1]

@@ -5,9 +5,11 @@
 //! The sampler is written in the lobe's own frame (axis = z) and inverts its CDF exactly; the rotated
 //! variant uses [`crate::frame::Frame`].
 
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
 use crate::frame::Frame;
+use core::f32::consts::TAU;
 use glam::{Vec2, Vec3};
-use std::f32::consts::TAU;
 
 /// The probability s / (d + s) of choosing the specular lobe of a diffuse + specular mixture with
 /// weights d, s ≥ 0 (½ when both vanish, where f = 0 anyway), kept within

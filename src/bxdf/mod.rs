@@ -22,6 +22,7 @@ mod albedo_tables;
 mod blinn_phong;
 mod compensated;
 mod lambert;
+#[cfg(feature = "std")]
 mod layered;
 mod lobe;
 mod microfacet;
@@ -41,7 +42,9 @@ pub use compensated::{
     EnergyCompensated, TabulatedAlbedo, average_fresnel, multiple_scattering_fresnel,
 };
 pub use lambert::Lambert;
+#[cfg(feature = "std")]
 pub(crate) use lambert::unit_rgb;
+#[cfg(feature = "std")]
 pub use layered::{LayeredBrdf, TRANSMISSION_SAMPLES};
 pub use microfacet::{Masking, MicrofacetBrdf, Sampling};
 pub use normal_mapping::{NormalMapMicrofacet, NormalMapTilt, ShadingNormal};
@@ -82,7 +85,7 @@ impl LobeFlags {
     }
 }
 
-impl std::ops::BitOr for LobeFlags {
+impl core::ops::BitOr for LobeFlags {
     type Output = LobeFlags;
     #[inline]
     fn bitor(self, rhs: LobeFlags) -> LobeFlags {
@@ -90,7 +93,7 @@ impl std::ops::BitOr for LobeFlags {
     }
 }
 
-impl std::ops::BitOrAssign for LobeFlags {
+impl core::ops::BitOrAssign for LobeFlags {
     #[inline]
     fn bitor_assign(&mut self, rhs: LobeFlags) {
         self.0 |= rhs.0;
@@ -216,6 +219,7 @@ macro_rules! forward_bxdf {
         }
     };
 }
+#[cfg(feature = "std")]
 pub(crate) use forward_bxdf;
 
 // A reference to a BRDF is a BRDF.

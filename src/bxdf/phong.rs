@@ -15,12 +15,14 @@ use super::lambert::unit_rgb;
 use super::lobe::{cosine_power, lobe_probability, pdf_cosine_power, sample_cosine_power_about};
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::error::{Error, Result, non_negative};
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
 use crate::frame::is_upper;
 use crate::fresnel::schlick;
 use crate::ndf::{phong_lobe_integral, phong_lobe_integral_arvo};
 use crate::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
+use core::f32::consts::{FRAC_1_PI, TAU};
 use glam::{Vec2, Vec3};
-use std::f32::consts::{FRAC_1_PI, TAU};
 
 /// Largest exponent accepted by [`PhongNormalization::EnergyNormalizedArvo`]: 2²⁴, the largest range in
 /// which every integer is an exact `f32`. Arvo's recurrence costs O(γ) per evaluation.

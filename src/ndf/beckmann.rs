@@ -9,13 +9,15 @@ use super::Ndf;
 use super::beckmann_guess;
 use crate::Result;
 use crate::error::positive;
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
 use crate::frame::slope_to_normal;
 use crate::math::{
     INV_SQRT_PI, atan2_pos, erf_with_exp_neg_sq, erfcx_small, erfinv, exp_neg_sq,
     is_positive_finite,
 };
+use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
-use std::f32::consts::PI;
 
 /// √π / 2.
 const HALF_SQRT_PI: f32 = 0.886_226_9;
@@ -365,7 +367,7 @@ fn sample_visible_slope_std(cot_theta: f32, tan_theta: f32, theta: f32, u: Vec2)
 #[inline(always)]
 fn guess_q(theta: f32, u: f32) -> f32 {
     use beckmann_guess::{NT, NU, Q};
-    let fi = (theta * (NT as f32 / std::f32::consts::FRAC_PI_2)).clamp(0.0, NT as f32 - 1e-3);
+    let fi = (theta * (NT as f32 / core::f32::consts::FRAC_PI_2)).clamp(0.0, NT as f32 - 1e-3);
     let fj = (u * NU as f32).clamp(0.0, NU as f32 - 1e-3);
     // `as usize` of a clamped non-negative float (NaN gives 0): always in bounds.
     let (i, j) = (fi as usize, fj as usize);
@@ -435,7 +437,7 @@ fn visible_slope_x<const HALLEY: bool>(
         // is below `safety` × tol; multiplied through by 4 e^(−2x²) F'⁴ (no division).
         let v = value.abs();
         let d2 = derivative * derivative;
-        let predicted = std::f32::consts::PI
+        let predicted = core::f32::consts::PI
             * tan_theta
             * (derivative * x * (1.0 / 3.0) + 0.25 * tan_theta).abs()
             * (v * v * v);

@@ -10,8 +10,10 @@ use super::phong_integral::phong_lobe_integral;
 use super::{Ggx, Ndf};
 use crate::Result;
 use crate::error::non_negative;
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
+use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
-use std::f32::consts::PI;
 
 /// Largest exponent used internally: 2/MIN_ALPHA² − 2 ≈ 2·10⁸, the Blinn-Phong equivalent of the
 /// smallest Beckmann α (and the narrowest GGX proposal the visible sampler can use).

@@ -7,7 +7,9 @@
 //! Accuracy targets are ~1e-13 relative (far below what the `f32` public API needs); each routine
 //! says where it is worse.
 
-use std::f64::consts::{FRAC_1_SQRT_2, PI};
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
+use core::f64::consts::{FRAC_1_SQRT_2, PI};
 
 /// 1/√(2π).
 const INV_SQRT_2PI: f64 = 0.398_942_280_401_432_7;
@@ -261,7 +263,7 @@ pub(crate) fn sample_ramp_counted(a: f64, u: f64) -> (f64, usize) {
             // Both bounds lie right of the root: take the tighter (exact at a = 0).
             inv_std_cdf(u * cdf_a).min(a - (-2.0 * ln_u).sqrt())
         };
-        if x.partial_cmp(&a) != Some(std::cmp::Ordering::Less) {
+        if x.partial_cmp(&a) != Some(core::cmp::Ordering::Less) {
             x = a - y_edge.max(f64::EPSILON * (1.0 + a));
         }
         let mut last = f64::INFINITY;

@@ -7,9 +7,11 @@
 use super::Ndf;
 use super::beckmann::{keep_visible, unit_square, validated_alpha, validated_alphas};
 use crate::Result;
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
 use crate::frame::normalize_robust;
+use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
-use std::f32::consts::PI;
 
 /// The anisotropic GGX (Trowbridge–Reitz) distribution.
 ///

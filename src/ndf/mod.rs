@@ -163,12 +163,14 @@ pub trait Ndf {
 /// backwards, for the NDFs whose V and A are the primary quantities (the glint patches, \[Chermain2019\]
 /// eq. 15). 0 for a below-horizon or non-finite `w`; `f32::MAX` where A(w) ≤ 0 < w_z (a patch leaning
 /// away from `w`: nothing of it is seen).
+#[cfg(feature = "std")] // used by the glint layer
 pub(crate) fn lambda_from_areas<N: Ndf + ?Sized>(ndf: &N, w: Vec3) -> f32 {
     lambda_of(w, |w| ndf.projected_area(w), |w| ndf.visible_area(w))
 }
 
 /// [`lambda_from_areas`] with the two areas given as functions (for a patch that has several ways
 /// of computing V, e.g. the mixture's scalar and block sums).
+#[cfg(feature = "std")] // used by the glint layer
 pub(crate) fn lambda_of(
     w: Vec3,
     projected_area: impl FnOnce(Vec3) -> f32,
@@ -253,6 +255,7 @@ macro_rules! forward_ndf {
         }
     };
 }
+#[cfg(feature = "std")]
 pub(crate) use forward_ndf;
 
 /// The dispatch of a reference: binds `$n` to the referent.

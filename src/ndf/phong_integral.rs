@@ -7,7 +7,9 @@
 //! Two algorithms: Mallett & Yuksel's O(1) closed form for real γ, and Arvo's O(n) recurrence for
 //! integer exponents. Both evaluate in `f64`.
 
-use std::f64::consts::PI;
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
+use core::f64::consts::PI;
 
 /// I(γ, cos θ) = ∫_{S²} max(0, ω·a)^γ max(0, ω·z) dω for real γ ≥ 0, in O(1).
 ///

@@ -16,9 +16,11 @@
 use super::Ndf;
 use super::gauss;
 use crate::error::{Error, Result, positive};
+#[cfg(not(feature = "std"))]
+use crate::float::Float as _;
 use crate::math::{finite_f32, finite_or_zero};
+use core::f64::consts::PI;
 use glam::{Mat2, Vec2, Vec3};
-use std::f64::consts::PI;
 
 /// Default floor on the slope standard deviation used by [`SlopeGaussian::from_moments`]:
 /// σ_ε = 0.01, the near-specular roughness of \[Chermain2019\] §5.2.2.
@@ -72,7 +74,7 @@ pub struct SlopeGaussian {
     inv_chol: [f32; 3],
 }
 
-const _: () = assert!(std::mem::size_of::<SlopeGaussian>() == 32);
+const _: () = assert!(core::mem::size_of::<SlopeGaussian>() == 32);
 
 /// The per-view quantities every masking term needs, in `f64`.
 #[derive(Clone, Copy, Debug)]
@@ -220,11 +222,11 @@ impl SlopeGaussian {
     const UNIT_FALLBACK: Self = SlopeGaussian {
         mean: Vec2::ZERO,
         chol: [
-            std::f32::consts::FRAC_1_SQRT_2,
+            core::f32::consts::FRAC_1_SQRT_2,
             0.0,
-            std::f32::consts::FRAC_1_SQRT_2,
+            core::f32::consts::FRAC_1_SQRT_2,
         ],
-        inv_chol: [std::f32::consts::SQRT_2, 0.0, std::f32::consts::SQRT_2],
+        inv_chol: [core::f32::consts::SQRT_2, 0.0, core::f32::consts::SQRT_2],
     };
 
     /// The lobe of a given mean slope and Cholesky factor L = [[l11, 0], [l21, l22]] (Σ = L Lᵀ),
@@ -232,6 +234,7 @@ impl SlopeGaussian {
     /// hold L (the Beckmann mixture's compact lobe blocks), so that the lobe equals the stored one
     /// bit for bit. `None` unless the mean is within [`MAX_SLOPE`], l11, l22 > 0 and L, L⁻¹ and the
     /// normalisation are finite normal `f32` numbers.
+    #[cfg(feature = "std")] // used by the glint layer
     pub(crate) fn from_mean_cholesky(mean: Vec2, l11: f32, l21: f32, l22: f32) -> Option<Self> {
         if !(mean.x.abs() <= MAX_SLOPE && mean.y.abs() <= MAX_SLOPE && l11 > 0.0 && l22 > 0.0) {
             return None;

@@ -2,7 +2,7 @@
 //! shared harnesses (chi-square, quadrature, seeded maps and RNGs, physics checks) are in `support`.
 //! One binary links the crate once instead of once per file. Tests that need a binary of their own
 //! stay beside this folder: `alloc` and `store_limits` (counting global allocators), `serde`
-//! (feature `serde`) and `normal_map_pixels` (run without default features in CI).
+//! (feature `serde`) and `normal_map_pixels` (run with `std` but without `image` in CI).
 //!
 //! Run one module with `cargo test --test it MODULE::` (e.g. `cargo test --test it mixture_sampling::`).
 

@@ -70,8 +70,8 @@ use super::ShadingNormal;
 use crate::bxdf::{Bxdf, BxdfSample, Lambert, LobeFlags};
 use crate::frame::{is_upper, reflect};
 use crate::warp::square_to_cosine_hemisphere;
+use core::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
-use std::f32::consts::FRAC_1_PI;
 
 /// Microfacet-based normal mapping of any inner BxDF: the shading normal is facet ω_p of a
 /// two-facet microsurface completed by a vertical mirror facet ω_t (module docs for the formulas,
