@@ -53,44 +53,42 @@ impl BinMap {
 
     /// Measures [`BinMap::moment_masking_errors`] (module docs).
     fn measure_masking_errors(&self) -> Vec<f32> {
-        {
-            let area = (self.width * self.height) as f64;
-            let levels = (0..)
-                .take_while(|&l| (1u64 << (2 * l)) as f64 <= area)
-                .count();
-            let exact = PatchOptions {
-                exact_masking_texels: f32::INFINITY,
-                smoothing_alpha: 0.0,
-                moment_masking_tolerance: 0.0,
-            };
-            let lobe = PatchOptions {
-                exact_masking_texels: 0.0,
-                ..exact
-            };
-            filtered_error::errors_per_level(
-                levels,
-                area,
-                [1.0, 1.0],
-                (self.width, self.height),
-                |fp: &Footprint| {
-                    let bins = self.patch_with(fp, &exact, None);
-                    if bins.area_texels() <= MIN_MOMENT_MASKING_TEXELS as f64 {
-                        return None;
+        let area = (self.width * self.height) as f64;
+        let levels = (0..)
+            .take_while(|&l| (1u64 << (2 * l)) as f64 <= area)
+            .count();
+        let exact = PatchOptions {
+            exact_masking_texels: f32::INFINITY,
+            smoothing_alpha: 0.0,
+            moment_masking_tolerance: 0.0,
+        };
+        let lobe = PatchOptions {
+            exact_masking_texels: 0.0,
+            ..exact
+        };
+        filtered_error::errors_per_level(
+            levels,
+            area,
+            [1.0, 1.0],
+            (self.width, self.height),
+            |fp: &Footprint| {
+                let bins = self.patch_with(fp, &exact, None);
+                if bins.area_texels() <= MIN_MOMENT_MASKING_TEXELS as f64 {
+                    return None;
+                }
+                let moment = self.patch_with(fp, &lobe, None);
+                let g1 = |l: f32| 1.0 / (1.0 + l as f64);
+                let (mut sum, mut n) = (0.0, 0);
+                for wo in views() {
+                    let e = g1(bins.lambda(wo));
+                    if e > 0.0 {
+                        sum += (1.0 - g1(moment.lambda(wo)) / e).abs();
+                        n += 1;
                     }
-                    let moment = self.patch_with(fp, &lobe, None);
-                    let g1 = |l: f32| 1.0 / (1.0 + l as f64);
-                    let (mut sum, mut n) = (0.0, 0);
-                    for wo in views() {
-                        let e = g1(bins.lambda(wo));
-                        if e > 0.0 {
-                            sum += (1.0 - g1(moment.lambda(wo)) / e).abs();
-                            n += 1;
-                        }
-                    }
-                    (n > 0).then(|| (sum / n as f64).min(1.0))
-                },
-            )
-        }
+                }
+                (n > 0).then(|| (sum / n as f64).min(1.0))
+            },
+        )
     }
 
     /// Whether a footprint of `area` texels (after the footprint's clamps) takes its masking terms
