@@ -21,6 +21,7 @@ mod bxdf_microfacet;
 mod bxdf_phong;
 mod bxdf_reciprocity;
 mod bxdf_sampling;
+mod density_contract;
 mod docs_figures;
 mod energy_compensation;
 mod frame_handedness;
