@@ -158,13 +158,17 @@ impl Bxdf for BlinnPhongLobe {
         let Some((h, c)) = half_vector_cos(wo, wi) else {
             return 0.0;
         };
-        let spec = if c > 0.0 {
-            (self.gamma + 1.0) / TAU * cosine_power(h.z, self.gamma) / (4.0 * c)
+        let p = self.p_spec();
+        // The specular term only where its lobe is drawn (p > 0: 0 · ∞ would be NaN), and at most
+        // `f32::MAX` where (γ+1)/(2π) c^γ / (4c) overflows (γ near `f32::MAX`), so that the density
+        // stays positive wherever the lobe has a value.
+        let spec = if p > 0.0 && c > 0.0 {
+            let s = (self.gamma + 1.0) / TAU * cosine_power(h.z, self.gamma) / (4.0 * c);
+            if s.is_nan() { 0.0 } else { s.min(f32::MAX) }
         } else {
             0.0
         };
-        let p = self.p_spec();
-        let v = (1.0 - p) * pdf_cosine_hemisphere(wi) + p * spec;
+        let v = ((1.0 - p) * pdf_cosine_hemisphere(wi) + p * spec).min(f32::MAX);
         if v.is_finite() { v } else { 0.0 }
     }
 

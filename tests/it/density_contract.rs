@@ -368,7 +368,8 @@ fn classic_cases(big: bool) -> Vec<Case> {
             ] {
                 // The energy-normalised N(wo) costs O(γ) per call (Arvo's sum) or an incomplete
                 // beta function whose cost grows with γ (Mallett-Yuksel): their exponents beyond
-                // 10⁴ are in the ignored sweep.
+                // 10⁴ are swept only with `big` (no test sets it: at γ = 10⁷ a sweep took more
+                // than 18 minutes).
                 let normalised = matches!(
                     n,
                     PhongNormalization::EnergyNormalizedArvo
@@ -594,14 +595,10 @@ fn run(cases: &[Case], wos: &[Vec3], wis: &[Vec3], us: &[Vec2]) {
     );
 }
 
-/// The models whose contract holds at every point of the sweep: Lambert, the Phong family (but for
-/// the Blinn-Phong lobe at γ = `f32::MAX`), energy compensation, the delta lobe, the adapters over
-/// Lambert.
+/// The models whose contract holds at every point of the sweep: Lambert, the Phong family,
+/// energy compensation, the delta lobe, the adapters over Lambert.
 fn passing_cases() -> Vec<Case> {
-    let mut v: Vec<Case> = classic_cases(false)
-        .into_iter()
-        .filter(|c| !(c.label.starts_with("Blinn-Phong lobe γ 34028")))
-        .collect();
+    let mut v: Vec<Case> = classic_cases(false);
     v.extend(
         mixture_cases()
             .into_iter()
@@ -618,19 +615,13 @@ fn passing_cases() -> Vec<Case> {
 /// The models with open violations (docs/bxdf.md, "The density contract"): `MicrofacetBrdf`
 /// (whose visible-normal density ⟨wo, h⟩ D(h)/V(wo) underflows before the Jacobian's 1/⟨wo, h⟩
 /// cancels its first factor, at grazing views and extreme α; and whose normal-sampling density
-/// D(h) cos θh underflows where cos θh does), the layered coats and adapters built on it, and the
-/// Blinn-Phong lobe at γ = `f32::MAX` (its pdf overflows).
-fn open_cases(big: bool) -> Vec<Case> {
+/// D(h) cos θh underflows where cos θh does), the layered coats and adapters built on it.
+fn open_cases() -> Vec<Case> {
     let mut v = microfacet_cases();
     v.extend(
         mixture_cases()
             .into_iter()
             .filter(|c| !c.label.starts_with("EnergyCompensated")),
-    );
-    v.extend(
-        classic_cases(big)
-            .into_iter()
-            .filter(|c| c.label.starts_with("Blinn-Phong lobe γ 34028")),
     );
     v.extend(
         adapter_cases()
@@ -646,13 +637,14 @@ fn eval_implies_pdf_at_grazing_and_extreme_parameters() {
     run(&passing_cases(), &g, &g, &u_grid());
 }
 
-/// The same sweep over the models with open violations (16,568 failed checks, each pair counted
+/// The same sweep over the models with open violations (6,808 failed checks, each pair counted
 /// once for `eval_pdf` and once for `eval`/`pdf`; the Phong family had 1,216 more before the
-/// cosine-power flush). Ignored
+/// cosine-power flush, the Blinn-Phong lobe at γ = `f32::MAX` 9,760 more before its pdf was
+/// capped). Ignored
 /// until those are fixed: `cargo test --test it density_contract:: -- --ignored --nocapture`.
 #[test]
 #[ignore = "open violations of the density contract in MicrofacetBrdf at grazing views"]
 fn eval_implies_pdf_for_microfacet_models() {
     let g = grid();
-    run(&open_cases(true), &g, &g, &u_grid());
+    run(&open_cases(), &g, &g, &u_grid());
 }
