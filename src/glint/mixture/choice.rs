@@ -33,6 +33,24 @@ pub(super) struct Footprinted<'a, L> {
     pub cut: Option<CutStats>,
 }
 
+impl<'a, L> Footprinted<'a, L> {
+    /// A footprint served by a few-lobe set (no gather), read at `level`, with what a cut did.
+    fn few(
+        level: L,
+        filtered: SlopeGaussian,
+        set: (Few<'a>, SetKind, f32),
+        cut: Option<CutStats>,
+    ) -> Self {
+        Footprinted {
+            level,
+            filtered,
+            gathered: None,
+            set: Some(set),
+            cut,
+        }
+    }
+}
+
 /// Which few-lobe patch a [`LobeSet`] is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum SetKind {
@@ -69,13 +87,12 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
     let area = fp.area();
     if area < options.sub_texel_area as f64 {
         let lobe = sub_texel::limit_lobe(store, fp.c, fp.cov, fp.seed(), sigma_min);
-        return Footprinted {
-            level: store.level(0),
-            filtered: lobe,
-            gathered: None,
-            set: Some((Few::One(lobe), SetKind::SubTexel, 1.0)),
-            cut: None,
-        };
+        return Footprinted::few(
+            store.level(0),
+            lobe,
+            (Few::One(lobe), SetKind::SubTexel, 1.0),
+            None,
+        );
     }
     let lod = 0.5 * area.max(1e-300).log2();
     let filtered = SlopeGaussian::from_moments(store.filtered_moments(fp.c, lod), sigma_min);
@@ -92,13 +109,7 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
     };
     let tolerance = options.filtered_tolerance;
     if area >= options.filtered_area as f64 && (error <= tolerance || tolerance == f32::INFINITY) {
-        return Footprinted {
-            level: store.level(0),
-            filtered,
-            gathered: None,
-            set: Some(few(sets)),
-            cut: None,
-        };
+        return Footprinted::few(store.level(0), filtered, few(sets), None);
     }
     // A cut of the hierarchy where the filtered mixture does not serve and the gather would cost
     // more than the cut (full storage).
@@ -122,23 +133,12 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
             options.cut_nodes as usize,
             &mut set,
         );
-        return Footprinted {
-            level: store.level(0),
-            filtered,
-            gathered: None,
-            set: Some((Few::Set(set), SetKind::Cut, stats.max_error)),
-            cut: Some(stats),
-        };
+        let set = (Few::Set(set), SetKind::Cut, stats.max_error);
+        return Footprinted::few(store.level(0), filtered, set, Some(stats));
     }
     let res = resolution_index(options.lod_resolution);
     let Some((finest, coarsest)) = level_range(store, fp, area, options) else {
-        return Footprinted {
-            level: store.level(0),
-            filtered,
-            gathered: None,
-            set: Some(few(sets)),
-            cut: None,
-        };
+        return Footprinted::few(store.level(0), filtered, few(sets), None);
     };
     let mut bufs = Lent::new(slots);
     // From the finest allowed level up while the next level's Σ W_n e(n) meets the tolerance (an
