@@ -32,32 +32,35 @@
 //! ## Sample weights
 //! With visible-normal sampling the pdf of wi is D_wo(h) / (4 wo·h) with D_wo(h) = ⟨wo, h⟩ D(h) / V_o,
 //! so the weight f cos θi / pdf = F · M A_i V_o = F · V_o A_i / (V_o A_i + A_o (V_i − A_i)) ≤ F
-//! (height-correlated; F A_i / V_i ≤ F separable): F G2 / G1(wo), whatever h is. It holds in
-//! floating point only if the factor ⟨wo, h⟩ of the density and the Jacobian's wo·h are the same
-//! number. At grazing views a micronormal nearly perpendicular to wo reflects wo to wi ≈ −wo, and h
-//! rebuilt from wo + wi is then off by up to ~6·10⁻⁸ / (2 wo·m) radians (the rounding of wi against
-//! the tiny sum); wo·h, a difference of terms of size 1, is off by as much, so any other cosine
-//! (the accurate ‖wo + wi‖/2, say) disagrees with it by a factor that grows like 1/(wo·m)²: with
-//! that cosine the weight reaches 880 at cos θo = 10⁻⁷ and 8.8·10¹⁵ at 10⁻²⁰ for Beckmann. The
-//! Jacobian therefore uses `wo.dot(h)` in `f32`, as the NDFs' `pdf_visible` does (every NDF
-//! and patch of the crate computes ⟨wo, m⟩ as `wo.dot(m)`; an [`Ndf`] of a caller's that rounds it
-//! otherwise gets a weight off by ~10⁻⁷ / ⟨wo, m⟩), and [`MicrofacetBrdf::eval`] and
-//! [`MicrofacetBrdf::pdf`] are 0 where the computed wo·h or wi·h is not positive. The weight is then
-//! F · G2/G1(wo) ≤ F up to a few ulps and up to the ratio of the normaliser of the NDF's
-//! `pdf_visible` to the `visible_area` its masking uses (1 for the analytic NDFs, ≤ 1 for patches
-//! whose masking uses an upper bound of V), for every view down to cos θo = 10⁻³⁰ and every u in
-//! [0, 1)² (tests/it/hostile_sampling.rs; measured ≤ 1 + 10⁻⁶ for the analytic NDFs and the mixture,
-//! ≤ 1 + 6·10⁻⁶ for the position-normal and smoothed bin-map patches; the unsmoothed bin map's
-//! visible sampler, which draws ⟨wo, m⟩ bilinearly in each bin, reaches 1.71 F in bins that wo's
-//! horizon cuts).
+//! (height-correlated; F A_i / V_i ≤ F separable): F G2 / G1(wo), whatever h is. The factor
+//! ⟨wo, h⟩ of the density and the Jacobian's 1/(4 wo·h) cancel exactly, so the density is formed
+//! without either: D(h) / (4 V_o), through [`Ndf::pdf_visible_over_cos_given_d`]. Formed as the
+//! quotient of the two, it would underflow at grazing views (⟨wo, h⟩ = 10⁻³⁶ makes ⟨wo, h⟩ D / V_o
+//! subnormal while f is 10²⁷), and it would hold in floating point only if both cosines were the
+//! same rounded number: at grazing views a micronormal nearly perpendicular to wo reflects wo to
+//! wi ≈ −wo, and h rebuilt from wo + wi is off by up to ~6·10⁻⁸ / (2 wo·m) radians, so any two
+//! differently rounded cosines disagree by a factor that grows like 1/(wo·m)² (880 at cos θo = 10⁻⁷,
+//! 8.8·10¹⁵ at 10⁻²⁰ for Beckmann). An [`Ndf`] of a caller's that keeps the default
+//! `pdf_visible_over_cos_given_d` (its `pdf_visible` divided by `wo.dot(m)`) gets the cancellation
+//! only if its `pdf_visible` computes ⟨wo, m⟩ as `wo.dot(m)`, as every NDF and patch of the crate
+//! does. [`MicrofacetBrdf::eval`] and [`MicrofacetBrdf::pdf`] are 0 where the computed wo·h or wi·h
+//! is not positive. The weight is then F · G2/G1(wo) ≤ F up to a few ulps and up to the ratio of
+//! the normaliser of the NDF's `pdf_visible` to the `visible_area` its masking uses (1 for the
+//! analytic NDFs, ≤ 1 for patches whose masking uses an upper bound of V), for every view down to
+//! cos θo = 10⁻³⁰ and every u in [0, 1)² (tests/it/hostile_sampling.rs; measured ≤ 1 + 10⁻⁶ for
+//! the analytic NDFs and the mixture, ≤ 1 + 6·10⁻⁶ for the position-normal and smoothed bin-map
+//! patches; the unsmoothed bin map's visible sampler, which draws ⟨wo, m⟩ bilinearly in each bin,
+//! reaches 1.71 F in bins that wo's horizon cuts).
 //!
 //! With normal sampling the pdf is D(h) cos θh / (4c), c = ‖wo + wi‖/2, and the weight is
 //! F · M A_i c / cos θh ≤ F (wo·h) / (V_o cos θh): not bounded by F (it grows as cos θh → 0, the
 //! reason visible-normal sampling is the default), but equal to that expression to rounding.
 //!
-//! A micronormal density below `f32::MIN_POSITIVE` (subnormal) is taken as 0 (`pdf` = 0, `sample`
-//! → `None`): subnormals carry too few digits for the weight to be right. There, and only there,
-//! `eval` may be positive where `pdf` is 0.
+//! **The density contract:** eval > 0 exactly where pdf > 0. A micronormal density D below
+//! `f32::MIN_POSITIVE` (subnormal: too few digits for a weight to be right) is taken as 0 by both
+//! `eval` and `pdf` (`sample` → `None`); a positive density below `f32::MIN_POSITIVE` (h near the
+//! horizon with normal sampling, or D/V where V is huge) is returned as `f32::MIN_POSITIVE`, one
+//! above `f32::MAX` as `f32::MAX`.
 
 use super::{Bxdf, BxdfSample, LobeFlags};
 use crate::frame::{half_vector_cos, is_upper, reflect};
@@ -225,8 +228,7 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
         // c = ‖wo + wi‖/2 rather than wo·h: exact where wi → −wo (frame::half_vector_cos) and
         // symmetric in (wo, wi), so F(c) stays reciprocal to the last bit.
         let (h, c) = half_vector_cos(wo, wi)?;
-        let k = wo.dot(h);
-        (c > 0.0 && k > 0.0 && wi.dot(h) > 0.0).then_some(Half { h, c, k })
+        (c > 0.0 && wo.dot(h) > 0.0 && wi.dot(h) > 0.0).then_some(Half { h, c })
     }
 
     /// The renderer's-measure factor A(wi)/cos θi (with `ai` = A(wi)) that turns the patch BRDF f_P (normalised in the
@@ -247,7 +249,8 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
     /// `d` = D(h) already evaluated.
     #[inline]
     fn eval_at(&self, wo: Vec3, wi: Vec3, hv: &Half, d: f32) -> Vec3 {
-        if d.is_nan() || d <= 0.0 {
+        // A subnormal D is taken as 0, here as in the density (`pdf_at`).
+        if d.is_nan() || d < f32::MIN_POSITIVE {
             return Vec3::ZERO;
         }
         let ai = self.ndf.projected_area(wi);
@@ -257,41 +260,43 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
     }
 
     /// The density of `sample` at the wi of `hv`: p_m(h) / (4 wo·h), the Jacobian of reflection
-    /// (\[Walter2007\] eq. 14) written with the cosine the micronormal density itself uses (module
-    /// docs, "Sample weights"): wo·h = `wo.dot(h)` for visible normals, whose density carries that
-    /// same factor, and c = ‖wo + wi‖/2 for normals drawn from D cos θ.
-    /// A micronormal density below `f32::MIN_POSITIVE` is subnormal (fewer than 23 significant
-    /// bits, none at all near 10⁻⁴⁵) and is taken as 0, so that every returned pdf is accurate
-    /// to f32 rounding and no sample is drawn where it is not.
+    /// (\[Walter2007\] eq. 14), with `d` = D(h) already evaluated. Formed from the NDF's density
+    /// per unit cosine, so that no factor is rounded away before it cancels (module docs, "Sample
+    /// weights"): for visible normals p_m / ⟨wo, h⟩ = D(h)/V(wo)
+    /// ([`Ndf::pdf_visible_over_cos_given_d`]) and the density is that over 4; for normals drawn
+    /// from D cos θ it is D(h) · cos θh / (4c), c = ‖wo + wi‖/2
+    /// ([`Ndf::pdf_normal_over_cos_given_d`]).
     ///
-    /// With `d` = Some(D(h)) already evaluated (by `eval_pdf`), the NDF is given it
-    /// ([`Ndf::pdf_visible_given_d`]): the same density, without a second evaluation of D where
-    /// the NDF's density needs one.
+    /// A micronormal density D below `f32::MIN_POSITIVE` (subnormal: fewer than 23 significant
+    /// bits, none at all near 10⁻⁴⁵) is taken as 0, here and in `eval_at`. A positive density
+    /// below `f32::MIN_POSITIVE` (a normal density at h near the horizon, or D/V where V is huge)
+    /// is returned as `f32::MIN_POSITIVE` and one above `f32::MAX` as `f32::MAX`: the BRDF is
+    /// positive exactly where its density is (the density contract, docs/bxdf.md), and directions
+    /// with a density that small are drawn with probability below 10⁻³⁸.
     #[inline]
-    fn pdf_at(&self, wo: Vec3, hv: &Half, d: Option<f32>) -> f32 {
-        let (pm, cos) = match (self.sampling, d) {
-            (Sampling::Normals, None) => (self.ndf.pdf_normal(hv.h), hv.c),
-            (Sampling::Normals, Some(d)) => (self.ndf.pdf_normal_given_d(hv.h, d), hv.c),
-            (Sampling::VisibleNormals, None) => (self.ndf.pdf_visible(wo, hv.h), hv.k),
-            (Sampling::VisibleNormals, Some(d)) => {
-                (self.ndf.pdf_visible_given_d(wo, hv.h, d), hv.k)
-            }
-        };
-        if pm.is_nan() || pm < f32::MIN_POSITIVE {
+    fn pdf_at(&self, wo: Vec3, hv: &Half, d: f32) -> f32 {
+        if d.is_nan() || d < f32::MIN_POSITIVE {
             return 0.0;
         }
-        let p = pm / (4.0 * cos);
-        if p.is_finite() && p > 0.0 { p } else { 0.0 }
+        let (per_cos, factor) = match self.sampling {
+            Sampling::Normals => (
+                self.ndf.pdf_normal_over_cos_given_d(hv.h, d),
+                hv.h.z / (4.0 * hv.c),
+            ),
+            Sampling::VisibleNormals => (self.ndf.pdf_visible_over_cos_given_d(wo, hv.h, d), 0.25),
+        };
+        if !(per_cos > 0.0 && factor > 0.0) {
+            return 0.0;
+        }
+        (per_cos * factor).clamp(f32::MIN_POSITIVE, f32::MAX)
     }
 }
 
-/// The half vector h = (wo + wi)/‖wo + wi‖ of a reflection configuration with its two cosines:
-/// c = ‖wo + wi‖/2 (accurate, symmetric: Fresnel and the normal sampler's Jacobian) and
-/// k = `wo.dot(h)` (the factor ⟨wo, m⟩ of the visible-normal density, rounded as NDFs round it).
+/// The half vector h = (wo + wi)/‖wo + wi‖ of a reflection configuration with
+/// c = ‖wo + wi‖/2 (accurate, symmetric: Fresnel and the normal sampler's Jacobian).
 struct Half {
     h: Vec3,
     c: f32,
-    k: f32,
 }
 
 impl<D: Ndf, F: Fresnel> Bxdf for MicrofacetBrdf<D, F> {
@@ -304,7 +309,7 @@ impl<D: Ndf, F: Fresnel> Bxdf for MicrofacetBrdf<D, F> {
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match Self::half(wo, wi) {
-            Some(hv) => self.pdf_at(wo, &hv, None),
+            Some(hv) => self.pdf_at(wo, &hv, self.ndf.d(hv.h)),
             None => 0.0,
         }
     }
@@ -314,7 +319,7 @@ impl<D: Ndf, F: Fresnel> Bxdf for MicrofacetBrdf<D, F> {
             Some(hv) => {
                 // D(h) once for both: the NDF's density may need it again (its contract check).
                 let d = self.ndf.d(hv.h);
-                (self.eval_at(wo, wi, &hv, d), self.pdf_at(wo, &hv, Some(d)))
+                (self.eval_at(wo, wi, &hv, d), self.pdf_at(wo, &hv, d))
             }
             None => (Vec3::ZERO, 0.0),
         }

@@ -574,6 +574,24 @@ impl Ndf for Beckmann {
         }
     }
 
+    /// D(m) / V(wo), V = cos θo (1 + Λ(wo)): [`Ndf::pdf_visible`] without its factor ⟨wo, m⟩,
+    /// which the reflection Jacobian cancels (no underflow at grazing views).
+    ///
+    /// # Reference
+    /// \[Heitz2014\] eq. 16.
+    #[inline]
+    fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        // `visible_over_cos` checks wo (wo.z > 0, wo·m > 0) and the quotient's finiteness.
+        let (num, den) = visible_area_ratio(wo.z, self.stretched_sin_sq(wo));
+        super::visible_over_cos(wo, m, d_m, num / den)
+    }
+
+    /// D(m): [`Ndf::pdf_normal`] = D cos θ_m without its cosine.
+    #[inline]
+    fn pdf_normal_over_cos_given_d(&self, m: Vec3, d_m: f32) -> f32 {
+        super::normal_over_cos(m, d_m)
+    }
+
     /// Height-correlated G2 = χ⁺(wo·m) χ⁺(wi·m) / (1 + Λ(wo) + Λ(wi)); 0 for degenerate input.
     fn g2_height_correlated(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
         super::masking::g2_height_correlated_checked(self, wo, wi, m)

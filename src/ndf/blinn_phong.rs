@@ -196,6 +196,20 @@ impl Ndf for BlinnPhong {
         }
     }
 
+    /// D(m) / V(wo): the default [`Ndf::pdf_visible`] without its factor ⟨wo, m⟩, which the
+    /// reflection Jacobian cancels (no underflow at grazing views).
+    ///
+    /// # Reference
+    /// \[Heitz2014\] eq. 16.
+    fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        super::visible_over_cos(wo, m, d_m, self.visible_area(wo))
+    }
+
+    /// D(m): [`Ndf::pdf_normal`] = D cos θ_m without its cosine.
+    fn pdf_normal_over_cos_given_d(&self, m: Vec3, d_m: f32) -> f32 {
+        super::normal_over_cos(m, d_m)
+    }
+
     /// Height-correlated G2 = χ⁺(wo·m) χ⁺(wi·m) / (1 + Λ(wo) + Λ(wi)); 0 for degenerate input.
     fn g2_height_correlated(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
         super::masking::g2_height_correlated_checked(self, wo, wi, m)

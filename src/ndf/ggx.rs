@@ -160,6 +160,24 @@ impl Ndf for Ggx {
         }
     }
 
+    /// D(m) / V(wo) with V = (z + √(z² + n²))/2: [`Ndf::pdf_visible`] without its factor
+    /// ⟨wo, m⟩, which the reflection Jacobian cancels (no underflow at grazing views).
+    ///
+    /// # Reference
+    /// \[Heitz2014\] eq. 16.
+    #[inline]
+    fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        let (x, y) = (self.alpha_x * wo.x, self.alpha_y * wo.y);
+        let s = (wo.z * wo.z + x * x + y * y).sqrt();
+        super::visible_over_cos(wo, m, d_m, 0.5 * (wo.z + s))
+    }
+
+    /// D(m): [`Ndf::pdf_normal`] = D cos θ_m without its cosine.
+    #[inline]
+    fn pdf_normal_over_cos_given_d(&self, m: Vec3, d_m: f32) -> f32 {
+        super::normal_over_cos(m, d_m)
+    }
+
     /// Height-correlated G2 = χ⁺(wo·m) χ⁺(wi·m) / (1 + Λ(wo) + Λ(wi)); 0 for degenerate input.
     fn g2_height_correlated(&self, wo: Vec3, wi: Vec3, m: Vec3) -> f32 {
         super::masking::g2_height_correlated_checked(self, wo, wi, m)

@@ -43,9 +43,10 @@ pub use slope_gaussian::*;
 /// `sample_visible` still returns a normal there. A sampler may draw normals where its density is 0
 /// (the tails of lobes that D truncates, or where D rounds to 0 in `f32`); `MicrofacetBrdf::sample`
 /// returns `None` for them, so the BRDF's pdf remains the density of the directions it produces.
-/// `pdf_visible` computes ⟨wo, m⟩ as `wo.dot(m)` in `f32`, the same number the reflection
-/// Jacobian of `MicrofacetBrdf` divides by, so that sample weights stay bounded at grazing views
-/// (src/bxdf/microfacet.rs, "Sample weights").
+/// `pdf_visible` computes ⟨wo, m⟩ as `wo.dot(m)` in `f32`. `MicrofacetBrdf` forms its density from
+/// [`Ndf::pdf_visible_over_cos_given_d`] (D_wo(m)/⟨wo, m⟩, the factor that the reflection Jacobian
+/// cancels, left out) and [`Ndf::pdf_normal_over_cos_given_d`], so that neither underflows at
+/// grazing views (src/bxdf/microfacet.rs, "Sample weights").
 pub trait Ndf {
     /// D(m): micronormal density per unit solid angle. 0 for m below the horizon.
     fn d(&self, m: Vec3) -> f32;
@@ -157,6 +158,63 @@ pub trait Ndf {
         let _ = d_m;
         self.pdf_visible(wo, m)
     }
+
+    /// D_wo(m) / ⟨wo, m⟩ = χ⁺(wo·m) D(m) / V(wo) (with `d_m` = `self.d(m)` already evaluated): the
+    /// visible-normal density without its factor ⟨wo, m⟩, which the reflection Jacobian
+    /// 1/(4 ⟨wo, m⟩) of `MicrofacetBrdf` cancels (\[Heitz2014\] eq. 16 with \[Walter2007\] eq. 14).
+    /// Formed without that factor, it does not underflow at grazing views, where ⟨wo, m⟩ may be
+    /// 10⁻³⁰ while the BRDF's value is large. 0 exactly where [`Ndf::pdf_visible`] is 0 for a
+    /// reason other than rounding (invalid `wo`, wo·m ≤ 0, D = 0).
+    ///
+    /// The default divides [`Ndf::pdf_visible_given_d`] by `wo.dot(m)`, so that an NDF whose
+    /// visible density is not ⟨wo, m⟩ D / V keeps its own (it may still underflow where ⟨wo, m⟩
+    /// is tiny); NDFs whose density is that product override it with D / V.
+    fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        let c = wo.dot(m);
+        if c.is_nan() || c <= 0.0 {
+            return 0.0;
+        }
+        let p = self.pdf_visible_given_d(wo, m, d_m) / c;
+        if p.is_finite() { p } else { 0.0 }
+    }
+
+    /// pdf_normal(m) / cos θ_m (with `d_m` = `self.d(m)` already evaluated): the normal density
+    /// without its factor cos θ_m, so that `MicrofacetBrdf` can tell a density that is positive
+    /// but below `f32`'s range (m near the horizon) from one that is 0. 0 exactly where
+    /// [`Ndf::pdf_normal`] is 0 for a reason other than rounding.
+    ///
+    /// The default divides [`Ndf::pdf_normal_given_d`] by m_z; NDFs whose normal density is
+    /// D(m) cos θ_m override it with D.
+    fn pdf_normal_over_cos_given_d(&self, m: Vec3, d_m: f32) -> f32 {
+        if m.z.is_nan() || m.z <= 0.0 {
+            return 0.0;
+        }
+        let p = self.pdf_normal_given_d(m, d_m) / m.z;
+        if p.is_finite() { p } else { 0.0 }
+    }
+}
+
+/// D / V: [`Ndf::pdf_visible_over_cos_given_d`] of an NDF whose visible density is
+/// χ⁺(wo·m) ⟨wo, m⟩ D(m) / V(wo), with V = `v` already evaluated; 0 for invalid `wo`, wo·m ≤ 0,
+/// m below the horizon, D ≤ 0 or a non-finite result.
+#[inline]
+pub(crate) fn visible_over_cos(wo: Vec3, m: Vec3, d_m: f32, v: f32) -> f32 {
+    if !(wo.z > 0.0 && m.z > 0.0 && wo.dot(m) > 0.0 && d_m > 0.0 && v > 0.0) {
+        return 0.0;
+    }
+    let p = d_m / v;
+    if p.is_finite() { p } else { 0.0 }
+}
+
+/// D: [`Ndf::pdf_normal_over_cos_given_d`] of an NDF whose normal density is D(m) cos θ_m; 0 for
+/// m below the horizon, non-finite m or D.
+#[inline]
+pub(crate) fn normal_over_cos(m: Vec3, d_m: f32) -> f32 {
+    if m.z > 0.0 && m.is_finite() && d_m.is_finite() && d_m > 0.0 {
+        d_m
+    } else {
+        0.0
+    }
 }
 
 /// Λ(w) = V(w)/A(w) − 1 from an NDF's own visible and projected areas: Smith's identity read
@@ -252,6 +310,14 @@ macro_rules! forward_ndf {
             fn pdf_visible_given_d(&self, wo: glam::Vec3, m: glam::Vec3, d_m: f32) -> f32 {
                 $dispatch!(self, n => n.pdf_visible_given_d(wo, m, d_m))
             }
+            #[inline]
+            fn pdf_visible_over_cos_given_d(&self, wo: glam::Vec3, m: glam::Vec3, d_m: f32) -> f32 {
+                $dispatch!(self, n => n.pdf_visible_over_cos_given_d(wo, m, d_m))
+            }
+            #[inline]
+            fn pdf_normal_over_cos_given_d(&self, m: glam::Vec3, d_m: f32) -> f32 {
+                $dispatch!(self, n => n.pdf_normal_over_cos_given_d(m, d_m))
+            }
         }
     };
 }
@@ -296,7 +362,7 @@ pub(crate) mod forwarding_tests {
         let src = include_str!("mod.rs");
         let methods = fn_names(block(src, "pub trait Ndf {"));
         let forwarded = fn_names(block(src, "macro_rules! forward_ndf {"));
-        assert!(methods.len() >= 14, "{methods:?}");
+        assert!(methods.len() >= 16, "{methods:?}");
         assert_eq!(methods, forwarded);
     }
 }

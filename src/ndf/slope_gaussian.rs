@@ -581,6 +581,28 @@ impl Ndf for SlopeGaussian {
             _ => 0.0,
         }
     }
+
+    /// D(m) / V(wo): [`Ndf::pdf_visible`] without its factor ⟨wo, m⟩ (which the reflection
+    /// Jacobian cancels), formed in `f64` logarithms like it and clamped like it, 0 where it is 0
+    /// (`d_m` is not needed: D comes from the same logarithm).
+    ///
+    /// # Reference
+    /// \[Heitz2014\] eq. 16.
+    fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        let _ = d_m;
+        match self.ln_d_and_pdf_visible(wo, m) {
+            Some((ln_d, l)) if d_of_ln(ln_d) > 0.0 => {
+                let ln_c = facing(wo, m).ln();
+                ((l - ln_c).exp() as f32).clamp(f32::MIN_POSITIVE, f32::MAX)
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// D(m): [`Ndf::pdf_normal`] = D cos θ_m without its cosine.
+    fn pdf_normal_over_cos_given_d(&self, m: Vec3, d_m: f32) -> f32 {
+        super::normal_over_cos(m, d_m)
+    }
 }
 
 /// V(w) from the view terms (see [`Ndf::visible_area`] for the branches).

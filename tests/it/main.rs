@@ -22,6 +22,7 @@ mod bxdf_phong;
 mod bxdf_reciprocity;
 mod bxdf_sampling;
 mod density_contract;
+mod density_contract_glint;
 mod docs_figures;
 mod energy_compensation;
 mod frame_handedness;

@@ -240,6 +240,17 @@ impl Ndf for LobeSet {
         let p = c * self.d(m) / v;
         if p.is_finite() { p } else { 0.0 }
     }
+
+    /// D(m) / V(wo): [`Ndf::pdf_visible`] without its factor ⟨wo, m⟩.
+    fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        if let Some(g) = self.single() {
+            return g.pdf_visible_over_cos_given_d(wo, m, d_m);
+        }
+        if !(wo.is_finite() && m.is_finite()) {
+            return 0.0;
+        }
+        crate::ndf::visible_over_cos(wo, m, d_m, self.visible_area(wo))
+    }
 }
 
 impl Few<'_> {
@@ -307,5 +318,9 @@ impl Ndf for Few<'_> {
 
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
         with_few!(self, 0.0, |n| n.pdf_visible(wo, m))
+    }
+
+    fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        with_few!(self, 0.0, |n| n.pdf_visible_over_cos_given_d(wo, m, d_m))
     }
 }

@@ -551,6 +551,11 @@ impl Ndf for MixturePatch<'_> {
         self.pdf_visible_with(wo, m, || d_m)
     }
 
+    /// [`Ndf::pdf_visible_given_d`] without its factor ⟨wo, m⟩ (no underflow at grazing views).
+    fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        self.pdf_visible_over_cos_with(wo, m, || d_m)
+    }
+
     /// [`Ndf::visible_area`] at the view: the exact V_P kept for the queries that follow at the
     /// same `wo` ([`MaskingMode::Exact`]); Scarf's bound, O(1), is not kept
     /// ([`MaskingMode::Approximate`]).
@@ -577,10 +582,15 @@ impl MixturePatch<'_> {
 
     /// The few-lobe patch's visible-normal density ⟨wo, m⟩⁺ D(m) / V(wo) with D(m) = `d()` and
     /// V(wo) through the view memo for a set (the same value its own `pdf_visible` computes); a
-    /// single lobe's own density.
-    fn few_pdf_visible(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
+    /// single lobe's own density. Without the factor ⟨wo, m⟩ where `over_cos`
+    /// ([`Ndf::pdf_visible_over_cos_given_d`]).
+    fn few_pdf_visible(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32, over_cos: bool) -> f32 {
         let Few::Set(_) = &self.few else {
-            return self.few.pdf_visible(wo, m);
+            return if over_cos {
+                self.few.pdf_visible_over_cos_given_d(wo, m, d())
+            } else {
+                self.few.pdf_visible(wo, m)
+            };
         };
         let c = wo.dot(m);
         if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
@@ -590,7 +600,7 @@ impl MixturePatch<'_> {
         if v.is_nan() || v <= 0.0 {
             return 0.0;
         }
-        let p = c * d() / v;
+        let p = if over_cos { d() / v } else { c * d() / v };
         if p.is_finite() { p } else { 0.0 }
     }
 
@@ -613,8 +623,22 @@ impl MixturePatch<'_> {
     /// through the patch's [`ViewMemo`].
     #[inline]
     fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
+        self.visible_density(wo, m, d, false)
+    }
+
+    /// [`Ndf::pdf_visible_over_cos_given_d`], with `d` giving D_P(m) for the density contract's
+    /// check.
+    #[inline]
+    fn pdf_visible_over_cos_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
+        self.visible_density(wo, m, d, true)
+    }
+
+    /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe (0 where D_P = `d()` is 0), without
+    /// the factor ⟨wo, m⟩ where `over_cos`.
+    #[inline]
+    fn visible_density(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32, over_cos: bool) -> f32 {
         let Some(g) = &self.gathered else {
-            return self.few_pdf_visible(wo, m, d);
+            return self.few_pdf_visible(wo, m, d, over_cos);
         };
         let c = wo.dot(m);
         if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
@@ -628,7 +652,8 @@ impl MixturePatch<'_> {
         if v.is_nan() || v <= 0.0 {
             return 0.0;
         }
-        let p = (c as f64 * self.untruncated_d(g, m) / v) as f32;
+        let k = if over_cos { 1.0 } else { c as f64 };
+        let p = (k * self.untruncated_d(g, m) / v) as f32;
         if p.is_finite() { p } else { 0.0 }
     }
 }

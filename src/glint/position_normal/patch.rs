@@ -530,19 +530,25 @@ impl Ndf for PositionNormalPatch<'_> {
     /// density of [`Ndf::sample_visible`] on the support of D_P (draws outside it as in
     /// [`Ndf::pdf_normal`]). 0 for invalid wo. O(elements).
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
-        self.pdf_visible_with(wo, m, || self.d(m))
+        self.pdf_visible_with(wo, m, || self.d(m), false)
     }
 
     /// [`Ndf::pdf_visible`] with D_P(m) = `d_m` given (the support check uses it).
     fn pdf_visible_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
-        self.pdf_visible_with(wo, m, || d_m)
+        self.pdf_visible_with(wo, m, || d_m, false)
+    }
+
+    /// [`Ndf::pdf_visible_given_d`] without its factor ⟨wo, m⟩ (no underflow at grazing views).
+    fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
+        self.pdf_visible_with(wo, m, || d_m, true)
     }
 }
 
 impl PositionNormalPatch<'_> {
-    /// [`Ndf::pdf_visible`], with `d` giving D_P(m) for the support check.
+    /// [`Ndf::pdf_visible`], with `d` giving D_P(m) for the support check; without the factor
+    /// ⟨wo, m⟩ where `over_cos` ([`Ndf::pdf_visible_over_cos_given_d`]).
     #[inline]
-    fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
+    fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32, over_cos: bool) -> f32 {
         let c = wo.dot(m);
         if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
             return 0.0;
@@ -554,7 +560,8 @@ impl PositionNormalPatch<'_> {
         if v.is_nan() || v <= 0.0 {
             return 0.0;
         }
-        let p = (c as f64 * self.untruncated_d(m) / v) as f32;
+        let k = if over_cos { 1.0 } else { c as f64 };
+        let p = (k * self.untruncated_d(m) / v) as f32;
         if p.is_finite() { p } else { 0.0 }
     }
 }
