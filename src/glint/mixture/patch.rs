@@ -27,6 +27,8 @@ use crate::math::{finite_f32, finite_or_zero};
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Vec2, Vec3};
 
+mod densities;
+
 /// The level a patch reads, in the mixture's storage.
 #[derive(Clone, Copy, Debug)]
 enum PatchLevel<'a> {
@@ -565,95 +567,5 @@ impl Ndf for MixturePatch<'_> {
             (Some(_), MaskingMode::Approximate) => self.visible_area(wo),
             (None, _) => self.few_view_visible_area(wo),
         }
-    }
-}
-
-impl MixturePatch<'_> {
-    /// The few-lobe patch's V(wo) at the view: a set's kept in the view memo (a shading point
-    /// asks for V(wo) at every density and sample), a single lobe's directly.
-    fn few_view_visible_area(&self, wo: Vec3) -> f32 {
-        match &self.few {
-            Few::Set(set) if wo.z > 0.0 && wo.is_finite() => {
-                self.view.get_or(wo, || set.visible_area(wo) as f64) as f32
-            }
-            few => few.visible_area(wo),
-        }
-    }
-
-    /// The few-lobe patch's visible-normal density ⟨wo, m⟩⁺ D(m) / V(wo) with D(m) = `d()` and
-    /// V(wo) through the view memo for a set (the same value its own `pdf_visible` computes); a
-    /// single lobe's own density. Without the factor ⟨wo, m⟩ where `over_cos`
-    /// ([`Ndf::pdf_visible_over_cos_given_d`]).
-    fn few_pdf_visible(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32, over_cos: bool) -> f32 {
-        let Few::Set(_) = &self.few else {
-            return if over_cos {
-                self.few.pdf_visible_over_cos_given_d(wo, m, d())
-            } else {
-                self.few.pdf_visible(wo, m)
-            };
-        };
-        let c = wo.dot(m);
-        if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
-            return 0.0;
-        }
-        let v = self.few_view_visible_area(wo);
-        if v.is_nan() || v <= 0.0 {
-            return 0.0;
-        }
-        let p = if over_cos { d() / v } else { c * d() / v };
-        if p.is_finite() { p } else { 0.0 }
-    }
-
-    /// [`Ndf::pdf_normal`], with `d` giving D_P(m) for the density contract's check.
-    #[inline]
-    fn pdf_normal_with(&self, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
-        let Some(g) = &self.gathered else {
-            return self.few.pdf_normal(m);
-        };
-        // 0 where D_P is (outside every lobe's slope box): one density contract for every NDF.
-        if !(m.z > 0.0 && m.is_finite()) || d() <= 0.0 {
-            return 0.0;
-        }
-        let p = self.untruncated_d(g, m) * m.z as f64;
-        let p = p as f32;
-        if p.is_finite() { p } else { 0.0 }
-    }
-
-    /// [`Ndf::pdf_visible`], with `d` giving D_P(m) for the density contract's check and V_P(wo)
-    /// through the patch's [`ViewMemo`].
-    #[inline]
-    fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
-        self.visible_density(wo, m, d, false)
-    }
-
-    /// [`Ndf::pdf_visible_over_cos_given_d`], with `d` giving D_P(m) for the density contract's
-    /// check.
-    #[inline]
-    fn pdf_visible_over_cos_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
-        self.visible_density(wo, m, d, true)
-    }
-
-    /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe (0 where D_P = `d()` is 0), without
-    /// the factor ⟨wo, m⟩ where `over_cos`.
-    #[inline]
-    fn visible_density(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32, over_cos: bool) -> f32 {
-        let Some(g) = &self.gathered else {
-            return self.few_pdf_visible(wo, m, d, over_cos);
-        };
-        let c = wo.dot(m);
-        if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
-            return 0.0;
-        }
-        // 0 where D_P is (outside every lobe's slope box): one density contract for every NDF.
-        if d() <= 0.0 {
-            return 0.0;
-        }
-        let v = self.view_exact_visible_area(g, wo);
-        if v.is_nan() || v <= 0.0 {
-            return 0.0;
-        }
-        let k = if over_cos { 1.0 } else { c as f64 };
-        let p = (k * self.untruncated_d(g, m) / v) as f32;
-        if p.is_finite() { p } else { 0.0 }
     }
 }
