@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release --example render [-- --quick] [--out DIR] [--spp N] [--width W]`
 //! `cargo run --release --example render -- --timing [--quick] [--texels 10,500,30000]
-//! [--materials mixture,bin]`
+//! [--materials mixture,bin] [--seed N | --map FILE.png]`
 //!
 //! Writes into DIR (default `target/brdf-out/`) a hammered normal map PNG (generated from a height
 //! field, then loaded back like any asset) and four tone-mapped renders of the same scene: analytic
@@ -33,6 +33,12 @@ fn main() -> Res<()> {
         }
         if let Some(list) = common::arg_value("--materials") {
             opts.materials = list.split(',').map(str::to_string).collect();
+        }
+        if let Some(seed) = common::arg_value("--seed") {
+            opts.seed = seed.parse()?;
+        }
+        if let Some(path) = common::arg_value("--map") {
+            opts.map_file = Some(path.into());
         }
         run_timing(&out, &opts)?;
         return Ok(());

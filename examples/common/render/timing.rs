@@ -32,8 +32,8 @@ use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::MixtureParams;
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, Footprint, GlintModel, GlintOptions, NormalMap, PositionNormalMap,
-    ScratchedParams, scratched,
+    BeckmannMixture, BinMap, Footprint, GlintModel, GlintOptions, NormalMap, NormalRepair,
+    PositionNormalMap, ScratchedParams, TangentConvention, scratched,
 };
 use brdf::material::{NormalMappedMaterial, NormalMapping};
 use brdf::{Ggx, GlintMaterial, Material, Vec2, Vec3};
@@ -58,6 +58,11 @@ pub struct TimingOptions {
     /// Materials to time, by label substring (case-insensitive; `=label` for the label alone);
     /// empty: all. Analytic GGX is always timed (every ratio is against it).
     pub materials: Vec<String>,
+    /// Seed of the scratched map (7: the map of docs/results.md).
+    pub seed: u64,
+    /// A normal-map image to time instead of the scratched map (square; `map_size` is then its
+    /// side), decoded as OpenGL-convention tangent-space normals.
+    pub map_file: Option<std::path::PathBuf>,
 }
 
 impl TimingOptions {
@@ -71,6 +76,8 @@ impl TimingOptions {
             texels_per_pixel: vec![10.0, 500.0, 30_000.0],
             rounds: 3,
             materials: Vec::new(),
+            seed: 7,
+            map_file: None,
         }
     }
 
@@ -249,8 +256,27 @@ pub fn uptime() -> String {
 pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
     let load_before = uptime();
     println!("uptime before: {load_before}");
-    let n = opts.map_size;
-    let map = Arc::new(scratched(n, n, ScratchedParams::default(), 7)?);
+    let (map, what) = match &opts.map_file {
+        Some(path) => (
+            NormalMap::from_image_file(path, TangentConvention::OpenGl, NormalRepair::default())?,
+            format!("{}", path.display()),
+        ),
+        None => {
+            let n = opts.map_size;
+            let map = scratched(n, n, ScratchedParams::default(), opts.seed)?;
+            (map, format!("scratched map, seed {}", opts.seed))
+        }
+    };
+    if map.width() != map.height() {
+        return Err(format!(
+            "the timed map must be square ({}×{})",
+            map.width(),
+            map.height()
+        )
+        .into());
+    }
+    let n = map.width();
+    let map = Arc::new(map);
     let alpha = std::f32::consts::SQRT_2 * rms_slope(&map);
     let silver = ConductorFresnel::SILVER;
     let wanted = |label: &str| {
@@ -296,7 +322,7 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         &mut || Ok(PositionNormalMap::build(&map, PositionNormalParams::default())?.into()),
     )?;
     println!(
-        "builds ({n}² scratched map, default parameters, wall time, with the measured errors of \
+        "builds ({n}² {what}, default parameters, wall time, with the measured errors of \
          the levels of detail):\n{builds}"
     );
     let plain = |m: &Arc<GlintModel>| GlintMaterial::new(m.clone(), silver);
