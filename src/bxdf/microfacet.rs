@@ -29,6 +29,15 @@
 //! The denominator of the second form equals A_o A_i (1 + Λ_o + Λ_i) ≥ 0 and stays positive when one
 //! of A_o, A_i vanishes while the corresponding V does not.
 //!
+//! **Leaning patches.** A glint patch whose mean plane faces away from a direction above the
+//! geometric horizon has A ≤ 0 there (Λ = ∞: \[Chermain2019\] eq. 15). The height-correlated form
+//! is then taken at its limit A → 0⁺, M = 1/(V_o A_i) (or 1/(V_i A_o)): continuous, symmetric in
+//! (wo, wi), and the visible-normal weight below stays F · V_o A_i / (V_o A_i) = F. The form itself,
+//! read at A_o < 0, would make the denominator V_o A_i + A_o (V_i − A_i) smaller than V_o A_i, and
+//! the weight F · V_o A_i / denominator above F without bound. (Of the crate's NDFs, `SlopeGaussian`
+//! (cos θ − w·μ̄) and the bin map's patch with exact masking (w·ā) return a signed A; the others
+//! clamp it at 0 themselves.)
+//!
 //! ## Sample weights
 //! With visible-normal sampling the pdf of wi is D_wo(h) / (4 wo·h) with D_wo(h) = ⟨wo, h⟩ D(h) / V_o,
 //! so the weight f cos θi / pdf = F · M A_i V_o = F · V_o A_i / (V_o A_i + A_o (V_i − A_i)) ≤ F
@@ -190,7 +199,8 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
 
     /// The masking factor M(wo, wi) = G2(wo, wi, h) / (A(wo) A(wi)) for a half vector with
     /// wo·h = wi·h > 0 (the χ⁺ factors are checked by the caller): 1/(V_o V_i) (separable) or
-    /// 1/(V_o A_i + V_i A_o − A_o A_i) (height-correlated); 0 when the denominator is not positive.
+    /// 1/(V_o A_i + V_i A_o − A_o A_i) with A_o, A_i taken at least 0 (height-correlated); 0 when
+    /// the denominator is not positive.
     pub fn masking_factor(&self, wo: Vec3, wi: Vec3) -> f32 {
         self.masking_factor_with(wo, wi, self.ndf.projected_area(wi))
     }
@@ -206,7 +216,9 @@ impl<D: Ndf, F: Fresnel> MicrofacetBrdf<D, F> {
         let denom = match self.masking {
             Masking::Separable => vo * vi,
             Masking::HeightCorrelated => {
-                let ao = self.ndf.projected_area(wo);
+                // A ≤ 0 (a leaning glint patch whose mean plane faces away from the direction):
+                // the form's limit A → 0⁺, M = 1/(V_o A_i) (module docs, "Leaning patches").
+                let (ao, ai) = (self.ndf.projected_area(wo).max(0.0), ai.max(0.0));
                 vo * ai + vi * ao - ao * ai
             }
         };
