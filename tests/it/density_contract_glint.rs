@@ -88,67 +88,74 @@ fn footprints() -> Vec<(f32, Footprint)> {
 /// weight bound is 2 F (docs/binmap.md; tests/it/hostile_sampling.rs).
 const BIN_MAP_BOUND: f32 = 2.0;
 
-/// Every model's patches on every map and footprint, as `'static` BRDFs (the built models are
-/// leaked: they live for the test process).
-fn cases(models: &str) -> Vec<Case> {
+/// The glint model a sweep covers.
+#[derive(Clone, Copy)]
+enum Model {
+    Mixture,
+    BinMap,
+    PositionNormal,
+}
+
+/// `value` for the rest of the test process (the patches borrow their model, and a `Case` holds a
+/// `'static` BRDF).
+fn leak<T>(value: T) -> &'static T {
+    Box::leak(Box::new(value))
+}
+
+/// One model's patches on every map and footprint, as `'static` BRDFs: only that model is built.
+fn cases(model: Model) -> Vec<Case> {
     let mut v = Vec::new();
     for (name, map) in maps() {
-        let mixture: &'static BeckmannMixture = Box::leak(Box::new(
-            BeckmannMixture::build(
-                &map,
-                MixtureParams {
+        match model {
+            Model::Mixture => {
+                let params = MixtureParams {
                     samples: 16,
                     ..MixtureParams::default()
-                },
-            )
-            .unwrap(),
-        ));
-        let bin_map: &'static BinMap = Box::leak(Box::new(
-            BinMap::build(
-                &map,
-                BinMapParams {
+                };
+                let mixture = leak(BeckmannMixture::build(&map, params).unwrap());
+                for (texels, fp) in footprints() {
+                    for masking in [MaskingMode::Exact, MaskingMode::Approximate] {
+                        let options = MixtureOptions {
+                            masking,
+                            ..MixtureOptions::default()
+                        };
+                        v.push(case(
+                            format!("mixture {masking:?} {name} {texels} texels"),
+                            MicrofacetBrdf::new(mixture.patch_with(&fp, &options, None), NoFresnel),
+                            Some(VISIBLE_BOUND),
+                        ));
+                    }
+                }
+            }
+            Model::BinMap => {
+                let params = BinMapParams {
                     bins_per_axis: 31,
                     ..BinMapParams::default()
-                },
-            )
-            .unwrap(),
-        ));
-        let pn: &'static PositionNormalMap = Box::leak(Box::new(
-            PositionNormalMap::build(&map, Default::default()).unwrap(),
-        ));
-        for (texels, fp) in footprints() {
-            if models.contains("mixture") {
-                for masking in [MaskingMode::Exact, MaskingMode::Approximate] {
-                    let options = MixtureOptions {
-                        masking,
-                        ..MixtureOptions::default()
-                    };
+                };
+                let bin_map = leak(BinMap::build(&map, params).unwrap());
+                for (texels, fp) in footprints() {
+                    for (alpha, bound) in [(0.0, BIN_MAP_BOUND), (0.05, VISIBLE_BOUND)] {
+                        let options = BinOptions {
+                            smoothing_alpha: alpha,
+                            ..BinOptions::default()
+                        };
+                        v.push(case(
+                            format!("bin map α {alpha} {name} {texels} texels"),
+                            MicrofacetBrdf::new(bin_map.patch_with(&fp, &options, None), NoFresnel),
+                            Some(bound),
+                        ));
+                    }
+                }
+            }
+            Model::PositionNormal => {
+                let pn = leak(PositionNormalMap::build(&map, Default::default()).unwrap());
+                for (texels, fp) in footprints() {
                     v.push(case(
-                        format!("mixture {masking:?} {name} {texels} texels"),
-                        MicrofacetBrdf::new(mixture.patch_with(&fp, &options, None), NoFresnel),
+                        format!("position-normal {name} {texels} texels"),
+                        MicrofacetBrdf::new(pn.patch(&fp), NoFresnel),
                         Some(VISIBLE_BOUND),
                     ));
                 }
-            }
-            if models.contains("bin map") {
-                for (alpha, bound) in [(0.0, BIN_MAP_BOUND), (0.05, VISIBLE_BOUND)] {
-                    let options = BinOptions {
-                        smoothing_alpha: alpha,
-                        ..BinOptions::default()
-                    };
-                    v.push(case(
-                        format!("bin map α {alpha} {name} {texels} texels"),
-                        MicrofacetBrdf::new(bin_map.patch_with(&fp, &options, None), NoFresnel),
-                        Some(bound),
-                    ));
-                }
-            }
-            if models.contains("position-normal") {
-                v.push(case(
-                    format!("position-normal {name} {texels} texels"),
-                    MicrofacetBrdf::new(pn.patch(&fp), NoFresnel),
-                    Some(VISIBLE_BOUND),
-                ));
             }
         }
     }
@@ -168,7 +175,7 @@ fn glint_grid() -> Vec<Vec3> {
 #[test]
 fn mixture_patches_keep_the_contract() {
     let g = glint_grid();
-    run(&cases("mixture"), &g, &g, &u_grid());
+    run(&cases(Model::Mixture), &g, &g, &u_grid());
 }
 
 /// Open (docs/bxdf.md, "The density contract"): the unsmoothed bin map's visible density is 0
@@ -182,7 +189,7 @@ fn mixture_patches_keep_the_contract() {
 #[ignore = "open: bin map pdf 0 where eval > 0 at wo·h ~ 1e-44, weights above their bounds"]
 fn bin_map_patches_keep_the_contract() {
     let g = grid();
-    run(&cases("bin map"), &g, &g, &u_grid());
+    run(&cases(Model::BinMap), &g, &g, &u_grid());
 }
 
 /// Position-normal keeps eval > 0 ⇒ pdf > 0 everywhere; open: its visible-sample weights exceed
@@ -193,5 +200,5 @@ fn bin_map_patches_keep_the_contract() {
 #[ignore = "open: position-normal weights up to 1.19 F on extreme maps"]
 fn position_normal_patches_keep_the_contract() {
     let g = grid();
-    run(&cases("position-normal"), &g, &g, &u_grid());
+    run(&cases(Model::PositionNormal), &g, &g, &u_grid());
 }
