@@ -7,7 +7,7 @@
 //! each patch's own sampler (so they hit occupied bins, the expensive case) and 1024 are evaluated
 //! per iteration: divide the time by 1024.
 //!
-//! Run: `cargo bench --bench binmap -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+//! Run: `cargo bench -p brdf-benches --bench binmap -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 //! (a group: append its name, e.g. `binmap_d_2048`).
 
 use brdf::glint::GlintNdf;

@@ -1,7 +1,7 @@
 //! The classic BRDFs: time of `eval`, `pdf` and `sample` per call, on 1024 inputs generated before
 //! timing (wo, wi uniform on the hemisphere; uc, u uniform).
 //!
-//! Run: `cargo bench --bench bxdf -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+//! Run: `cargo bench -p brdf-benches --bench bxdf -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 //! (the figures in docs/results.md, section "Classic BRDFs", come from this command).
 
 use brdf::bxdf::{

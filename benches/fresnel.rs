@@ -4,12 +4,12 @@
 //! figure is the throughput of independent calls (as in a renderer), not the latency of a chain of
 //! additions into one accumulator.
 //!
-//! Run: `cargo bench --bench fresnel -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+//! Run: `cargo bench -p brdf-benches --bench fresnel -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 //! (the figures in docs/results.md, section "Fresnel and warps", come from this command).
 //!
 //! Table mode (the Fresnel rows of the C++ comparison in docs/results.md,
 //! "Analytic NDFs: speed against pbrt-v4 and Mitsuba 3"):
-//! `BRDF_TABLE=1 cargo bench --bench fresnel` prints the minimum and median ns per call over
+//! `BRDF_TABLE=1 cargo bench -p brdf-benches --bench fresnel` prints the minimum and median ns per call over
 //! 5 × 1000 batches of 1024 calls on the inputs of `benches/cpp/analytic.cpp`.
 
 use brdf::Vec3;

@@ -4,7 +4,7 @@
 //! Inputs (maps) are generated before timing. The reference uses short settings (2.5·10⁵ positions)
 //! so that its cost per position can be read off: divide by `BinnedPndf::samples()`.
 //!
-//! Run: `cargo bench --bench glint -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+//! Run: `cargo bench -p brdf-benches --bench glint -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 
 use brdf::glint::{
     BrushedParams, FlakesParams, Footprint, HemisphereBins, Kernel, ScratchedParams, binned_pndf,

@@ -16,7 +16,7 @@
 //! 32 (wo, wi) pairs (half reflected about the full patch's visible samples, half cosine-distributed),
 //! the same inputs for both storages, so criterion's throughput is the time per call.
 //!
-//! Run: `cargo bench --bench mixture -- --warm-up-time 0.5 --measurement-time 2 --sample-size 10`
+//! Run: `cargo bench -p brdf-benches --bench mixture -- --warm-up-time 0.5 --measurement-time 2 --sample-size 10`
 //! (the queries only: append `'^mixture_(patch|d|lambda_exact|sample_visible|eval_pdf)/'`; one map:
 //! e.g. `/bumpy/`; build times at 2048²:
 //! `cargo test --release --test it -- --ignored mixture::build_2048 --nocapture`).
@@ -258,7 +258,7 @@ fn queries(c: &mut Criterion) {
 /// The build with the default separable filter against the 256-node QMC build
 /// ([`brdf::glint::mixture::MomentMethod::Qmc`]), on the four procedural maps at 512² and 1024² (2048²:
 /// `cargo test --lib -- --ignored build_timing_2048 --nocapture`, which alternates the two).
-/// Run: `cargo bench --bench mixture -- mixture_build_method --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+/// Run: `cargo bench -p brdf-benches --bench mixture -- mixture_build_method --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 fn build_method(c: &mut Criterion) {
     use brdf::glint::mixture::MomentMethod;
     for n in [512usize, 1024] {
@@ -300,7 +300,7 @@ fn build_method(c: &mut Criterion) {
 /// the default cost cap), alternating per footprint, 256 to 65 536 texels; the same 32 normals
 /// (drawn from the full patch) for both.
 ///
-/// `cargo bench --bench mixture -- mixture_lod --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+/// `cargo bench -p brdf-benches --bench mixture -- mixture_lod --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 fn lod(c: &mut Criterion) {
     let full = PatchOptions {
         masking: MaskingMode::Exact,

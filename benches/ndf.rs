@@ -8,11 +8,11 @@
 //! chain of additions into one accumulator (which capped the cheapest functions at one `f32` add
 //! latency per call before 2026-11).
 //!
-//! `cargo bench --bench ndf -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+//! `cargo bench -p brdf-benches --bench ndf -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 //!
 //! Table mode (the crate's column of the C++ comparison in docs/results.md,
 //! "Analytic NDFs: speed against pbrt-v4 and Mitsuba 3"):
-//! `BRDF_TABLE=1 cargo bench --bench ndf` prints, for α ∈ {0.1, 0.5, 1}, the minimum and median
+//! `BRDF_TABLE=1 cargo bench -p brdf-benches --bench ndf` prints, for α ∈ {0.1, 0.5, 1}, the minimum and median
 //! ns per call over 5 × 1000 batches of 1024 calls on the inputs of `benches/cpp/analytic.cpp`
 //! (see benches/cpp/README.md; `benches/cpp/run.sh` runs both sides alternately).
 

@@ -4,7 +4,7 @@
 //!
 //! Inputs (map, representation, patches, directions) are generated before timing.
 //!
-//! Run: `cargo bench --bench position_normal -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+//! Run: `cargo bench -p brdf-benches --bench position_normal -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{Footprint, GlintNdf, PositionNormalMap, bumpy};

@@ -6,7 +6,7 @@
 //! loop with the error of each patch (docs/results.md, "Cost and error of a shading point against
 //! footprint").
 //!
-//! Run: `cargo bench --bench shading_point -- --warm-up-time 0.2 --measurement-time 1
+//! Run: `cargo bench -p brdf-benches --bench shading_point -- --warm-up-time 0.2 --measurement-time 1
 //! --sample-size 10`
 
 use brdf::fresnel::ConductorFresnel;

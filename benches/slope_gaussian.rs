@@ -5,7 +5,7 @@
 //! 0.05 to 0.5 (correlation ±0.7), directions uniform in cos θ ∈ (0.02, 1]. Reported per batch;
 //! divide by 1024 for the per-call time.
 //!
-//! Run: `cargo bench --bench slope_gaussian -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
+//! Run: `cargo bench -p brdf-benches --bench slope_gaussian -- --warm-up-time 0.2 --measurement-time 0.5 --sample-size 10`
 
 use brdf::ndf::{Ndf, SlopeGaussian};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};

@@ -3,7 +3,7 @@
 # (C++, crate, C++, crate), printing ns per call (minimum and median over batches of 1024 calls).
 # Run from the crate root: `sh benches/cpp/run.sh [ROUNDS [BATCHES [POOL]]]` (default 5 1000 16;
 # POOL blocks of 1024 inputs, batch k on block k mod POOL; 1 repeats one block, see table_common.rs).
-# Not part of CI: needs g++; the crate side builds with `cargo bench --no-run`.
+# Not part of CI: needs g++; the crate side builds with `cargo bench -p brdf-benches --no-run`.
 # Before/after comparisons: set BEFORE_NDF and BEFORE_FRESNEL to bench binaries built from an older
 # `src/` (copied out of target/release/deps/ before rebuilding); each pass then runs C++, before,
 # crate, with the before rows labelled `before`.
@@ -14,7 +14,7 @@ POOL=${3:-16}
 OUT=target/cpp
 mkdir -p "$OUT"
 g++ -O3 -fno-math-errno -std=c++17 -o "$OUT/analytic" benches/cpp/analytic.cpp
-cargo bench --bench ndf --bench fresnel --no-run 2>/dev/null
+cargo bench -p brdf-benches --bench ndf --bench fresnel --no-run 2>/dev/null
 NDF=$(ls -t target/release/deps/ndf-* | grep -v '\.d$' | head -1)
 FRESNEL=$(ls -t target/release/deps/fresnel-* | grep -v '\.d$' | head -1)
 echo "# $(uptime)"

@@ -501,7 +501,8 @@ fn check_anisotropic_furnace(
 #[test]
 fn anisotropic_white_furnace_is_one() {
     // Extreme ratios both ways (1:100), moderate ones and pairs between the tables' α nodes;
-    // φo along both axes and between them; θo up to 85°.
+    // φo along the x axis and between the axes; θo at normal incidence, 70° and 85° (the y axis and
+    // 45° are in the ignored full grid).
     let pairs = [
         (0.01, 1.0),
         (1.0, 0.01),
@@ -510,8 +511,7 @@ fn anisotropic_white_furnace_is_one() {
         (0.013, 0.11),
         (0.7, 0.3),
     ];
-    let (over, under) =
-        check_anisotropic_furnace(&pairs, &[0.0, 45.0, 70.0, 85.0], &[0.0, 45.0, 90.0], 50_000);
+    let (over, under) = check_anisotropic_furnace(&pairs, &[0.0, 70.0, 85.0], &[0.0, 45.0], 50_000);
     eprintln!("anisotropic subset: max E − 1 = {over:.2e}, max 1 − E = {under:.2e}");
 }
 

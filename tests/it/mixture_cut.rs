@@ -235,71 +235,126 @@ fn identical_lobes_merge_at_once() {
     }
 }
 
-/// The cut against the full mixture on the four procedural maps (128²) at 1024 and 4096 texels,
-/// three centres each: at 64 nodes within the distances measured on 256² maps (docs/results.md:
-/// TV ≤ 0.11 on bumpy, brushed and scratched, ≤ 0.26 on flakes), with a margin of 0.04 for the
-/// estimate's noise (4096 draws: a few per cent of the TV) and the smaller map; and a larger cut is
-/// not farther (up to that noise).
+/// The cut against the full mixture on the four procedural maps (128²) at 1024 and 4096 texels:
+/// at 64 nodes within the distances measured on 256² maps (docs/results.md: TV ≤ 0.11 on bumpy,
+/// brushed and scratched, ≤ 0.26 on flakes), with a margin of 0.04 for the estimate's noise (4096
+/// draws: a few per cent of the TV) and the smaller map; and a larger cut is not farther (up to that
+/// noise). One footprint of 4096 texels per map (the defaults' cut starts there);
+/// [`close_to_the_full_mixture_every_centre`] takes three centres at each size.
 #[test]
 fn close_to_the_full_mixture() {
+    close_to_the_full_mixture_at(&[(4096.0, 1)]);
+}
+
+/// [`close_to_the_full_mixture`] at three centres per size:
+/// `cargo test --release --test it -- --ignored mixture_cut::close_to_the_full_mixture_every_centre`.
+#[test]
+#[ignore]
+fn close_to_the_full_mixture_every_centre() {
+    let cases: Vec<(f32, u64)> = [1024.0f32, 4096.0]
+        .into_iter()
+        .flat_map(|a| (0..3).map(move |c| (a, c)))
+        .collect();
+    close_to_the_full_mixture_at(&cases);
+}
+
+/// The distances of [`close_to_the_full_mixture`] at each (footprint area, centre index) of `cases`.
+fn close_to_the_full_mixture_at(cases: &[(f32, u64)]) {
     for (name, map) in support::procedural_maps(N) {
         let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
         let bound = if name == "flakes" { 0.30 } else { 0.15 };
-        for area in [1024.0f32, 4096.0] {
-            for c in 0..3 {
-                let centre = Vec2::new(0.17 + 0.31 * c as f32, 0.71 - 0.23 * c as f32);
-                let fp = Footprint::isotropic_texels(centre, area, N, N);
-                let full = mix.patch_with(&fp, &PatchOptions::full(), None);
-                let small = mix.patch_with(&fp, &cut_options(9), None);
-                let big = mix.patch_with(&fp, &cut_options(64), None);
-                let (tv9, _) = support::density_distances(&full, &small, 4096, 7 + c);
-                let (tv64, l2) = support::density_distances(&full, &big, 4096, 7 + c);
-                println!(
-                    "{name} {area} centre {c}: tv 9 nodes {tv9:.3}, 64 nodes {tv64:.3} (l2 {l2:.3})"
-                );
-                assert!(tv64 <= bound, "{name} {area} {c}: {tv64}");
-                assert!(tv64 <= tv9 + 0.03, "{name} {area} {c}: {tv64} > {tv9}");
-            }
+        for &(area, c) in cases {
+            let centre = Vec2::new(0.17 + 0.31 * c as f32, 0.71 - 0.23 * c as f32);
+            let fp = Footprint::isotropic_texels(centre, area, N, N);
+            let full = mix.patch_with(&fp, &PatchOptions::full(), None);
+            let small = mix.patch_with(&fp, &cut_options(9), None);
+            let big = mix.patch_with(&fp, &cut_options(64), None);
+            let (tv9, _) = support::density_distances(&full, &small, 4096, 7 + c);
+            let (tv64, l2) = support::density_distances(&full, &big, 4096, 7 + c);
+            println!(
+                "{name} {area} centre {c}: tv 9 nodes {tv9:.3}, 64 nodes {tv64:.3} (l2 {l2:.3})"
+            );
+            assert!(tv64 <= bound, "{name} {area} {c}: {tv64}");
+            assert!(tv64 <= tv9 + 0.03, "{name} {area} {c}: {tv64} > {tv9}");
         }
     }
 }
 
 /// Both samplers of a cut patch against their pdfs (chi-square; the harness's default cells) at a
-/// medium and a large footprint, on the white-noise map, at two views.
+/// large footprint, on the white-noise map, at a grazing view, for a cut of 16 nodes (the same code
+/// as the default 64, whose lobes make every pass 4× longer); [`chi_square_of_the_cut_sweep`] takes
+/// 64 nodes, a medium footprint and a second view.
 #[test]
 fn chi_square_of_the_cut() {
+    chi_square_of_the_cut_at(16, &[4096.0], &[75.0]);
+}
+
+/// [`chi_square_of_the_cut`] at 64 nodes, 64 and 4096 texels, θo 30° and 75°:
+/// `cargo test --release --test it -- --ignored mixture_cut::chi_square_of_the_cut_sweep`.
+#[test]
+#[ignore]
+fn chi_square_of_the_cut_sweep() {
+    chi_square_of_the_cut_at(64, &[64.0, 4096.0], &[30.0, 75.0]);
+}
+
+fn chi_square_of_the_cut_at(nodes: u32, areas: &[f32], thetas: &[f64]) {
     let map = support::mixture::noise(N, 4);
     let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
-    for area in [64.0f32, 4096.0] {
+    for &area in areas {
         let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.71), area, N, N);
-        let patch = mix.patch_with(&fp, &cut_options(64), None);
+        let patch = mix.patch_with(&fp, &cut_options(nodes), None);
         assert!(
             patch.few_lobes().count() > 8,
             "{}",
             patch.few_lobes().count()
         );
-        support::chi2_few_lobe_samplers(&patch, &format!("cut {area}"), &[30.0, 75.0]);
+        support::chi2_few_lobe_samplers(&patch, &format!("cut {area}"), thetas);
     }
 }
 
 /// White furnace in the renderer's measure (F = 1) of cut patches: the mean of `sample().weight()`
 /// ≤ 1 + 4 standard errors and equal to the quadrature of eval · cos θi, on a smooth and a sparse
-/// map, at a small and a large footprint.
+/// map, a small cut at a grazing view on one and a large cut at an oblique view on the other;
+/// [`furnace_of_the_cut_sweep`] takes both sizes at three views on both maps.
 #[test]
 fn furnace_of_the_cut() {
-    let mut rng = support::rng(9);
-    for (name, map) in support::procedural_maps(N).into_iter().step_by(2) {
-        let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
+    furnace_of_the_cut_at(&[(0, 16.0, 75.0), (1, 4096.0, 45.0)]);
+}
+
+/// [`furnace_of_the_cut`] at 16 and 4096 texels, θo 0°, 45° and 75°, on both maps:
+/// `cargo test --release --test it -- --ignored mixture_cut::furnace_of_the_cut_sweep`.
+#[test]
+#[ignore]
+fn furnace_of_the_cut_sweep() {
+    let mut cases = Vec::new();
+    for map in 0..2 {
         for area in [16.0f32, 4096.0] {
+            for theta in [0.0f64, 45.0, 75.0] {
+                cases.push((map, area, theta));
+            }
+        }
+    }
+    furnace_of_the_cut_at(&cases);
+}
+
+/// The furnaces of [`furnace_of_the_cut`] at each (map: 0 the first procedural map, 1 the third;
+/// footprint area; θo in degrees) of `cases`.
+fn furnace_of_the_cut_at(cases: &[(usize, f32, f64)]) {
+    let mut rng = support::rng(9);
+    for (i, (name, map)) in support::procedural_maps(N)
+        .into_iter()
+        .step_by(2)
+        .enumerate()
+    {
+        let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
+        for &(_, area, theta) in cases.iter().filter(|c| c.0 == i) {
             let fp = Footprint::isotropic_texels(Vec2::new(0.52, 0.28), area, N, N);
             let patch = mix.patch_with(&fp, &cut_options(64), None);
             assert!(patch.cut().is_some());
             let brdf = MicrofacetBrdf::new(&patch, NoFresnel);
-            for theta in [0.0f64, 45.0, 75.0] {
-                let wo = support::dir(theta, 30.0);
-                let label = format!("{name} {area} θo {theta}");
-                support::bxdf::assert_half_vector_furnace(&brdf, wo, 50_000, &mut rng, &label);
-            }
+            let wo = support::dir(theta, 30.0);
+            let label = format!("{name} {area} θo {theta}");
+            support::bxdf::assert_half_vector_furnace(&brdf, wo, 50_000, &mut rng, &label);
         }
     }
 }

@@ -428,13 +428,28 @@ fn spread_children(mix: &BeckmannMixture, nodes: &[((i64, i64), f64)], l: u32) -
 /// full mixture, TV(Σ W'_n M_n, full) — the node weights spread evenly over their lobes — is not
 /// bounded; it is printed (docs/mixture.md gives the measured values). At least four cases must
 /// pick a level ≥ 1 (otherwise the test would check nothing).
+///
+/// The default suite takes the 256-texel footprints;
+/// [`level_of_detail_respects_its_tolerance_at_1024_texels`] adds 1024.
 #[test]
 fn level_of_detail_respects_its_tolerance_at_its_resolution() {
+    level_of_detail_respects_its_tolerance_at(&[256.0]);
+}
+
+/// `cargo test --release --test it -- --ignored
+/// mixture_lod::level_of_detail_respects_its_tolerance_at_1024_texels`
+#[test]
+#[ignore]
+fn level_of_detail_respects_its_tolerance_at_1024_texels() {
+    level_of_detail_respects_its_tolerance_at(&[256.0, 1024.0]);
+}
+
+fn level_of_detail_respects_its_tolerance_at(areas: &[f32]) {
     let n = 64;
     let mut merged = 0;
     for (name, map) in support::procedural_maps(n) {
         let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
-        for area in [256.0f32, 1024.0] {
+        for &area in areas {
             let fp = Footprint::isotropic_texels(Vec2::new(0.43, 0.57), area, n, n);
             let full_p = mix.patch_with(
                 &fp,

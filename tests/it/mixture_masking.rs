@@ -58,12 +58,28 @@ fn proj(w: Vec3, s: [f64; 2]) -> f64 {
     w.z as f64 - w.x as f64 * s[0] - w.y as f64 * s[1]
 }
 
+/// The normalisation and Smith identities of every lobe of patches of 1, 16 and 256 texels, on every
+/// test map; [`normalisation_and_smith_identities_per_lobe_at_4096`] adds the 4096-texel patches
+/// (their thousands of lobes, each integrated on a 57² grid toward 8 directions, take half a minute).
 #[test]
 fn normalisation_and_smith_identities_per_lobe() {
+    normalisation_and_smith_identities_per_lobe_at(&AREAS[..3]);
+}
+
+/// [`normalisation_and_smith_identities_per_lobe`] at every footprint of `AREAS`:
+/// `cargo test --release --test it -- --ignored
+/// mixture_masking::normalisation_and_smith_identities_per_lobe_at_4096`.
+#[test]
+#[ignore]
+fn normalisation_and_smith_identities_per_lobe_at_4096() {
+    normalisation_and_smith_identities_per_lobe_at(&AREAS);
+}
+
+fn normalisation_and_smith_identities_per_lobe_at(areas: &[f32]) {
     let mut worst = [0.0f64; 3];
     for (name, map) in maps() {
         let mix = BeckmannMixture::build(&map, MixtureParams::default()).unwrap();
-        for area in AREAS {
+        for &area in areas {
             let patch = exact_patch(&mix, &footprint(area, Vec2::new(0.37, 0.61)));
             let (norm, err) = integrate_per_lobe(&patch, &|_| 1.0);
             // Trapezoid on whitened Gaussians: exponentially accurate (< 1e-9) + f32 P22 (1e-6).

@@ -124,8 +124,23 @@ fn check(name: &str, value: f64, err: f64, expected: f64, rel: f64) -> Option<St
         .then(|| format!("{name}: quadrature {value} ± {err}, expected {expected} (tol {tol:e})"))
 }
 
+/// The identities at normal incidence, 60° and 89°; [`hemisphere_identities_every_view`] adds 30°
+/// and 80° (`THETAS`).
 #[test]
 fn hemisphere_identities() {
+    hemisphere_identities_at(&[0.0, 60.0, 89.0]);
+}
+
+/// `cargo test --release --test it -- --ignored ndf_centred_integrals::hemisphere_identities_every_view`
+#[test]
+#[ignore]
+fn hemisphere_identities_every_view() {
+    hemisphere_identities_at(&THETAS);
+}
+
+/// ∫ D cos = 1 for every case, and at each view of `thetas` (degrees) the visible area, Smith's
+/// A(1 + Λ) and the visible pdf's integral.
+fn hemisphere_identities_at(thetas: &[f64]) {
     let cases = all_cases();
     let failures: Vec<String> = cases
         .par_iter()
@@ -140,7 +155,7 @@ fn hemisphere_identities() {
                 N_PHI,
             );
             out.extend(check(&format!("{} ∫D cos", case.name), v, e, 1.0, 1e-5));
-            for &theta in &THETAS {
+            for &theta in thetas {
                 let wo = support::dir(theta, if case.aniso { PHI_ANISO } else { 0.0 });
                 // ∫⟨wo, m⟩⁺ D dm = visible_area(wo) (= cos θ (1 + Λ) for Beckmann and GGX).
                 let (v, e) = support::quadrature::integrate_hemisphere(

@@ -58,8 +58,25 @@ fn patches_are_total() {
 /// the same code with resolved cells. Footprints of 16 and 64 texels; the BRDF sampler on the smooth
 /// map (on the white-noise map a few elements with large Jacobians put far Gaussian tails at
 /// grazing wi, where the harness's 6 × 6-node cell integrals of a ~10 σ tail are too coarse).
+///
+/// The default suite takes the normal sampler at 16 texels and the visible one at θo 70°;
+/// [`samplers_match_their_densities_sweep`] adds 64 texels and θo 30°.
 #[test]
 fn samplers_match_their_densities() {
+    samplers_match_their_densities_at(&[(16.0, 100)], &[70.0]);
+}
+
+/// `cargo test --release --test it -- --ignored position_normal_brdf::samplers_match_their_densities_sweep`
+#[test]
+#[ignore]
+fn samplers_match_their_densities_sweep() {
+    samplers_match_their_densities_at(&[(16.0, 100), (64.0, 50)], &[30.0, 70.0]);
+}
+
+/// The chi-squares of [`samplers_match_their_densities`]: the normal sampler at each (footprint
+/// area, cells along z) of `normal_cases`, the visible sampler at each θo of `thetas` (degrees), and
+/// the published BRDF's sampler.
+fn samplers_match_their_densities_at(normal_cases: &[(f32, usize)], thetas: &[f64]) {
     let map = noise(32, 0.4, 4);
     let pn = PositionNormalMap::build(
         &map,
@@ -75,7 +92,7 @@ fn samplers_match_their_densities() {
         res_phi: 2 * res_z,
         ..Chi2::new(name, family)
     };
-    for (area, res) in [(16.0f32, 100usize), (64.0, 50)] {
+    for &(area, res) in normal_cases {
         let fp = Footprint::isotropic_texels(Vec2::new(0.4, 0.6), area, 32, 32);
         let patch = pn.patch(&fp);
         chi(&format!("pn_normal_{area}"), res)
@@ -87,7 +104,7 @@ fn samplers_match_their_densities() {
     }
     let fp = Footprint::isotropic_texels(Vec2::new(0.4, 0.6), 16.0, 32, 32);
     let patch = pn.patch(&fp);
-    for theta in [30.0, 70.0] {
+    for &theta in thetas {
         let wo = support::dir(theta, 40.0);
         // 2·10⁵ draws on 50 × 100 cells (~40 per cell): the visible sampler and density cost
         // O(elements) per call each.

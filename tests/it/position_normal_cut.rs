@@ -68,14 +68,27 @@ fn served_where_the_options_say_and_bounded() {
     }
 }
 
-/// The cut against the exact element sum on the four procedural maps (128²) at 1024 and 4096
-/// texels: at 64 nodes within the distance this test measured (TV 0.04-0.11 on bumpy, brushed and
-/// scratched, 0.14-0.17 on flakes) plus 0.04 for the estimate's noise (4096 draws).
+/// The cut against the exact element sum on the four procedural maps (128²) at 1024 texels: at 64
+/// nodes within the distance this test measured (TV 0.04-0.11 on bumpy, brushed and scratched,
+/// 0.14-0.17 on flakes, at 1024 and 4096 texels) plus 0.04 for the estimate's noise (4096 draws);
+/// [`close_to_the_element_sum_at_4096`] adds 4096 texels (an element sum of seconds per map).
 #[test]
 fn close_to_the_element_sum() {
+    close_to_the_element_sum_at(&[1024.0]);
+}
+
+/// [`close_to_the_element_sum`] at 1024 and 4096 texels:
+/// `cargo test --release --test it -- --ignored position_normal_cut::close_to_the_element_sum_at_4096`.
+#[test]
+#[ignore]
+fn close_to_the_element_sum_at_4096() {
+    close_to_the_element_sum_at(&[1024.0, 4096.0]);
+}
+
+fn close_to_the_element_sum_at(areas: &[f32]) {
     for (name, map) in support::procedural_maps(N) {
         let pn = PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap();
-        for area in [1024.0f32, 4096.0] {
+        for &area in areas {
             let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.58), area, N, N);
             let full = pn.patch_with(&fp, &exact(), None);
             let cut = pn.patch_with(&fp, &cut_only(64), None);
@@ -87,19 +100,39 @@ fn close_to_the_element_sum() {
     }
 }
 
-/// Both samplers of a position-normal cut patch against their pdfs, and its white furnace in the
-/// renderer's measure.
+/// Both samplers of a position-normal cut patch against their pdfs at a grazing view, and its white
+/// furnace in the renderer's measure at an oblique one, for a cut of 16 nodes (the same code as the
+/// default 64, whose 256 lobes make each pass 4× longer);
+/// [`samplers_and_furnace_of_the_cut_sweep`] takes the default 64 nodes and a second view for each.
 #[test]
 fn samplers_and_furnace_of_the_cut() {
+    samplers_and_furnace_of_the_cut_at(16, &[75.0], &[60.0]);
+}
+
+/// [`samplers_and_furnace_of_the_cut`] at 64 nodes, the samplers at θo 30° and 75° and the furnace
+/// at 0° and 60°: `cargo test --release --test it -- --ignored
+/// position_normal_cut::samplers_and_furnace_of_the_cut_sweep`.
+#[test]
+#[ignore]
+fn samplers_and_furnace_of_the_cut_sweep() {
+    samplers_and_furnace_of_the_cut_at(64, &[30.0, 75.0], &[0.0, 60.0]);
+}
+
+fn samplers_and_furnace_of_the_cut_at(nodes: u32, chi2_thetas: &[f64], furnace_thetas: &[f64]) {
     let map = support::position_normal::noise(64, 0.3, 5);
     let pn = PositionNormalMap::build(&map, PositionNormalParams::default()).unwrap();
     let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.71), 2048.0, 64, 64);
-    let patch = pn.patch_with(&fp, &cut_only(64), None);
+    let patch = pn.patch_with(&fp, &cut_only(nodes), None);
+    assert!(
+        patch.weighted_lobes().count() > 4 * nodes as usize / 2,
+        "{} lobes",
+        patch.weighted_lobes().count()
+    );
     assert!(patch.cut().is_some());
-    support::chi2_few_lobe_samplers(&patch, "position-normal cut", &[30.0, 75.0]);
+    support::chi2_few_lobe_samplers(&patch, "position-normal cut", chi2_thetas);
     let brdf = MicrofacetBrdf::new(&patch, NoFresnel);
     let mut rng = support::rng(4);
-    for theta in [0.0f64, 60.0] {
+    for &theta in furnace_thetas {
         let wo = support::dir(theta, 30.0);
         support::bxdf::assert_half_vector_furnace(
             &brdf,

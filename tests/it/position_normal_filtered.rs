@@ -86,17 +86,39 @@ fn chi_square_of_the_filtered_mixture() {
 }
 
 /// White furnace in the renderer's measure (F = 1): the mean of `sample().weight()` ≤ 1 + 4
-/// standard errors and equal to the quadrature of eval · cos θi, on a smooth and a sparse map.
+/// standard errors and equal to the quadrature of eval · cos θi, on a smooth map at a grazing view
+/// and a sparse one at an oblique view; [`furnace_of_the_filtered_mixture_sweep`] takes three views
+/// on both.
 #[test]
 fn furnace_of_the_filtered_mixture() {
+    furnace_of_the_filtered_mixture_at(&[(0, 75.0), (1, 45.0)]);
+}
+
+/// [`furnace_of_the_filtered_mixture`] at θo 0°, 45° and 75° on both maps: `cargo test --release
+/// --test it -- --ignored position_normal_filtered::furnace_of_the_filtered_mixture_sweep`.
+#[test]
+#[ignore]
+fn furnace_of_the_filtered_mixture_sweep() {
+    let cases: Vec<(usize, f64)> = (0..2)
+        .flat_map(|m| [0.0, 45.0, 75.0].map(|t| (m, t)))
+        .collect();
+    furnace_of_the_filtered_mixture_at(&cases);
+}
+
+/// The furnaces at each (map: 0 the first procedural map, 1 the third; θo in degrees) of `cases`.
+fn furnace_of_the_filtered_mixture_at(cases: &[(usize, f64)]) {
     let mut rng = support::rng(8);
-    for (name, map) in support::procedural_maps(N).into_iter().step_by(2) {
+    for (i, (name, map)) in support::procedural_maps(N)
+        .into_iter()
+        .step_by(2)
+        .enumerate()
+    {
         let pn = build(&map);
         let fp = Footprint::isotropic_texels(Vec2::new(0.52, 0.28), 1024.0, N, N);
         let patch = pn.patch_with(&fp, &forced(), None);
         assert!(patch.is_filtered_mixture());
         let brdf = MicrofacetBrdf::new(&patch, NoFresnel);
-        for theta in [0.0f64, 45.0, 75.0] {
+        for &(_, theta) in cases.iter().filter(|c| c.0 == i) {
             let wo = support::dir(theta, 30.0);
             let label = format!("{name} θo {theta}");
             support::bxdf::assert_half_vector_furnace(&brdf, wo, 50_000, &mut rng, &label);

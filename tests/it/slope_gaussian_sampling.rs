@@ -215,8 +215,25 @@ impl Whitened {
     }
 }
 
+/// The visible sampler of every test lobe at normal incidence and at θo 60° and 89°, toward and away
+/// from the lobe's tilt; [`chi2_sample_visible_every_view`] adds 30° and 80°. Each test keeps the
+/// significance of the whole family of `CHI2_FAMILY`.
 #[test]
 fn chi2_sample_visible() {
+    chi2_sample_visible_at(&[60.0, 89.0]);
+}
+
+/// [`chi2_sample_visible`] at θo 0°, 30°, 60°, 80° and 89°:
+/// `cargo test --release --test it -- --ignored slope_gaussian_sampling::chi2_sample_visible_every_view`.
+#[test]
+#[ignore]
+fn chi2_sample_visible_every_view() {
+    chi2_sample_visible_at(&[30.0, 60.0, 80.0, 89.0]);
+}
+
+/// The visible sampler's chi-square of every test lobe at θo = 0 and at each of `thetas` (degrees),
+/// toward and away from the tilt.
+fn chi2_sample_visible_at(thetas: &[f64]) {
     let mut jobs = Vec::new();
     for (name, mean, sx, sy, rho) in chi2_params() {
         // Azimuths: toward the side the lobe is tilted to (the mean normal's azimuth, i.e. that of
@@ -232,12 +249,12 @@ fn chi2_sample_visible() {
             toward + 180.0
         };
         jobs.push((name.clone(), mean, sx, sy, rho, 0.0, 0.0));
-        for theta in [30.0, 60.0, 80.0, 89.0] {
+        for &theta in thetas {
             jobs.push((name.clone(), mean, sx, sy, rho, theta, toward));
             jobs.push((name.clone(), mean, sx, sy, rho, theta, away));
         }
     }
-    assert_eq!(jobs.len() + chi2_params().len(), CHI2_FAMILY);
+    assert!(jobs.len() + chi2_params().len() <= CHI2_FAMILY);
     let failures: Vec<String> = jobs
         .par_iter()
         .filter_map(|(name, mean, sx, sy, rho, theta, phi)| {
