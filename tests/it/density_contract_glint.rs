@@ -183,7 +183,10 @@ fn mixture_patches_keep_the_contract() {
 /// wo to `f32` precision (wo·h ~ 10⁻⁴⁴: its density interpolates ⟨wo, m⟩ bilinearly over each
 /// bin's corners), and the sample weights of both forms exceed their stated bounds (2 F
 /// unsmoothed, up to 8·10³ on the tilted map at 1,024 texels and 27 on bumpy at 4 texels; F
-/// smoothed, up to 1.2·10² on the tilted map). The full grid:
+/// smoothed, up to 1.2·10² on the tilted map), on back-scattered draws at grazing views: with exact
+/// terms the same bilinear ⟨wo, m⟩ stands in for the exact one, without them (1,024 texels on
+/// brushed, scratched and tilted) the visible sampler falls back to D cos θh (docs/bxdf.md, "The
+/// density contract"). The full grid:
 /// `cargo test --test it density_contract_glint:: -- --ignored --nocapture`.
 #[test]
 #[ignore = "open: bin map pdf 0 where eval > 0 at wo·h ~ 1e-44, weights above their bounds"]
