@@ -269,9 +269,8 @@ fn tv_rows(
 const TV_HEADER: &str = "| map | footprint (texels) | patch options | level full / compact | TV full | TV compact | ΔTV | TV full ↔ compact |\n|---|---|---|---|---|---|---|---|";
 
 /// The default-suite version of the table: 128² maps, 2.5·10⁵ truth positions, default patch
-/// options, every map at 256 texels (the bin masses of a 4096-texel patch cost seconds per map, and
-/// at the default options full storage serves its filtered mixture there, where the budget does not
-/// apply: 4096 texels are in the ignored table).
+/// options, every map at 256 texels (the bin masses of a 4096-texel patch cost seconds per map:
+/// 4096 texels are in the ignored table).
 #[test]
 fn compact_tv_change_is_within_0_002() {
     let rows = tv_rows(
