@@ -60,7 +60,7 @@ fn proj(w: Vec3, s: [f64; 2]) -> f64 {
 
 /// The normalisation and Smith identities of every lobe of patches of 1, 16 and 256 texels, on every
 /// test map; [`normalisation_and_smith_identities_per_lobe_at_4096`] adds the 4096-texel patches
-/// (their thousands of lobes, each integrated on a 57² grid toward 8 directions, take half a minute).
+/// (their thousands of lobes, each integrated on a 57² grid toward 8 directions, take 15-30 s).
 #[test]
 fn normalisation_and_smith_identities_per_lobe() {
     normalisation_and_smith_identities_per_lobe_at(&AREAS[..3]);
