@@ -174,6 +174,20 @@ pub fn assert_half_vector_furnace(
     mean
 }
 
+/// [`assert_half_vector_furnace`] with 50,000 draws at each θo of `thetas` (degrees, φo = 30°),
+/// each case named "`label` θo θ".
+pub fn assert_half_vector_furnaces(
+    b: &dyn Bxdf,
+    thetas: impl IntoIterator<Item = f64>,
+    rng: &mut impl rand::Rng,
+    label: &str,
+) {
+    for theta in thetas {
+        let wo = super::dir(theta, 30.0);
+        assert_half_vector_furnace(b, wo, 50_000, rng, &format!("{label} θo {theta}"));
+    }
+}
+
 /// Tolerance of a furnace comparison: 4 × the quadrature's error estimate (which overestimates the
 /// error of the finer rule, see `support::quadrature`) plus 1e-5 for the f32 rounding of the integrand
 /// (relative ~1e-7 per value, accumulated over a sum of positive terms).
