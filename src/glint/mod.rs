@@ -127,6 +127,7 @@ mod kernels;
 pub mod mixture;
 mod model;
 pub mod position_normal;
+pub mod procedural;
 mod scratch;
 #[cfg(feature = "serde")]
 mod serialize;
@@ -137,6 +138,7 @@ pub use binmap::{BinMap, BinMapPatch};
 pub use mixture::{BeckmannMixture, MixturePatch};
 pub use model::{GlintModel, GlintOptions, GlintPatch};
 pub use position_normal::{PositionNormalBrdf, PositionNormalMap, PositionNormalPatch};
+pub use procedural::{ProceduralGlints, ProceduralPatch};
 pub use scratch::GlintScratch;
 pub use surface::{
     BrushedParams, FlakesParams, Footprint, MAX_ANISOTROPY, MAX_CARVE_WORK_PER_TEXEL,

@@ -14,7 +14,9 @@
 
 use super::io::format::{Kind, Stored};
 use super::io::header;
-use super::{BeckmannMixture, BinMap, Footprint, GlintNdf, GlintScratch, PositionNormalMap};
+use super::{
+    BeckmannMixture, BinMap, Footprint, GlintNdf, GlintScratch, PositionNormalMap, ProceduralGlints,
+};
 use crate::error::{Error, Result};
 use crate::ndf::forward_ndf;
 use glam::Vec2;
@@ -197,6 +199,8 @@ glint_models! {
     BinMap(BinMap), bin_map, "bin map";
     /// The position-normal Gaussians of \[Yan2016\], the baseline ([`crate::glint::position_normal`]).
     PositionNormal(PositionNormalMap), position_normal, "position-normal";
+    /// Procedural glints without a normal map ([`crate::glint::procedural`]).
+    Procedural(ProceduralGlints), procedural, "procedural";
 }
 
 forward_ndf!(['a] GlintPatch<'a>, forward);

@@ -9,7 +9,9 @@
 //! Self-describing text formats (JSON) store the bytes as an array of numbers: correct, but ~4× the
 //! binary size; use a binary serde format or the files themselves for large maps.
 
-use crate::glint::{BeckmannMixture, BinMap, GlintModel, NormalMap, PositionNormalMap};
+use crate::glint::{
+    BeckmannMixture, BinMap, GlintModel, NormalMap, PositionNormalMap, ProceduralGlints,
+};
 use serde::de::{Deserializer, Error as _, SeqAccess, Visitor};
 use serde::ser::{Error as _, Serializer};
 use serde::{Deserialize, Serialize};
@@ -66,4 +68,5 @@ serde_via_file!(NormalMap, NormalMap::load);
 serde_via_file!(BeckmannMixture, BeckmannMixture::load);
 serde_via_file!(PositionNormalMap, PositionNormalMap::load);
 serde_via_file!(BinMap, BinMap::load);
+serde_via_file!(ProceduralGlints, ProceduralGlints::load);
 serde_via_file!(GlintModel, GlintModel::load);

@@ -285,6 +285,15 @@ impl SlopeGaussian {
         })
     }
 
+    /// The same lobe moved to mean `mean` (covariance unchanged); `None` if a component of `mean` is
+    /// not finite or exceeds [`MAX_SLOPE`] in magnitude.
+    #[cfg(feature = "std")]
+    #[inline]
+    pub(crate) fn with_mean(&self, mean: Vec2) -> Option<Self> {
+        (mean.x.abs() <= MAX_SLOPE && mean.y.abs() <= MAX_SLOPE)
+            .then_some(SlopeGaussian { mean, ..*self })
+    }
+
     /// The mean slope μ.
     #[inline]
     pub fn mean(&self) -> Vec2 {

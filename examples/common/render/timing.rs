@@ -14,6 +14,9 @@
 //!   above 128 texels take the masking of their moment lobe (O(1)) instead of their own bins;
 //! - conventional normal mapping for reference: `Material::NormalMapped` of GGX α = 0.02 (silver)
 //!   through the tilt adapter (the map's interpolated normal at the footprint's centre);
+//! - procedural glints (`ProceduralGlints`, no map): the Beckmann limit of the same α as the
+//!   analytic GGX, one facet per texel of a `map_size`² grid (the map's texels, so that the texels
+//!   per pixel are the same), facet roughness 0.02, silver Fresnel;
 //! - the mixture as a glint clear coat (dielectric Fresnel η = 1.5) over red Lambert paint
 //!   (`GlintMaterial::over_base`, a `LayeredBrdf`): its time against the plain mixture's is the
 //!   cost of the coat's first-bounce reflectance R̂(wo).
@@ -31,6 +34,7 @@ use brdf::fresnel::{ConductorFresnel, DielectricFresnel};
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::MixtureParams;
 use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::procedural::{ProceduralGlints, ProceduralParams};
 use brdf::glint::{
     BeckmannMixture, BinMap, Footprint, GlintModel, GlintOptions, NormalMap, NormalRepair,
     PositionNormalMap, ScratchedParams, TangentConvention, scratched,
@@ -321,6 +325,15 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         ],
         &mut || Ok(PositionNormalMap::build(&map, PositionNormalParams::default())?.into()),
     )?;
+    let procedural = timed_build(&["procedural glints"], &mut || {
+        let params = ProceduralParams {
+            alpha: Vec2::splat(alpha),
+            resolution: [n, n],
+            seed: opts.seed,
+            ..Default::default()
+        };
+        Ok(ProceduralGlints::new(params)?.into())
+    })?;
     println!(
         "builds ({n}² {what}, default parameters, wall time, with the measured errors of \
          the levels of detail):\n{builds}"
@@ -405,6 +418,7 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
             }),
         }),
         coat,
+        entry("procedural glints", &procedural),
     ];
     let entries: Vec<Entry> = all
         .into_iter()

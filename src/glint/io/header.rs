@@ -61,6 +61,8 @@ pub(crate) enum Kind {
     /// [`crate::glint::BeckmannMixture`] in compact storage
     /// ([`crate::glint::mixture::LobeStorage::Compact`]).
     BeckmannMixtureCompact = 5,
+    /// [`crate::glint::ProceduralGlints`].
+    ProceduralGlints = 6,
 }
 
 impl Kind {
@@ -71,6 +73,7 @@ impl Kind {
             3 => "PositionNormalMap".into(),
             4 => "BinMap".into(),
             5 => "BeckmannMixture (compact)".into(),
+            6 => "ProceduralGlints".into(),
             c => format!("unknown kind {c}"),
         }
     }

@@ -29,21 +29,34 @@ pub(crate) struct LobeSet {
     g: Vec<SlopeGaussian>,
     /// Slope boxes [min x, min y, max x, max y] (module docs).
     boxes: Vec<[f32; 4]>,
+    /// Per lobe, √(Σxx + Σyy) ≥ the largest standard deviation of its slope along any direction.
+    spread: Vec<f32>,
 }
 
 /// Mass of a lobe left outside its slope box: 10⁻⁶, the mixture's default slope tail.
 pub(crate) const BOX_TAIL: f64 = 1.0e-6;
 
-/// The slope box of `g` holding 1 − [`BOX_TAIL`] of it: mean ± k (√Σxx, √Σyy), k = √(−2 ln tail).
-fn slope_box(g: &SlopeGaussian) -> [f32; 4] {
-    let k = (-2.0 * BOX_TAIL.ln()).sqrt() as f32;
+/// k = √(−2 ln [`BOX_TAIL`]): a slope box's half-width in standard deviations.
+fn box_sigmas() -> f32 {
+    (-2.0 * BOX_TAIL.ln()).sqrt() as f32
+}
+
+/// The half-widths of the slope box of `g` holding 1 − [`BOX_TAIL`] of it: k (√Σxx, √Σyy),
+/// k = √(−2 ln tail).
+pub(crate) fn box_half_widths(g: &SlopeGaussian) -> Vec2 {
+    let k = box_sigmas();
     let c = g.covariance();
-    let (hx, hy) = (
+    Vec2::new(
         k * c.x_axis.x.max(0.0).sqrt(),
         k * c.y_axis.y.max(0.0).sqrt(),
-    );
+    )
+}
+
+/// The slope box of `g` holding 1 − [`BOX_TAIL`] of it: mean ± [`box_half_widths`].
+fn slope_box(g: &SlopeGaussian) -> [f32; 4] {
+    let h = box_half_widths(g);
     let m = g.mean();
-    [m.x - hx, m.y - hy, m.x + hx, m.y + hy]
+    [m.x - h.x, m.y - h.y, m.x + h.x, m.y + h.y]
 }
 
 /// What a few-lobe patch holds: one lobe inline, or a set lent by the caller's scratch.
@@ -64,6 +77,7 @@ impl LobeSet {
         self.w.clear();
         self.g.clear();
         self.boxes.clear();
+        self.spread.clear();
     }
 
     /// Adds a lobe of weight `w` (ignored unless `w` is positive and finite).
@@ -71,8 +85,33 @@ impl LobeSet {
         if w > 0.0 && w.is_finite() {
             self.w.push(w);
             self.g.push(g);
-            self.boxes.push(slope_box(&g));
+            let b = slope_box(&g);
+            let half = Vec2::new(0.5 * (b[2] - b[0]), 0.5 * (b[3] - b[1]));
+            self.boxes.push(b);
+            self.spread.push(half.length() / box_sigmas());
             self.n += 1;
+        }
+    }
+
+    /// Adds a lobe of weight `w` whose slope box (the box of [`BOX_TAIL`], as [`LobeSet::push`]
+    /// computes it) is mean ± `half` per axis: for many lobes of one shape, whose half-widths
+    /// [`box_half_widths`] computes once.
+    pub fn push_with_half_widths(&mut self, w: f32, g: SlopeGaussian, half: Vec2) {
+        if w > 0.0 && w.is_finite() {
+            let m = g.mean();
+            self.w.push(w);
+            self.g.push(g);
+            self.boxes
+                .push([m.x - half.x, m.y - half.y, m.x + half.x, m.y + half.y]);
+            self.spread.push(half.length() / box_sigmas());
+            self.n += 1;
+        }
+    }
+
+    /// Multiplies the weights of the lobes pushed from index `start` on by `factor`.
+    pub fn scale_from(&mut self, start: usize, factor: f32) {
+        for w in &mut self.w[start.min(self.n)..self.n] {
+            *w *= factor;
         }
     }
 
@@ -139,6 +178,20 @@ impl LobeSet {
 }
 
 impl LobeSet {
+    /// V_i(w) of lobe i, the number `SlopeGaussian::visible_area` returns: where the lobe lies
+    /// wholly in front of w (A_s > 8 s_w, checked with the bound s_w ≤ spread · |w_xy|), V_i = A_s
+    /// exactly, computed as that function computes it without its per-lobe square root.
+    #[inline]
+    fn lobe_visible_area(&self, i: usize, w: Vec3, w_xy: f32) -> f32 {
+        let m = self.g[i].mean();
+        let a_s = w.z as f64 - (m.x as f64 * w.x as f64 + m.y as f64 * w.y as f64);
+        if a_s > 8.0 * (self.spread[i] * w_xy) as f64 * (1.0 + 1e-6) {
+            crate::math::finite_or_zero(a_s)
+        } else {
+            self.g[i].visible_area(w)
+        }
+    }
+
     /// The lobe itself when the set is one lobe of weight 1 (every query then delegates to it,
     /// bit for bit).
     #[inline]
@@ -187,7 +240,13 @@ impl Ndf for LobeSet {
         if let Some(g) = self.single() {
             return g.visible_area(w);
         }
-        let v: f32 = self.iter().map(|(wi, g)| wi * g.visible_area(w)).sum();
+        if !(w.z > 0.0 && w.is_finite()) {
+            return 0.0;
+        }
+        let w_xy = Vec2::new(w.x, w.y).length();
+        let v: f32 = (0..self.n)
+            .map(|i| self.w[i] * self.lobe_visible_area(i, w, w_xy))
+            .sum();
         if v.is_finite() { v } else { 0.0 }
     }
 
@@ -208,7 +267,8 @@ impl Ndf for LobeSet {
         if !(wo.z > 0.0 && wo.is_finite()) {
             return self.sample_normal(u);
         }
-        match self.pick(|i| self.w[i] * self.g[i].visible_area(wo), u.x) {
+        let w_xy = Vec2::new(wo.x, wo.y).length();
+        match self.pick(|i| self.w[i] * self.lobe_visible_area(i, wo, w_xy), u.x) {
             Some((i, ux)) => self.g[i].sample_visible(wo, Vec2::new(ux, u.y)),
             None => self.sample_normal(u),
         }

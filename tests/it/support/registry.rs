@@ -9,6 +9,7 @@ use brdf::Vec2;
 use brdf::glint::binmap::{self, BinMapParams};
 use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams, PatchOptions};
 use brdf::glint::position_normal::{self, PositionNormalParams};
+use brdf::glint::procedural::{self, ProceduralGlints, ProceduralParams};
 use brdf::glint::{
     BeckmannMixture, BinMap, Footprint, GlintModel, GlintNdf, GlintOptions, NormalMap,
     PositionNormalMap,
@@ -90,6 +91,18 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
     };
     let position_normal =
         GlintModel::from(PositionNormalMap::build(map, PositionNormalParams::default()).unwrap());
+    // Procedural glints at the map's resolution (the surface does not read the map).
+    let procedural = GlintModel::from(
+        ProceduralGlints::new(ProceduralParams {
+            resolution: [map.width(), map.height()],
+            density: 4.0,
+            seed: 3,
+            ..ProceduralParams::default()
+        })
+        .unwrap(),
+    );
+    let mut loose = GlintOptions::default();
+    loose.procedural = procedural::PatchOptions { tolerance: 0.5 };
     let examples = vec![
         example(
             "mixture, exact masking",
@@ -123,6 +136,8 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
             position_normal,
             pn_filtered,
         ),
+        example("procedural", procedural.clone(), GlintOptions::default()),
+        example("procedural, tolerance 0.5", procedural, loose),
     ];
     for name in GlintModel::NAMES {
         assert!(

@@ -5,6 +5,7 @@ use super::format::reseal;
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{LobeStorage, MixtureParams, SeedKernel};
 use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::procedural::{ProceduralGlints, ProceduralParams};
 use brdf::glint::{BeckmannMixture, BinMap, NormalMap, PositionNormalMap};
 use brdf::{Error, Vec3};
 
@@ -71,6 +72,11 @@ pub fn small_files() -> Vec<(&'static str, Vec<u8>, fn(&[u8]) -> brdf::Result<()
         ..BinMapParams::default()
     };
     let bm = BinMap::build(&m, bm_params).unwrap();
+    let pg = ProceduralGlints::new(ProceduralParams {
+        seed: 5,
+        ..ProceduralParams::default()
+    })
+    .unwrap();
     vec![
         ("mixture", small_mixture_file(), |b| {
             load_mixture(b).map(drop)
@@ -86,6 +92,9 @@ pub fn small_files() -> Vec<(&'static str, Vec<u8>, fn(&[u8]) -> brdf::Result<()
         }),
         ("bin map", saved(|w| bm.save(w)), |b| {
             BinMap::load(&mut &b[..]).map(drop)
+        }),
+        ("procedural", saved(|w| pg.save(w)), |b| {
+            ProceduralGlints::load(&mut &b[..]).map(drop)
         }),
     ]
 }

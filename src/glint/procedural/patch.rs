@@ -1,0 +1,147 @@
+//! The patch of a footprint, [`ProceduralPatch`]: the lobes of the one or two lattice levels the
+//! footprint reads, weighted by its kernel, blended into the limit lobe as the footprint grows;
+//! every term of the [`Ndf`](crate::ndf::Ndf) exact over those lobes (src/glint/kernels/lobe_set.rs).
+
+use super::ProceduralGlints;
+use super::lattice::{CELL_SIGMAS, Kernel, gather_level};
+use super::params::PatchOptions;
+use crate::glint::kernels::lobe_set::{Few, LobeSet};
+use crate::glint::scratch::Lent;
+use crate::glint::{Footprint, GlintScratch};
+use crate::ndf::forward_ndf;
+
+/// The P-NDF of one footprint of a [`ProceduralGlints`] surface: an [`Ndf`](crate::ndf::Ndf) with
+/// D_P(m) = (1 − b) Σ_i w_i D_i(m) + b D_lim(m).
+///
+/// - The lobes D_i are those of the lattice level whose cells are 1-2 kernel standard deviations
+///   wide (the finer level l) and of the next coarser level, weighted (1 − t) and t by where the
+///   footprint's size falls between them (a trilinear filter over levels, so the P-NDF changes
+///   continuously with the footprint), each level's weights k(p_i) normalised over its lobes
+///   (src/glint/procedural/lattice.rs).
+/// - b blends in the limit lobe D_lim (the Beckmann NDF of the surface's α) as the footprint's
+///   expected relative L2 distance to it, ρ = √((σx σy / σ_f² − 1) / n) for the n = density ·
+///   4π √det Σ facets the kernel sees, falls from 2 · `tolerance` to `tolerance`: b = 1 (the limit
+///   lobe alone, one lobe) below `tolerance`.
+/// - Masking, densities and samplers are exact over the patch's lobes: V(w) = Σ w_i V_i(w), the
+///   signed projected area from the mean slope, `sample_visible` picks a lobe ∝ w_i V_i(wo) then its
+///   visible normal (density Σ w_i ⟨wo,m⟩⁺ D_i / V(wo)), as every glint patch of the crate.
+///
+/// Every lobe of every level has mean NDF D_lim, and the kernel weights do not depend on the
+/// lobes' slopes, so the mean of D_P over footprint positions is D_lim at every footprint size.
+#[derive(Clone, Debug)]
+pub struct ProceduralPatch<'a> {
+    few: Few<'a>,
+    level: f32,
+    limit_weight: f32,
+    distance: f32,
+}
+
+/// Binds the patch's lobes to `$n` (for [`forward_ndf`]).
+macro_rules! to_few {
+    ($s:ident, $n:ident => $e:expr) => {{
+        let $n = &$s.few;
+        $e
+    }};
+}
+
+forward_ndf!(['a] ProceduralPatch<'a>, to_few);
+
+impl ProceduralPatch<'_> {
+    /// The number of lobes the patch holds (the limit lobe included): at most a few tens, whatever
+    /// the footprint.
+    pub fn lobe_count(&self) -> usize {
+        match &self.few {
+            Few::None => 0,
+            Few::One(_) => 1,
+            Few::Set(s) => s.len(),
+        }
+    }
+
+    /// The continuous lattice level the footprint reads (0: one facet per cell; the patch holds the
+    /// levels ⌊level⌋ and ⌊level⌋ + 1).
+    pub fn level(&self) -> f32 {
+        self.level
+    }
+
+    /// The weight b of the limit lobe in the patch (0: facets only; 1: the limit NDF alone).
+    pub fn limit_weight(&self) -> f32 {
+        self.limit_weight
+    }
+
+    /// The expected relative L2 distance ρ of a patch of this footprint to the limit NDF
+    /// (what [`PatchOptions::tolerance`] is compared with).
+    pub fn expected_distance(&self) -> f32 {
+        self.distance
+    }
+}
+
+/// Builds the patch of `footprint` (the model's `patch_with`).
+pub(super) fn make_patch<'a>(
+    model: &'a ProceduralGlints,
+    footprint: &Footprint,
+    options: &PatchOptions,
+    scratch: Option<&'a GlintScratch>,
+) -> ProceduralPatch<'a> {
+    let p = &model.params;
+    let [width, height] = p.resolution;
+    let (c, cov) = footprint.gaussian_texels(width, height);
+    let levels = &model.levels;
+    let s0 = levels[0].spacing[0].max(levels[0].spacing[1]);
+    let kernel = Kernel::new(
+        [c.x as f64, c.y as f64],
+        [
+            cov.x_axis.x as f64,
+            cov.x_axis.y as f64,
+            cov.y_axis.y as f64,
+        ],
+        s0 * s0 / (CELL_SIGMAS * CELL_SIGMAS),
+    );
+    // ρ² = (σx σy / σ_f² − 1) / n, n = density · 4π √det Σ.
+    let n = p.density as f64
+        * 4.0
+        * std::f64::consts::PI
+        * (kernel.lambda[0] * kernel.lambda[1]).sqrt();
+    let ratio =
+        (p.alpha.x as f64 * p.alpha.y as f64) / (p.facet_alpha as f64 * p.facet_alpha as f64);
+    let distance = ((ratio - 1.0).max(0.0) / n).sqrt();
+    let tol = options.tolerance();
+    let b = ((2.0 * tol - distance) / tol).clamp(0.0, 1.0) as f32;
+    // The finer level: cells of CELL_SIGMAS/2 to CELL_SIGMAS minor standard deviations
+    // (x = log2(CELL_SIGMAS σ_minor / s0) ≥ 0).
+    let x = (CELL_SIGMAS * kernel.lambda[1].sqrt() / s0).log2().max(0.0);
+    let top = levels.len() - 1;
+    let (fine, t) = if x >= top as f64 {
+        (top, 0.0)
+    } else {
+        let f = x.floor();
+        (f as usize, (x - f) as f32)
+    };
+    let few = if b >= 1.0 {
+        Few::One(model.limit)
+    } else {
+        let mut set = Lent::<LobeSet>::new(scratch.map(|s| s.home()));
+        set.clear();
+        let lattice = 1.0 - b;
+        if t < 1.0 {
+            gather_level(levels, fine, p.seed, &kernel, lattice * (1.0 - t), &mut set);
+        }
+        if t > 0.0 {
+            gather_level(levels, fine + 1, p.seed, &kernel, lattice * t, &mut set);
+        }
+        if b > 0.0 {
+            set.push(b, model.limit);
+        }
+        set.normalise();
+        if set.len() == 0 {
+            Few::One(model.limit)
+        } else {
+            Few::Set(set)
+        }
+    };
+    ProceduralPatch {
+        few,
+        level: x as f32,
+        limit_weight: b,
+        distance: distance as f32,
+    }
+}
