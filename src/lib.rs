@@ -2,7 +2,8 @@
 //!
 //! BRDF math and glint normal distribution functions for renderers: Fresnel, analytic NDFs, classic
 //! and microfacet BRDFs, and glints (the sparkle of scratched, brushed and flaky metal) from a
-//! high-definition normal map through one of three glint models.
+//! high-definition normal map through one of three glint models, or without a map from procedural
+//! glints ([`glint::procedural`]).
 //!
 //! ## Quick start
 //!

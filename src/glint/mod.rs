@@ -13,8 +13,10 @@
 //! - **Models**, each a public module that owns its build parameters, its per-query options and its
 //!   `DEFAULT_*` constants: [`mixture`] (the Beckmann mixture of \[Chermain2019\]), [`binmap`] (the
 //!   inverse bin map of \[Atanasov2020\]), [`position_normal`] (the position-normal Gaussians of
-//!   \[Yan2016\], the baseline). Their model and patch types are re-exported here, with
-//!   [`GlintModel`], which holds any of them at run time.
+//!   \[Yan2016\], the baseline); without a normal map, [`procedural`] (glints from a seed and a
+//!   facet density, converging to a Beckmann NDF, in bounded time per footprint: docs/procedural.md).
+//!   Their model and patch types are re-exported here, with [`GlintModel`], which holds any of them
+//!   at run time.
 //! - **Inputs** (re-exported here): [`NormalMap`] and the procedural maps, image decoding,
 //!   [`Footprint`].
 //! - **Truths** (re-exported here): [`binned_pndf`], [`convolved_pndf`], [`tv_distance`],

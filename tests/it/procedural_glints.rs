@@ -270,11 +270,12 @@ fn furnace_is_at_most_one() {
 }
 
 /// Bounded work: the patch holds at most 48 lobes at every footprint size, aspect ratio and
-/// orientation (the lobes visited by every query), from a hundredth of a texel to many map periods.
+/// orientation (the lobes visited by every query), from a hundredth of a texel to many map periods,
+/// at densities from about one facet per uv period to 64 per texel.
 #[test]
 fn every_patch_holds_few_lobes() {
     let mut rng = support::rng(21);
-    for density in [0.01f32, 1.0, 64.0] {
+    for density in [1e-6f32, 0.01, 1.0, 64.0] {
         let s = ProceduralGlints::new(ProceduralParams {
             density,
             ..ProceduralParams::default()
@@ -282,7 +283,7 @@ fn every_patch_holds_few_lobes() {
         .unwrap();
         let mut most = 0;
         for _ in 0..4000 {
-            let area = 10f32.powf(rng.random_range(-2.0..8.0));
+            let area = 10f32.powf(rng.random_range(-2.0..12.0));
             let aspect = 10f32.powf(rng.random_range(0.0..3.0));
             let angle = rng.random_range(0.0..std::f32::consts::PI);
             let uv = Vec2::new(rng.random(), rng.random());

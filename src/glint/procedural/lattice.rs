@@ -144,13 +144,15 @@ pub(super) struct Kernel {
 }
 
 impl Kernel {
-    /// The kernel of a footprint Gaussian (centre, covariance xx, xy, yy), its minor variance raised
-    /// to at least λ1 / [`MAX_ANISOTROPY`]² and both to at least `floor`.
-    pub fn new(center: [f64; 2], cov: [f64; 3], floor: f64) -> Kernel {
+    /// The kernel of a footprint Gaussian (centre, covariance xx, xy, yy), its major variance
+    /// lowered to at most `ceiling` (a footprint wider than the pattern's period averages the
+    /// period), its minor variance raised to at least λ1 / [`MAX_ANISOTROPY`]², both to at least
+    /// `floor`.
+    pub fn new(center: [f64; 2], cov: [f64; 3], floor: f64, ceiling: f64) -> Kernel {
         let [sxx, sxy, syy] = cov;
         let half_tr = 0.5 * (sxx + syy);
         let d = (0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy).sqrt();
-        let l1 = (half_tr + d).max(floor);
+        let l1 = (half_tr + d).min(ceiling).max(floor);
         let l2 = (half_tr - d)
             .max(l1 / (MAX_ANISOTROPY * MAX_ANISOTROPY))
             .max(floor);

@@ -115,6 +115,13 @@ impl GlintNdf for ProceduralGlints {
         options: &PatchOptions,
         scratch: Option<&'a GlintScratch>,
     ) -> ProceduralPatch<'a> {
-        patch::make_patch(self, footprint, options, scratch)
+        patch::make_patch(
+            &self.params,
+            &self.levels,
+            self.limit,
+            footprint,
+            options,
+            scratch,
+        )
     }
 }

@@ -2,15 +2,14 @@
 //! footprint reads, weighted by its kernel, blended into the limit lobe as the footprint grows;
 //! every term of the [`Ndf`](crate::ndf::Ndf) exact over those lobes (src/glint/kernels/lobe_set.rs).
 
-use super::ProceduralGlints;
-use super::lattice::{CELL_SIGMAS, Kernel, gather_level};
-use super::params::PatchOptions;
+use super::lattice::{CELL_SIGMAS, Kernel, Level, gather_level};
+use super::params::{PatchOptions, ProceduralParams};
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::scratch::Lent;
 use crate::glint::{Footprint, GlintScratch};
-use crate::ndf::forward_ndf;
+use crate::ndf::{SlopeGaussian, forward_ndf};
 
-/// The P-NDF of one footprint of a [`ProceduralGlints`] surface: an [`Ndf`](crate::ndf::Ndf) with
+/// The P-NDF of one footprint of a [`ProceduralGlints`](super::ProceduralGlints) surface: an [`Ndf`](crate::ndf::Ndf) with
 /// D_P(m) = (1 − b) Σ_i w_i D_i(m) + b D_lim(m).
 ///
 /// - The lobes D_i are those of the lattice level whose cells are 1-2 kernel standard deviations
@@ -75,17 +74,18 @@ impl ProceduralPatch<'_> {
     }
 }
 
-/// Builds the patch of `footprint` (the model's `patch_with`).
+/// Builds the patch of `footprint` on the surface of parameters `p`, levels `levels` and limit
+/// lobe `limit` (the model's `patch_with`).
 pub(super) fn make_patch<'a>(
-    model: &'a ProceduralGlints,
+    p: &ProceduralParams,
+    levels: &[Level],
+    limit: SlopeGaussian,
     footprint: &Footprint,
     options: &PatchOptions,
     scratch: Option<&'a GlintScratch>,
 ) -> ProceduralPatch<'a> {
-    let p = &model.params;
     let [width, height] = p.resolution;
     let (c, cov) = footprint.gaussian_texels(width, height);
-    let levels = &model.levels;
     let s0 = levels[0].spacing[0].max(levels[0].spacing[1]);
     let kernel = Kernel::new(
         [c.x as f64, c.y as f64],
@@ -95,6 +95,7 @@ pub(super) fn make_patch<'a>(
             cov.y_axis.y as f64,
         ],
         s0 * s0 / (CELL_SIGMAS * CELL_SIGMAS),
+        (width.min(height) as f64).powi(2),
     );
     // ρ² = (σx σy / σ_f² − 1) / n, n = density · 4π √det Σ.
     let n = p.density as f64
@@ -117,7 +118,7 @@ pub(super) fn make_patch<'a>(
         (f as usize, (x - f) as f32)
     };
     let few = if b >= 1.0 {
-        Few::One(model.limit)
+        Few::One(limit)
     } else {
         let mut set = Lent::<LobeSet>::new(scratch.map(|s| s.home()));
         set.clear();
@@ -129,11 +130,11 @@ pub(super) fn make_patch<'a>(
             gather_level(levels, fine + 1, p.seed, &kernel, lattice * t, &mut set);
         }
         if b > 0.0 {
-            set.push(b, model.limit);
+            set.push(b, limit);
         }
         set.normalise();
         if set.len() == 0 {
-            Few::One(model.limit)
+            Few::One(limit)
         } else {
             Few::Set(set)
         }
