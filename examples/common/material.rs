@@ -59,8 +59,8 @@ pub fn binmap_sigma(map: &BinMap, options: &BinMapOptions) -> f32 {
 }
 
 /// The slope σ of the material a [`GlintModel`] renders with `options`, read from the built model
-/// (the mixture's lobe floor, the position-normal elements' σ_r) or from one of its patches (the bin
-/// map's smoothing lobes).
+/// (the mixture's lobe floor, the position-normal elements' σ_r, the procedural facets' α_f/√2) or
+/// from one of its patches (the bin map's smoothing lobes).
 pub fn model_sigma(model: &GlintModel, options: &GlintOptions) -> f32 {
     let fp = Footprint::isotropic_texels(Vec2::splat(0.5), 4.0, 64, 64);
     let scratch = GlintScratch::default();
@@ -74,6 +74,10 @@ pub fn model_sigma(model: &GlintModel, options: &GlintOptions) -> f32 {
             .map_or(0.0, |a| a / std::f32::consts::SQRT_2),
         GlintPatch::PositionNormal(_) => match model {
             GlintModel::PositionNormal(m) => m.params().sigma_r,
+            _ => f32::NAN,
+        },
+        GlintPatch::Procedural(_) => match model {
+            GlintModel::Procedural(m) => m.params().facet_alpha / std::f32::consts::SQRT_2,
             _ => f32::NAN,
         },
         _ => f32::NAN,
