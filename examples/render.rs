@@ -12,7 +12,7 @@
 //! procedural glints, no normal map, over dark blue paint). `--quick` is the gallery's small, fast
 //! setting.
 //!
-//! `--timing` instead measures frame times: analytic GGX, the three glint models at their defaults
+//! `--timing` instead measures frame times: analytic GGX, the four glint models at their defaults
 //! and conventional normal mapping on one scratched map at three map scales, alternating, and writes
 //! `render_timing.csv` (examples/common/render/timing.rs). See docs/render.md.
 
