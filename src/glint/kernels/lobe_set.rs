@@ -108,13 +108,6 @@ impl LobeSet {
         }
     }
 
-    /// Multiplies the weights of the lobes pushed from index `start` on by `factor`.
-    pub fn scale_from(&mut self, start: usize, factor: f32) {
-        for w in &mut self.w[start.min(self.n)..self.n] {
-            *w *= factor;
-        }
-    }
-
     /// Scales the weights to sum to 1 (an empty set stays empty).
     pub fn normalise(&mut self) {
         let sum: f32 = self.weights().iter().sum();

@@ -12,11 +12,6 @@
 //! from N(0, σ² − σ_f²) (docs/procedural.md, "Levels"):
 //! 1/β_l² = 1/σ² + (1/σ_f² − 1/σ²) / n_l.
 
-use crate::error::Result;
-use crate::glint::kernels::lobe_set::{LobeSet, box_half_widths};
-use crate::ndf::SlopeGaussian;
-use glam::{Mat2, Vec2};
-
 use super::params::ProceduralParams;
 
 /// Kernel truncation radius, in Mahalanobis units: lobes with q = dᵀ Σ⁻¹ d ≥ R² weigh 0.
@@ -40,21 +35,13 @@ pub(super) struct Level {
     /// Cell sides in texels along u and v: resolution / cells (equal up to the rounding of the
     /// cell counts).
     pub spacing: [f64; 2],
-    /// The lobes' shared shape: centred, slope standard deviation β_l per axis.
-    pub shape: SlopeGaussian,
-    /// Standard deviation of the lobes' means per axis, τ_l = √(σ² − β_l²).
-    pub tau: [f32; 2],
-    /// The half-widths of the lobes' slope boxes (src/glint/kernels/lobe_set.rs).
-    pub half: Vec2,
 }
 
 /// The levels of a surface, from level 0 (about one facet per cell) up to the level of one cell per
 /// uv period.
-pub(super) fn levels(p: &ProceduralParams) -> Result<Vec<Level>> {
+pub(super) fn levels(p: &ProceduralParams) -> Vec<Level> {
     let res = p.resolution.map(|r| r as f64);
     let n0 = res.map(|r| (r * (p.density as f64).sqrt()).round().max(1.0));
-    let sigma = [p.alpha.x as f64, p.alpha.y as f64].map(|a| a / std::f64::consts::SQRT_2);
-    let sigma_f = p.facet_alpha as f64 / std::f64::consts::SQRT_2;
     let mut out: Vec<Level> = Vec::new();
     let mut l = 0i32;
     loop {
@@ -63,29 +50,24 @@ pub(super) fn levels(p: &ProceduralParams) -> Result<Vec<Level>> {
             break;
         }
         let spacing = [0, 1].map(|a| res[a] / cells[a] as f64);
-        let facets = (p.density as f64 * spacing[0] * spacing[1]).max(1.0);
-        let beta2 = sigma.map(|s| {
-            let inv = 1.0 / (s * s) + (1.0 / (sigma_f * sigma_f) - 1.0 / (s * s)) / facets;
-            1.0 / inv
-        });
-        let shape = SlopeGaussian::new(
-            Vec2::ZERO,
-            Mat2::from_diagonal(Vec2::new(beta2[0] as f32, beta2[1] as f32)),
-        )?;
-        let tau = [0, 1].map(|a| (sigma[a] * sigma[a] - beta2[a]).max(0.0).sqrt() as f32);
-        out.push(Level {
-            cells,
-            spacing,
-            shape,
-            tau,
-            half: box_half_widths(&shape),
-        });
+        out.push(Level { cells, spacing });
         if cells == [1, 1] {
             break;
         }
         l += 1;
     }
-    Ok(out)
+    out
+}
+
+/// The lobes' shared width: per axis 1/β² = 1/σ² + r (1/σ_f² − 1/σ²) with r = min(1, K/n), for a
+/// patch whose kernel weights have the effective count K = 1/Σ w_i² and whose footprint holds n
+/// facets (docs/procedural.md, "Lobe widths"): (β², τ² = σ² − β²) per axis.
+pub(super) fn lobe_widths(sigma: [f64; 2], sigma_f: f64, r: f64) -> ([f64; 2], [f64; 2]) {
+    let r = r.clamp(0.0, 1.0);
+    let beta2 =
+        sigma.map(|s| 1.0 / (1.0 / (s * s) + r * (1.0 / (sigma_f * sigma_f) - 1.0 / (s * s))));
+    let tau2 = [0, 1].map(|a| (sigma[a] * sigma[a] - beta2[a]).max(0.0));
+    (beta2, tau2)
 }
 
 /// The SplitMix64 finaliser (Steele et al. 2014): a bijective mix of 64 bits.
@@ -204,19 +186,40 @@ impl Kernel {
     }
 }
 
-/// Pushes the lobes of `level` under `kernel` into `set`, their weights
+/// The lobes a patch gathers before their width is known: kernel weight and standard-normal mean
+/// coordinates, at most [`Candidates::CAPACITY`] (on the stack: a patch allocates nothing).
+pub(super) struct Candidates {
+    pub len: usize,
+    pub w: [f32; Candidates::CAPACITY],
+    pub z: [[f32; 2]; Candidates::CAPACITY],
+}
+
+impl Candidates {
+    /// More than a patch can gather (two levels of at most ~20 lobes each within the kernel's
+    /// ellipse; `procedural_glints::every_patch_holds_few_lobes`).
+    pub const CAPACITY: usize = 128;
+
+    pub fn new() -> Candidates {
+        Candidates {
+            len: 0,
+            w: [0.0; Candidates::CAPACITY],
+            z: [[0.0; 2]; Candidates::CAPACITY],
+        }
+    }
+}
+
+/// Adds the lobes of `level` under `kernel` to `out`, their weights
 /// k(p) = exp(−q/2) − exp(−R²/2) (q < R², continuous at the truncation) normalised over the level
-/// and scaled by `scale`; returns how many were pushed. The kernel is floored at the level's cell:
-/// both its standard deviations at least half a cell, so that a cell's lobe always lies within
-/// R of the centre.
+/// and scaled by `scale`. The kernel is floored at the level's cell: both its standard deviations at
+/// least half a cell, so that a cell's lobe always lies within R of the centre.
 pub(super) fn gather_level(
     levels: &[Level],
     index: usize,
     seed: u64,
     kernel: &Kernel,
     scale: f32,
-    set: &mut LobeSet,
-) -> usize {
+    out: &mut Candidates,
+) {
     let level = &levels[index];
     let [s, t] = level.spacing;
     let kernel = kernel.floored(0.25 * s.max(t) * s.max(t));
@@ -238,7 +241,7 @@ pub(super) fn gather_level(
     // A cell whose rectangle is farther than R major standard deviations from the centre holds no
     // lobe of the ellipse (its Mahalanobis distance is at least its distance over σ_major).
     let far2 = r2 * kernel.lambda[0];
-    let start = set.len();
+    let start = out.len;
     let mut sum = 0.0f64;
     for j in j0..=j1 {
         let (y0, y1) = (j as f64 * t - cy, (j + 1) as f64 * t - cy);
@@ -258,7 +261,7 @@ pub(super) fn gather_level(
             } else {
                 0.0
             };
-            if nx * nx + ny * ny >= far2 {
+            if nx * nx + ny * ny >= far2 || out.len == Candidates::CAPACITY {
                 continue;
             }
             let (wi, wj) = (i.rem_euclid(cells_u) as u32, j.rem_euclid(cells_v) as u32);
@@ -271,17 +274,18 @@ pub(super) fn gather_level(
                 continue;
             }
             let w = ((-0.5 * q) as f32).exp() - edge;
-            let z = mean_z(h);
-            let mean = Vec2::new(level.tau[0] * z[0], level.tau[1] * z[1]);
-            if let Some(g) = level.shape.with_mean(mean) {
-                set.push_with_half_widths(w, g, level.half);
+            if w > 0.0 {
+                out.w[out.len] = w;
+                out.z[out.len] = mean_z(h);
+                out.len += 1;
                 sum += w as f64;
             }
         }
     }
-    let pushed = set.len() - start;
     if sum > 0.0 {
-        set.scale_from(start, (scale as f64 / sum) as f32);
+        let f = (scale as f64 / sum) as f32;
+        for w in &mut out.w[start..out.len] {
+            *w *= f;
+        }
     }
-    pushed
 }

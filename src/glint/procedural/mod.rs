@@ -72,7 +72,7 @@ impl ProceduralGlints {
     /// ([`ProceduralParams::validate`]).
     pub fn new(params: ProceduralParams) -> Result<Self> {
         params.validate()?;
-        let levels = lattice::levels(&params)?;
+        let levels = lattice::levels(&params);
         let limit = SlopeGaussian::beckmann(params.alpha.x, params.alpha.y)?;
         Ok(ProceduralGlints {
             params,

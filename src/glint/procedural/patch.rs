@@ -2,31 +2,36 @@
 //! footprint reads, weighted by its kernel, blended into the limit lobe as the footprint grows;
 //! every term of the [`Ndf`](crate::ndf::Ndf) exact over those lobes (src/glint/kernels/lobe_set.rs).
 
-use super::lattice::{CELL_SIGMAS, Kernel, Level, gather_level};
+use super::lattice::{CELL_SIGMAS, Candidates, Kernel, Level, gather_level, lobe_widths};
 use super::params::{PatchOptions, ProceduralParams};
-use crate::glint::kernels::lobe_set::{Few, LobeSet};
+use crate::glint::kernels::lobe_set::{Few, LobeSet, box_half_widths};
 use crate::glint::scratch::Lent;
 use crate::glint::{Footprint, GlintScratch};
 use crate::ndf::{SlopeGaussian, forward_ndf};
+use glam::{Mat2, Vec2};
 
-/// The P-NDF of one footprint of a [`ProceduralGlints`](super::ProceduralGlints) surface: an [`Ndf`](crate::ndf::Ndf) with
-/// D_P(m) = (1 − b) Σ_i w_i D_i(m) + b D_lim(m).
+/// The P-NDF of one footprint of a [`ProceduralGlints`](super::ProceduralGlints) surface: an
+/// [`Ndf`](crate::ndf::Ndf) with D_P(m) = (1 − b) Σ_i w_i D_i(m) + b D_lim(m).
 ///
-/// - The lobes D_i are those of the lattice level whose cells are 1-2 kernel standard deviations
+/// - The lobes D_i are those of the lattice level whose cells are 1.5-3 kernel standard deviations
 ///   wide (the finer level l) and of the next coarser level, weighted (1 − t) and t by where the
 ///   footprint's size falls between them (a trilinear filter over levels, so the P-NDF changes
 ///   continuously with the footprint), each level's weights k(p_i) normalised over its lobes
 ///   (src/glint/procedural/lattice.rs).
-/// - b blends in the limit lobe D_lim (the Beckmann NDF of the surface's α) as the footprint's
-///   expected relative L2 distance to it, ρ = √((σx σy / σ_f² − 1) / n) for the n = density ·
-///   4π √det Σ facets the kernel sees, falls from 2 · `tolerance` to `tolerance`: b = 1 (the limit
-///   lobe alone, one lobe) below `tolerance`.
+/// - All lobes share one width β: each stands for n / K facets, n = density · 4π √det Σ those the
+///   footprint holds and K = (Σ w)² / Σ w² the lobes the kernel effectively sees, so
+///   1/β² = 1/σ² + min(1, K/n) (1/σ_f² − 1/σ²) per axis and the patch is as far from the limit, in
+///   expected L2, as n facets of roughness σ_f are; its means are z τ with τ² = σ² − β².
+/// - b blends in the limit lobe D_lim (the Beckmann NDF of the surface's α) as that expected
+///   relative L2 distance, ρ = √((σx σy / (βx βy) − 1) / K), falls from 2 · `tolerance` to
+///   `tolerance`: b = 1 (the limit lobe alone, one lobe) below `tolerance`.
 /// - Masking, densities and samplers are exact over the patch's lobes: V(w) = Σ w_i V_i(w), the
 ///   signed projected area from the mean slope, `sample_visible` picks a lobe ∝ w_i V_i(wo) then its
 ///   visible normal (density Σ w_i ⟨wo,m⟩⁺ D_i / V(wo)), as every glint patch of the crate.
 ///
-/// Every lobe of every level has mean NDF D_lim, and the kernel weights do not depend on the
-/// lobes' slopes, so the mean of D_P over footprint positions is D_lim at every footprint size.
+/// Every lobe has mean NDF D_lim (β² + τ² = σ², with β, τ depending on the footprint only), and the
+/// kernel weights do not depend on the lobes' slopes, so the mean of D_P over the random field is
+/// D_lim at every footprint size.
 #[derive(Clone, Debug)]
 pub struct ProceduralPatch<'a> {
     few: Few<'a>,
@@ -97,19 +102,29 @@ pub(super) fn make_patch<'a>(
         s0 * s0 / (CELL_SIGMAS * CELL_SIGMAS),
         (width.min(height) as f64).powi(2),
     );
-    // ρ² = (σx σy / σ_f² − 1) / n, n = density · 4π √det Σ.
+    // The facets the footprint holds, n = density · 4π √det Σ (the effective count of a Gaussian
+    // kernel), and the distance to the limit of n facets, ρ² = (σx σy / σ_f² − 1) / n.
     let n = p.density as f64
         * 4.0
         * std::f64::consts::PI
         * (kernel.lambda[0] * kernel.lambda[1]).sqrt();
-    let ratio =
-        (p.alpha.x as f64 * p.alpha.y as f64) / (p.facet_alpha as f64 * p.facet_alpha as f64);
-    let distance = ((ratio - 1.0).max(0.0) / n).sqrt();
+    let sigma = [p.alpha.x as f64, p.alpha.y as f64].map(|a| a / std::f64::consts::SQRT_2);
+    let sigma_f = p.facet_alpha as f64 / std::f64::consts::SQRT_2;
+    let ratio = sigma[0] * sigma[1] / (sigma_f * sigma_f);
     let tol = options.tolerance();
-    let b = ((2.0 * tol - distance) / tol).clamp(0.0, 1.0) as f32;
+    let footprint_distance = ((ratio - 1.0).max(0.0) / n).sqrt();
     // The finer level: cells of CELL_SIGMAS/2 to CELL_SIGMAS minor standard deviations
     // (x = log2(CELL_SIGMAS σ_minor / s0) ≥ 0).
     let x = (CELL_SIGMAS * kernel.lambda[1].sqrt() / s0).log2().max(0.0);
+    if footprint_distance <= tol {
+        // The patch's own distance is at most this one: the limit lobe alone.
+        return ProceduralPatch {
+            few: Few::One(limit),
+            level: x as f32,
+            limit_weight: 1.0,
+            distance: footprint_distance as f32,
+        };
+    }
     let top = levels.len() - 1;
     let (fine, t) = if x >= top as f64 {
         (top, 0.0)
@@ -117,17 +132,49 @@ pub(super) fn make_patch<'a>(
         let f = x.floor();
         (f as usize, (x - f) as f32)
     };
+    let mut cand = Candidates::new();
+    if t < 1.0 {
+        gather_level(levels, fine, p.seed, &kernel, 1.0 - t, &mut cand);
+    }
+    if t > 0.0 {
+        gather_level(levels, fine + 1, p.seed, &kernel, t, &mut cand);
+    }
+    let weights = &cand.w[..cand.len];
+    let sum: f64 = weights.iter().map(|&w| w as f64).sum();
+    let sum2: f64 = weights.iter().map(|&w| (w as f64) * (w as f64)).sum();
+    // The kernel's effective lobe count K = (Σ w)² / Σ w²; each lobe stands for n / K facets.
+    let k = if sum2 > 0.0 { sum * sum / sum2 } else { 1.0 };
+    let (beta2, tau2) = lobe_widths(sigma, sigma_f, k / n);
+    let shape = SlopeGaussian::new(
+        Vec2::ZERO,
+        Mat2::from_diagonal(Vec2::new(beta2[0] as f32, beta2[1] as f32)),
+    );
+    let (Ok(shape), true) = (shape, cand.len > 0) else {
+        return ProceduralPatch {
+            few: Few::One(limit),
+            level: x as f32,
+            limit_weight: 1.0,
+            distance: 0.0,
+        };
+    };
+    // The patch's expected distance: ρ² = Σ (w_i/Σw)² (σx σy / (βx βy) − 1).
+    let distance = ((sigma[0] * sigma[1] / (beta2[0] * beta2[1]).sqrt() - 1.0).max(0.0) / k).sqrt();
+    let b = ((2.0 * tol - distance) / tol).clamp(0.0, 1.0) as f32;
     let few = if b >= 1.0 {
         Few::One(limit)
     } else {
+        let tau = tau2.map(|v| v.sqrt() as f32);
+        // Slope boxes holding 1 − 10⁻¹² of each lobe (√2 × the half-widths of the shared 10⁻⁶
+        // tail): the facet lobes are narrow and many, and a sampler's draws beyond a box (where D
+        // is 0) stay a 10⁻¹² event per draw.
+        let half = box_half_widths(&shape) * std::f32::consts::SQRT_2;
         let mut set = Lent::<LobeSet>::new(scratch.map(|s| s.home()));
         set.clear();
-        let lattice = 1.0 - b;
-        if t < 1.0 {
-            gather_level(levels, fine, p.seed, &kernel, lattice * (1.0 - t), &mut set);
-        }
-        if t > 0.0 {
-            gather_level(levels, fine + 1, p.seed, &kernel, lattice * t, &mut set);
+        let scale = (1.0 - b) / sum as f32;
+        for (w, z) in weights.iter().zip(&cand.z[..cand.len]) {
+            if let Some(g) = shape.with_mean(Vec2::new(tau[0] * z[0], tau[1] * z[1])) {
+                set.push_with_half_widths(w * scale, g, half);
+            }
         }
         if b > 0.0 {
             set.push(b, limit);
