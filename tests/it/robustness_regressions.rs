@@ -254,3 +254,44 @@ fn regression_ggx_visible_sampler_at_min_alpha() {
     assert!(brdf::frame::normalize_robust(Vec3::ZERO).is_none());
     assert!(brdf::frame::normalize_robust(Vec3::splat(f32::NAN)).is_none());
 }
+
+/// Found by the `store_procedural` fuzz target (first run): the projected area of a set of lobes
+/// (`LobeSet`, src/glint/kernels/lobe_set.rs: procedural patches, the mixture's filtered mixtures)
+/// is cos θ − w_xy·μ, and for a finite but huge non-unit w (w_y = −2.5·10³⁸) against a leaning
+/// mean (μ_y ≈ 1.9, a surface of α_y = 1.5 under a footprint that gathers one cell) the product
+/// overflowed to ∞. It is now 0 where it is not finite, as for invalid w; finite values unchanged.
+#[test]
+fn regression_lobe_set_projected_area_of_huge_directions() {
+    use brdf::glint::procedural::{PatchOptions, ProceduralGlints, ProceduralParams};
+    let surface = ProceduralGlints::new(ProceduralParams {
+        alpha: Vec2::new(0.045_605_47, 1.515_625),
+        facet_alpha: 0.01,
+        density: 0.2,
+        resolution: [48, 16],
+        seed: 5_927_300_059_587_086_911,
+    })
+    .unwrap();
+    let fp = Footprint::from_differentials(
+        Vec2::new(3.993_029_2e-35, 2.407_412_4e-35),
+        Vec2::new(1.77e-43, 0.0),
+        Vec2::new(-107_479_040.0, 6.648_12e-40),
+    );
+    let (wo, wi) = (
+        Vec3::new(0.0, 0.000_171_661_42, f32::NAN),
+        Vec3::new(0.0, -2.525_533_2e38, 1.0374e-41),
+    );
+    for tolerance in [PatchOptions::default().tolerance, 0.5] {
+        let patch = surface.patch_with(&fp, &PatchOptions { tolerance }, None);
+        assert!(
+            patch.projected_area(wi).is_finite(),
+            "tolerance {tolerance}"
+        );
+        check_ndf(
+            &patch,
+            wo,
+            wi,
+            -3.283_520_2e21,
+            Vec2::new(2.475_797_3e-14, f32::NAN),
+        );
+    }
+}

@@ -3,12 +3,16 @@
 
 use crate::support;
 
+use brdf::Vec2;
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{LobeStorage, MixtureParams, SeedKernel};
 use brdf::glint::position_normal::PositionNormalParams;
+use brdf::glint::procedural::{ProceduralGlints, ProceduralParams};
 use brdf::glint::{BeckmannMixture, BinMap, PositionNormalMap};
+use support::format::reseal;
 use support::store::{
-    map, mixture_as_version_3, mixture_as_version_4, position_normal_as_version_3, saved,
+    bin_map_as_version_5, map, mixture_as_version_3, mixture_as_version_4, mixture_as_version_5,
+    position_normal_as_version_3, position_normal_as_version_5, saved,
 };
 
 /// Writes the seed files of the store fuzz targets (small valid files of each kind):
@@ -37,6 +41,12 @@ fn write_fuzz_seeds() {
             "store_mixture",
             &format!("mixture{n}"),
             saved(|w| mx.save(w)),
+        );
+        // As format version 5 wrote it (no filtered mixture: built on load).
+        write(
+            "store_mixture",
+            &format!("mixture{n}_v5"),
+            mixture_as_version_5(&saved(|w| mx.save(w))),
         );
         // A Gaussian-seeded one, also as format versions 4 (no seed kernel) and 3 (with patch
         // options, read and ignored) wrote it.
@@ -76,8 +86,10 @@ fn write_fuzz_seeds() {
         let pn = PositionNormalMap::build(&m, PositionNormalParams::default()).unwrap();
         let file = saved(|w| pn.save(w));
         let v3 = position_normal_as_version_3(&file, 128.0);
+        let v5 = position_normal_as_version_5(&file);
         write("store_position_normal", &format!("pn{n}"), file);
         write("store_position_normal", &format!("pn{n}_v3"), v3);
+        write("store_position_normal", &format!("pn{n}_v5"), v5);
         for (bins, leaf) in [(3, 1), (7, 2)] {
             let params = BinMapParams {
                 bins_per_axis: bins,
@@ -85,11 +97,43 @@ fn write_fuzz_seeds() {
                 ..BinMapParams::default()
             };
             let bm = BinMap::build(&map(n + 3), params).unwrap();
+            let file = saved(|w| bm.save(w));
+            let errors = bm.moment_masking_errors().len();
             write(
                 "store_binmap",
-                &format!("bm{n}_{bins}"),
-                saved(|w| bm.save(w)),
+                &format!("bm{n}_{bins}_v5"),
+                bin_map_as_version_5(&file, errors),
             );
+            write("store_binmap", &format!("bm{n}_{bins}"), file);
         }
+    }
+    // Procedural glints (model kind 6): the defaults, and a surface with no two parameters alike
+    // (anisotropic, non-square, under one facet per texel), also under format version 2 (the
+    // payload is the same in every version).
+    let procedural = [
+        (
+            "procedural",
+            ProceduralParams {
+                seed: 1,
+                ..ProceduralParams::default()
+            },
+        ),
+        (
+            "procedural_aniso",
+            ProceduralParams {
+                alpha: Vec2::new(0.1, 0.5),
+                facet_alpha: 0.01,
+                density: 0.4,
+                resolution: [48, 20],
+                seed: u64::MAX,
+            },
+        ),
+    ];
+    for (name, params) in procedural {
+        let file = saved(|w| ProceduralGlints::new(params).unwrap().save(w));
+        let mut v2 = file.clone();
+        v2[8..12].copy_from_slice(&2u32.to_le_bytes());
+        write("store_procedural", &format!("{name}_v2"), reseal(v2));
+        write("store_procedural", name, file);
     }
 }

@@ -6,6 +6,7 @@
 use crate::support;
 
 use brdf::Error;
+use brdf::glint::procedural::ProceduralGlints;
 use brdf::glint::{BeckmannMixture, BinMap, GlintModel, NormalMap, PositionNormalMap};
 use support::format::reseal;
 use support::store::{is_flip_error, small_files};
@@ -13,7 +14,7 @@ use support::store::{is_flip_error, small_files};
 type Load = fn(&[u8]) -> brdf::Result<()>;
 
 /// Every loader that reads the file header, by name.
-fn loaders() -> [(&'static str, Load); 5] {
+fn loaders() -> [(&'static str, Load); 6] {
     [
         ("GlintModel", |b| GlintModel::load(&mut &b[..]).map(drop)),
         ("BeckmannMixture", |b| {
@@ -24,6 +25,9 @@ fn loaders() -> [(&'static str, Load); 5] {
             PositionNormalMap::load(&mut &b[..]).map(drop)
         }),
         ("NormalMap", |b| NormalMap::load(&mut &b[..]).map(drop)),
+        ("ProceduralGlints", |b| {
+            ProceduralGlints::load(&mut &b[..]).map(drop)
+        }),
     ]
 }
 
@@ -172,4 +176,54 @@ fn an_unknown_kind_is_wrong_only_when_the_checksum_vouches_for_it() {
         matches!(&e, Error::WrongModelKind { found, .. } if found == "NormalMap"),
         "{e}"
     );
+}
+
+/// An intact file of a kind a loader does not read is the wrong model, named by its kind (every
+/// file of `small_files`, kinds 1 to 6, through every loader); the kinds a loader reads load.
+#[test]
+fn another_models_file_is_the_wrong_model_kind() {
+    // The kinds each loader reads, and the name an error gives each kind (docs/format.md).
+    let reads = |loader: &str, code: u32| match loader {
+        "GlintModel" => (2..=6).contains(&code),
+        "BeckmannMixture" => code == 2 || code == 5,
+        "PositionNormalMap" => code == 3,
+        "BinMap" => code == 4,
+        "NormalMap" => code == 1,
+        "ProceduralGlints" => code == 6,
+        _ => unreachable!("{loader}"),
+    };
+    let names = [
+        "NormalMap",
+        "BeckmannMixture",
+        "PositionNormalMap",
+        "BinMap",
+        "BeckmannMixture (compact)",
+        "ProceduralGlints",
+    ];
+    let mut codes = Vec::new();
+    for (kind, file, _) in small_files() {
+        let code = u32::from_le_bytes(file[12..16].try_into().unwrap());
+        codes.push(code);
+        for (name, load) in loaders() {
+            let r = load(&file);
+            if reads(name, code) {
+                assert!(r.is_ok(), "{kind} via {name}: {r:?}");
+                continue;
+            }
+            let e = r.unwrap_err();
+            let found_name = names[code as usize - 1];
+            let expected_name = if name == "GlintModel" {
+                "glint model"
+            } else {
+                name
+            };
+            assert!(
+                matches!(&e, Error::WrongModelKind { found, expected }
+                    if found == found_name && expected == expected_name),
+                "{kind} via {name}: {e}"
+            );
+        }
+    }
+    codes.sort_unstable();
+    assert_eq!(codes, [1, 2, 3, 4, 5, 6], "a small file of every kind");
 }

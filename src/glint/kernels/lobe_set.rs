@@ -226,7 +226,10 @@ impl Ndf for LobeSet {
             return 0.0;
         }
         let mu = self.mean_slope();
-        (w.z - w.x * mu.x - w.y * mu.y).max(0.0)
+        // A huge non-unit w overflows the products: 0, as for invalid w (the values of every
+        // finite result are unchanged).
+        let a = (w.z - w.x * mu.x - w.y * mu.y).max(0.0);
+        if a.is_finite() { a } else { 0.0 }
     }
 
     fn visible_area(&self, w: Vec3) -> f32 {
