@@ -138,7 +138,8 @@ fn mean_over_positions_is_the_limit() {
     // axes): the disc masses by the Rayleigh-like closed form are replaced by quadrant indicators
     // shifted to one σ (a product of normal cdfs).
     let q = |x: f64| 0.5 * libm::erfc(x / 2f64.sqrt());
-    let functions: [(&str, Box<dyn Fn([f64; 2]) -> f64>, f64); 7] = [
+    type SlopeFn<'a> = Box<dyn Fn([f64; 2]) -> f64 + 'a>;
+    let functions: [(&str, SlopeFn, f64); 7] = [
         ("E sx", Box::new(|s| s[0] / sigma[0]), 0.0),
         ("E sy", Box::new(|s| s[1] / sigma[1]), 0.0),
         ("E sx²", Box::new(|s| (s[0] / sigma[0]).powi(2)), 1.0),
