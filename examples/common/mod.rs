@@ -16,6 +16,7 @@ pub mod normal_mapping;
 pub mod orb;
 pub mod orb_curves;
 pub mod pndf_images;
+pub mod procedural;
 pub mod quadrature;
 pub mod render;
 pub mod shading_points;
