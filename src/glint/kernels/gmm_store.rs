@@ -55,7 +55,7 @@ pub(crate) fn load_chain(
 ) -> Result<StoredChain> {
     let sizes = level_sizes(nx, ny);
     let n = d.len("filtered-mixture levels", usize::MAX)?;
-    if n + 1 != sizes.len() {
+    if n.checked_add(1) != Some(sizes.len()) {
         return Err(format::invalid(format!(
             "filtered-mixture levels = {n} but the grid {nx}×{ny} has {} above the lobes",
             sizes.len() - 1

@@ -139,7 +139,7 @@ impl Default for PatchOptions {
 
 impl PatchOptions {
     /// The tolerance as a query uses it (clamped, NaN → the default).
-    pub(crate) fn tolerance(&self) -> f64 {
+    pub(crate) fn clamped_tolerance(&self) -> f64 {
         if self.tolerance.is_nan() {
             DEFAULT_TOLERANCE as f64
         } else {

@@ -111,7 +111,7 @@ pub(super) fn make_patch<'a>(
     let sigma = [p.alpha.x as f64, p.alpha.y as f64].map(|a| a / std::f64::consts::SQRT_2);
     let sigma_f = p.facet_alpha as f64 / std::f64::consts::SQRT_2;
     let ratio = sigma[0] * sigma[1] / (sigma_f * sigma_f);
-    let tol = options.tolerance();
+    let tol = options.clamped_tolerance();
     let footprint_distance = ((ratio - 1.0).max(0.0) / n).sqrt();
     // The finer level: cells of CELL_SIGMAS/2 to CELL_SIGMAS minor standard deviations
     // (x = log2(CELL_SIGMAS σ_minor / s0) ≥ 0).
