@@ -117,7 +117,8 @@ pub(super) fn make_patch<'a>(
     // (x = log2(CELL_SIGMAS σ_minor / s0) ≥ 0).
     let x = (CELL_SIGMAS * kernel.lambda[1].sqrt() / s0).log2().max(0.0);
     if footprint_distance <= tol {
-        // The patch's own distance is at most this one: the limit lobe alone.
+        // The patch's own distance is at most this one (exactly so for isotropic α): the
+        // limit lobe alone.
         return ProceduralPatch {
             few: Few::One(limit),
             level: x as f32,
