@@ -463,8 +463,8 @@ fn version_3_option_fields_are_read_and_ignored() {
 }
 
 /// A stored filtered mixture that no build writes, with a valid checksum, is refused with what is
-/// wrong: a node whose weights do not sum to 1, a level count or an error count that does not
-/// match the chain, an error that is not a total variation (docs/format.md, "The filtered mixture
+/// wrong: a node whose weights do not sum to 1, a level count (2⁶⁴ − 1 included) or an error count
+/// that does not match the chain, an error that is not a total variation (docs/format.md, "The filtered mixture
 /// in a file").
 #[test]
 fn inconsistent_filtered_mixtures_are_errors() {
@@ -492,6 +492,11 @@ fn inconsistent_filtered_mixtures_are_errors() {
     f[chain..chain + 8].copy_from_slice(&2u64.to_le_bytes());
     let e = load(f);
     assert!(e.to_string().contains("filtered-mixture levels = 2"), "{e}");
+    // A level count of 2⁶⁴ − 1 (found by fuzzing: `n + 1` overflowed, a panic in debug builds).
+    let mut f = file.clone();
+    f[chain..chain + 8].copy_from_slice(&u64::MAX.to_le_bytes());
+    let e = load(f);
+    assert!(e.to_string().contains("filtered-mixture levels ="), "{e}");
     // The errors end the payload: their count (one per level of the chain, 4 here) and values.
     let count = file.len() - 8 - 4 * 4 - 8;
     assert_eq!(word(&file, count), 4);
