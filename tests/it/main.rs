@@ -78,6 +78,7 @@ mod slope_gaussian_sampling;
 mod specular;
 mod store_corrupt_files;
 mod store_forged_files;
+mod store_forged_procedural;
 mod store_fuzz_seeds;
 mod store_header_errors;
 mod store_roundtrip;

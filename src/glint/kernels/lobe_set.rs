@@ -52,13 +52,6 @@ pub(crate) fn box_half_widths(g: &SlopeGaussian) -> Vec2 {
     )
 }
 
-/// The slope box of `g` holding 1 − [`BOX_TAIL`] of it: mean ± [`box_half_widths`].
-fn slope_box(g: &SlopeGaussian) -> [f32; 4] {
-    let h = box_half_widths(g);
-    let m = g.mean();
-    [m.x - h.x, m.y - h.y, m.x + h.x, m.y + h.y]
-}
-
 /// What a few-lobe patch holds: one lobe inline, or a set lent by the caller's scratch.
 #[derive(Clone, Debug)]
 pub(crate) enum Few<'a> {
@@ -82,15 +75,7 @@ impl LobeSet {
 
     /// Adds a lobe of weight `w` (ignored unless `w` is positive and finite).
     pub fn push(&mut self, w: f32, g: SlopeGaussian) {
-        if w > 0.0 && w.is_finite() {
-            self.w.push(w);
-            self.g.push(g);
-            let b = slope_box(&g);
-            let half = Vec2::new(0.5 * (b[2] - b[0]), 0.5 * (b[3] - b[1]));
-            self.boxes.push(b);
-            self.spread.push(half.length() / box_sigmas());
-            self.n += 1;
-        }
+        self.push_with_half_widths(w, g, box_half_widths(&g));
     }
 
     /// Adds a lobe of weight `w` whose slope box (the box of [`BOX_TAIL`], as [`LobeSet::push`]

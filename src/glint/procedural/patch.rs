@@ -51,6 +51,17 @@ macro_rules! to_few {
 forward_ndf!(['a] ProceduralPatch<'a>, to_few);
 
 impl ProceduralPatch<'_> {
+    /// The patch that is the limit lobe alone, at continuous level `level` and expected distance
+    /// `distance`.
+    fn limit_alone(limit: SlopeGaussian, level: f64, distance: f64) -> Self {
+        ProceduralPatch {
+            few: Few::One(limit),
+            level: level as f32,
+            limit_weight: 1.0,
+            distance: distance as f32,
+        }
+    }
+
     /// The number of lobes the patch holds (the limit lobe included): at most a few tens, whatever
     /// the footprint.
     pub fn lobe_count(&self) -> usize {
@@ -119,12 +130,7 @@ pub(super) fn make_patch<'a>(
     if footprint_distance <= tol {
         // The patch's own distance is at most this one (exactly so for isotropic α): the
         // limit lobe alone.
-        return ProceduralPatch {
-            few: Few::One(limit),
-            level: x as f32,
-            limit_weight: 1.0,
-            distance: footprint_distance as f32,
-        };
+        return ProceduralPatch::limit_alone(limit, x, footprint_distance);
     }
     let top = levels.len() - 1;
     let (fine, t) = if x >= top as f64 {
@@ -151,19 +157,15 @@ pub(super) fn make_patch<'a>(
         Mat2::from_diagonal(Vec2::new(beta2[0] as f32, beta2[1] as f32)),
     );
     let (Ok(shape), true) = (shape, cand.len > 0) else {
-        return ProceduralPatch {
-            few: Few::One(limit),
-            level: x as f32,
-            limit_weight: 1.0,
-            distance: 0.0,
-        };
+        return ProceduralPatch::limit_alone(limit, x, 0.0);
     };
     // The patch's expected distance: ρ² = Σ (w_i/Σw)² (σx σy / (βx βy) − 1).
     let distance = ((sigma[0] * sigma[1] / (beta2[0] * beta2[1]).sqrt() - 1.0).max(0.0) / k).sqrt();
     let b = ((2.0 * tol - distance) / tol).clamp(0.0, 1.0) as f32;
-    let few = if b >= 1.0 {
-        Few::One(limit)
-    } else {
+    if b >= 1.0 {
+        return ProceduralPatch::limit_alone(limit, x, distance);
+    }
+    let few = {
         let tau = tau2.map(|v| v.sqrt() as f32);
         // Slope boxes holding 1 − 10⁻¹² of each lobe (√2 × the half-widths of the shared 10⁻⁶
         // tail): the facet lobes are narrow and many, and a sampler's draws beyond a box (where D
