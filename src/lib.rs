@@ -64,7 +64,7 @@
 //! ```
 //!
 //! A renderer that mixes analytic, layered, normal-mapped and glint materials keeps them in one
-//! `Vec<`[`Material`]`>` and shades every hit with `material.bsdf(&footprint, &scratch)` (module
+//! `Vec<`[`Material`]`>` and shades every hit with `material.bsdf(&footprint, wo, &scratch)` (module
 //! [`material`]). The `render` example is a small path tracer built this way (`cargo run --release
 //! --example render`).
 //!
@@ -161,19 +161,18 @@
 //!
 //! With `default-features = false` the crate is `#![no_std]` and allocates nothing: the analytic
 //! core, [`frame`], [`warp`], [`fresnel`], [`ndf`] (Beckmann, GGX, Blinn-Phong, [`SlopeGaussian`],
-//! masking, samplers, Phong lobe integrals) and [`bxdf`] but [`LayeredBrdf`] (Lambert, the Phong
-//! family, [`MicrofacetBrdf`], [`bxdf::EnergyCompensated`] with its static tables,
+//! masking, samplers, Phong lobe integrals) and [`bxdf`] (Lambert, the Phong family,
+//! [`MicrofacetBrdf`], [`bxdf::EnergyCompensated`] with its static tables, [`LayeredBrdf`],
 //! [`SpecularReflection`], the normal-mapping adapters), for GPU shaders (rust-gpu) and other
 //! `no_std` code. Its float functions (`sqrt`, `exp`, `ln`, …) are then `libm`'s instead of std's
 //! (glam's through its `nostd-libm` feature), which may change results in the last bits; no feature
 //! needs naming. Not in the core, for they need std or a heap: [`glint`] (maps, parallel builds,
-//! files, `Vec`-backed models), [`material`], [`LayeredBrdf`] (a `Mutex` cache), `Fresnel` for
-//! `Box<T>`, and the [`Error`] variants of files and decoding (they hold a `String`, a path or an
+//! files, `Vec`-backed models), [`material`], `Fresnel` for `Box<T>`, and the [`Error`] variants of files and decoding (they hold a `String`, a path or an
 //! `io::Error`).
 
 #![cfg_attr(not(feature = "std"), no_std)]
-// The docs describe the whole crate; without `std` their links to the glint layer, `material` and
-// `LayeredBrdf` have no target (CI checks every link in the default build).
+// The docs describe the whole crate; without `std` their links to the glint layer and `material`
+// have no target (CI checks every link in the default build).
 #![cfg_attr(not(feature = "std"), allow(rustdoc::broken_intra_doc_links))]
 
 pub mod bxdf;
@@ -190,7 +189,6 @@ mod math;
 pub mod ndf;
 pub mod warp;
 
-#[cfg(feature = "std")]
 pub use bxdf::LayeredBrdf;
 pub use bxdf::{
     BlinnPhongLobe, Bxdf, BxdfSample, Lambert, MicrofacetBrdf, NormalMapMicrofacet, NormalMapTilt,

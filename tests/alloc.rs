@@ -161,12 +161,12 @@ fn materials_with_several_live_bsdfs_allocate_nothing() {
     let path = |scratch: &brdf::glint::GlintScratch, k: usize| -> f32 {
         let n = materials.len();
         let fp = |j: usize| &footprints[(k + j) % footprints.len()];
-        let (a, b, c) = (
-            materials[k % n].bsdf(fp(0), scratch),
-            materials[(k + 1) % n].bsdf(fp(1), scratch),
-            materials[(k + 2) % n].bsdf(fp(2), scratch),
-        );
         let wo = support::dir(10.0 + 7.0 * (k % 11) as f64, 37.0 * k as f64);
+        let (a, b, c) = (
+            materials[k % n].bsdf(fp(0), wo, scratch),
+            materials[(k + 1) % n].bsdf(fp(1), wo, scratch),
+            materials[(k + 2) % n].bsdf(fp(2), wo, scratch),
+        );
         let wi = support::dir(35.0, 180.0 + 37.0 * k as f64);
         let mut acc = 0.0;
         for bsdf in [&a, &b, &c] {

@@ -3,7 +3,7 @@
 //! point light and an environment light, multiple importance sampling against BRDF sampling).
 //!
 //! Every material is a `brdf::Material` in one `Vec`, used the same way: at a hit, its BSDF for
-//! the hit's ray footprint (`material.bsdf(&footprint, &scratch)`, one `GlintScratch` per thread),
+//! the hit's ray footprint and view (`material.bsdf(&footprint, wo, &scratch)`, one `GlintScratch` per thread),
 //! then radiance = Σ f(wo, wi) · L · cos θi / pdf, with the geometric cosine (local `wi.z`). World space: y up, lengths in scene units; BRDFs see
 //! directions in the local frame of the hit (z = normal, x = ∂p/∂u). See docs/render.md.
 
@@ -287,7 +287,7 @@ impl Scene {
                 cone.footprint(hit.uv, hit.dpdu, hit.dpdv, d, hit.n)
             };
             let material = &self.materials[self.material_at(&hit)];
-            let bsdf = material.bsdf(&footprint, scratch);
+            let bsdf = material.bsdf(&footprint, wo, scratch);
             let u = [
                 rng.random::<f32>(),
                 rng.random(),

@@ -44,7 +44,7 @@ pub fn points(n: usize, seed: u64) -> Vec<Point> {
 /// `Material::bsdf` (the patch), `eval_pdf` toward both light directions and one `sample`.
 pub fn shade(material: &Material, p: &Point, area: f32, size: usize, scratch: &GlintScratch) {
     let fp = Footprint::isotropic_texels(p.uv, area, size, size);
-    let b = material.bsdf(&fp, scratch);
+    let b = material.bsdf(&fp, p.wo, scratch);
     black_box(b.eval_pdf(p.wo, p.wi[0]));
     black_box(b.eval_pdf(p.wo, p.wi[1]));
     black_box(b.sample(p.wo, p.uc, p.u));

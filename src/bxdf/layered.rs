@@ -19,8 +19,10 @@
 //! so the set is as small as keeps the accuracy: a glint patch's visible normals are a mixture of
 //! narrow lobes, chosen by the first coordinate, and the four distinct first coordinates pick the
 //! same four lobes a 4 × 4 grid picks (the same R̂ on glint patches at a quarter of the passes; on a
-//! smooth analytic lobe the quadrature error grows from ~0.007 to ~0.011 RMS up to 75°). R̂ is cached
-//! per `wo` (a renderer evaluates many `wi` for one `wo`).
+//! smooth analytic lobe the quadrature error grows from ~0.007 to ~0.011 RMS up to 75°). A layer
+//! prepared for its view ([`LayeredBrdf::with_view`], which `Material::bsdf` calls with the shading
+//! point's wo) computes R̂(wo) once (a renderer evaluates many `wi` for one `wo`); an unprepared one
+//! estimates it per query. Nothing is kept lazily.
 //!
 //! Not reciprocal: the base term depends on wo only. A reciprocal form (1 − R(wo))(1 − R(wi)) / (1 −
 //! R̄) would need R at every wi, i.e. a full visible-normal integral per evaluation, which a glint
@@ -32,9 +34,8 @@ use crate::frame::is_upper;
 use crate::fresnel::Fresnel;
 use crate::ndf::Ndf;
 use crate::warp::{pdf_cosine_hemisphere, square_to_cosine_hemisphere};
+use core::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
-use std::f32::consts::FRAC_1_PI;
-use std::sync::Mutex;
 
 /// Number of visible normals that estimate the first-bounce reflectance R(wo) of the specular layer:
 /// the points ((k + ½)/N, ((3k mod N) + ½)/N), k < N = 4 (module docs).
@@ -73,22 +74,13 @@ const MIN_LOBE_PROBABILITY: f32 = 0.05;
 /// assert!(s.weight().max_element() <= 1.0 + 1e-3);
 /// # Ok::<(), brdf::Error>(())
 /// ```
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct LayeredBrdf<D, F> {
     specular: MicrofacetBrdf<D, F>,
     base: Vec3,
-    /// The last (wo, R̂(wo)).
-    cache: Mutex<Option<(Vec3, Vec3)>>,
-}
-
-impl<D: Clone, F: Clone> Clone for LayeredBrdf<D, F> {
-    fn clone(&self) -> Self {
-        LayeredBrdf {
-            specular: self.specular.clone(),
-            base: self.base,
-            cache: Mutex::new(None),
-        }
-    }
+    /// R̂(wo) at the view the layer was prepared for ([`LayeredBrdf::with_view`]): the bits of
+    /// wo and the value.
+    view: Option<([u32; 3], Vec3)>,
 }
 
 impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
@@ -98,16 +90,17 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
         Ok(LayeredBrdf {
             specular,
             base: unit_rgb("base", base)?,
-            cache: Mutex::new(None),
+            view: None,
         })
     }
 
-    /// [`LayeredBrdf::new`] for a `base` already checked by `unit_rgb`.
+    /// [`LayeredBrdf::new`] for a `base` already checked by `unit_rgb` (`Material`'s glint coats).
+    #[cfg(feature = "std")]
     pub(crate) fn with_valid_base(specular: MicrofacetBrdf<D, F>, base: Vec3) -> Self {
         LayeredBrdf {
             specular,
             base,
-            cache: Mutex::new(None),
+            view: None,
         }
     }
 
@@ -121,27 +114,31 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
         self.base
     }
 
+    /// The layer prepared for the view direction `wo`: R̂(wo) ([`TRANSMISSION_SAMPLES`] visible
+    /// normals of the specular layer) computed here once and read by every query at that wo (the
+    /// same bits); queries at any other view estimate their own, and every value is the
+    /// unprepared layer's, bit for bit. Prepare the specular layer's NDF for `wo` first where it
+    /// has a view step of its own (a glint patch's `with_view`), as `Material::bsdf` does.
+    pub fn with_view(mut self, wo: Vec3) -> Self {
+        self.view = None;
+        if is_upper(wo) {
+            self.view = Some((key_of(wo), self.estimate_reflectance(wo)));
+        }
+        self
+    }
+
     /// R̂(wo): the specular layer's first-bounce reflectance ∫ F(wo·m) D_wo(m) dm, estimated on
-    /// [`TRANSMISSION_SAMPLES`] lattice-stratified visible normals (module docs). In [0, 1] per channel; 1 for
-    /// invalid `wo` (nothing transmitted).
+    /// [`TRANSMISSION_SAMPLES`] lattice-stratified visible normals (module docs); the prepared value
+    /// at the prepared view ([`LayeredBrdf::with_view`]). In [0, 1] per channel; 1 for invalid `wo`
+    /// (nothing transmitted).
     pub fn first_bounce_reflectance(&self, wo: Vec3) -> Vec3 {
         if !is_upper(wo) {
             return Vec3::ONE;
         }
-        let cached = match self.cache.lock() {
-            Ok(g) => *g,
-            Err(p) => *p.into_inner(),
-        };
-        if let Some((w, r)) = cached
-            && w == wo
-        {
-            return r;
+        match self.view {
+            Some((k, r)) if k == key_of(wo) => r,
+            _ => self.estimate_reflectance(wo),
         }
-        let r = self.estimate_reflectance(wo);
-        if let Ok(mut g) = self.cache.lock() {
-            *g = Some((wo, r));
-        }
-        r
     }
 
     fn estimate_reflectance(&self, wo: Vec3) -> Vec3 {
@@ -176,12 +173,17 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
     /// The probability of sampling the specular lobe.
     fn specular_probability(&self, r: Vec3) -> f32 {
         let spec = r.element_sum() / 3.0;
-        let diffuse = self.base_value(r).element_sum() / 3.0 * std::f32::consts::PI;
+        let diffuse = self.base_value(r).element_sum() / 3.0 * core::f32::consts::PI;
         if diffuse <= 0.0 {
             return 1.0;
         }
         (spec / (spec + diffuse)).clamp(MIN_LOBE_PROBABILITY, 1.0 - MIN_LOBE_PROBABILITY)
     }
+}
+
+/// The key of a direction: its components' bits.
+fn key_of(w: Vec3) -> [u32; 3] {
+    [w.x.to_bits(), w.y.to_bits(), w.z.to_bits()]
 }
 
 /// The [`TRANSMISSION_SAMPLES`] points of the R̂ quadrature in [0, 1)²: the rank-1 lattice

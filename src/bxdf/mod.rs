@@ -22,7 +22,6 @@ mod albedo_tables;
 mod blinn_phong;
 mod compensated;
 mod lambert;
-#[cfg(feature = "std")]
 mod layered;
 mod lobe;
 mod microfacet;
@@ -44,7 +43,6 @@ pub use compensated::{
 pub use lambert::Lambert;
 #[cfg(feature = "std")]
 pub(crate) use lambert::unit_rgb;
-#[cfg(feature = "std")]
 pub use layered::{LayeredBrdf, TRANSMISSION_SAMPLES};
 pub use microfacet::{Masking, MicrofacetBrdf, Sampling};
 pub use normal_mapping::{NormalMapMicrofacet, NormalMapTilt, ShadingNormal};

@@ -19,7 +19,7 @@ use super::{
 };
 use crate::error::{Error, Result};
 use crate::ndf::forward_ndf;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use std::io::{Read, Write};
 
 /// Generates [`GlintModel`], [`GlintPatch`], [`GlintOptions`] and their impls from one line per
@@ -88,6 +88,20 @@ macro_rules! glint_models {
                 }
             }
         )+
+
+        impl GlintPatch<'_> {
+            /// The patch prepared for the view direction `wo` (shading frame): what every query at
+            /// that wo shares (the exact V(wo), and the bin map's visible normalisation), computed
+            /// here once by the variant's own `with_view`; queries at any other view compute their
+            /// own, and every value is the unprepared patch's, bit for bit. `Material::bsdf` calls
+            /// it with the shading point's wo; a renderer that builds patches itself calls it once
+            /// per shading point before its `eval_pdf` and `sample` queries.
+            pub fn with_view(self, wo: Vec3) -> Self {
+                match self {
+                    $( GlintPatch::$variant(p) => GlintPatch::$variant(p.with_view(wo)), )+
+                }
+            }
+        }
 
         impl GlintModel {
             /// The names of the registered models, in registry order (for logs, charts and

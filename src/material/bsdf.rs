@@ -39,8 +39,8 @@ pub(super) enum Plain<'a> {
     BlinnPhong(&'a BlinnPhongLobe),
     Microfacet(&'a MicrofacetBrdf<AnalyticNdf, AnyFresnel>),
     Compensated(&'a EnergyCompensated<AnalyticNdf, AnyFresnel>),
-    /// A copy per shading point: the layered BRDF caches R̂(wo), which must not be shared between
-    /// threads shading other points.
+    /// A copy per shading point, prepared for its view (R̂(wo) computed once:
+    /// [`LayeredBrdf::with_view`]).
     Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
     Mirror(&'a SpecularReflection<AnyFresnel>),
 }

@@ -24,7 +24,7 @@
 //! let footprint = Footprint::isotropic_texels(Vec2::new(0.3, 0.6), 8.0, 64, 64);
 //! let wo = Vec3::new(0.3, 0.1, 0.9).normalize();
 //! for material in &materials {
-//!     let bsdf = material.bsdf(&footprint, &scratch);
+//!     let bsdf = material.bsdf(&footprint, wo, &scratch);
 //!     if let Some(s) = bsdf.sample(wo, 0.5, Vec2::new(0.25, 0.75)) {
 //!         assert!(s.weight().is_finite() && s.weight().min_element() >= 0.0);
 //!     }
@@ -165,19 +165,35 @@ impl Material {
     }
 
     /// The material's BRDF at a shading point whose ray footprint on the surface is `footprint`
-    /// (surface uv; ignored unless [`Material::uses_footprint`]). Glint patches take their
-    /// buffers from `scratch` (one per render thread) and give them back when the [`Bsdf`] drops.
-    /// Total: any footprint works.
-    pub fn bsdf<'a>(&'a self, footprint: &Footprint, scratch: &'a GlintScratch) -> Bsdf<'a> {
+    /// (surface uv; ignored unless [`Material::uses_footprint`]), prepared for the view direction
+    /// `wo` (shading frame, toward the viewer: the `wo` the renderer then passes to `eval_pdf` and
+    /// `sample`). Glint patches take their buffers from `scratch` (one per render thread) and give
+    /// them back when the [`Bsdf`] drops. Total: any footprint and any `wo` work.
+    ///
+    /// The view step: what every query at `wo` shares is computed here, once (a glint patch's
+    /// exact V(wo), a pass over its lobes; a layered material's first-bounce reflectance R̂(wo),
+    /// a few visible-normal draws). Queries at another view stay exact and compute their own;
+    /// nothing is kept lazily.
+    pub fn bsdf<'a>(
+        &'a self,
+        footprint: &Footprint,
+        wo: Vec3,
+        scratch: &'a GlintScratch,
+    ) -> Bsdf<'a> {
         Bsdf(match self {
             Material::Glint(g) => {
                 let fp = g.map_footprint(footprint);
-                let patch = g.model().patch_with(&fp, g.options(), Some(scratch));
+                let patch = g
+                    .model()
+                    .patch_with(&fp, g.options(), Some(scratch))
+                    .with_view(wo);
                 let layer = MicrofacetBrdf::new(patch, g.fresnel());
                 match g.base() {
                     None => Inner::Glint(layer),
                     // Validated by `GlintMaterial::over_base`.
-                    Some(base) => Inner::GlintCoat(LayeredBrdf::with_valid_base(layer, base)),
+                    Some(base) => {
+                        Inner::GlintCoat(LayeredBrdf::with_valid_base(layer, base).with_view(wo))
+                    }
                 }
             }
             Material::NormalMapped(nm) => {
@@ -191,6 +207,7 @@ impl Material {
                     (Some(n), NormalMapping::Tilt) => Inner::Tilt(NormalMapTilt::new(base, n)),
                 }
             }
+            Material::Layered(b) => Inner::Plain(Plain::Layered(b.clone().with_view(wo))),
             // Every other material is footprint-independent (`plain` is `Some`).
             plain => Inner::Plain(plain.plain().unwrap_or(Plain::Lambert(&Lambert::BLACK))),
         })

@@ -82,4 +82,5 @@ mod store_forged_procedural;
 mod store_fuzz_seeds;
 mod store_header_errors;
 mod store_roundtrip;
+mod view_step;
 mod warp;

@@ -94,10 +94,10 @@ fn reciprocity_and_sample_eval_pdf_agreement() {
 
 #[test]
 fn shading_point_queries_equal_those_of_a_fresh_patch() {
-    // A patch keeps the exact V_P of the last view (shared by eval, pdf and sample at one wo) and
-    // `eval_pdf` hands D(h) to the pdf: every value must be the one a fresh copy of the patch (which
-    // keeps nothing) returns through the separate `eval` and `pdf`, bit for bit, also when threads
-    // share the patch and overwrite each other's view.
+    // A patch prepared for a view (`with_view`: V_P(wo) computed once, shared by eval, pdf and
+    // sample at that wo) and `eval_pdf` handing D(h) to the pdf: every value must be the one the
+    // unprepared patch returns through the separate `eval` and `pdf`, bit for bit, also when
+    // threads share the patches.
     use brdf::bxdf::Sampling;
     use brdf::glint::GlintNdf;
     use brdf::glint::mixture::{LobeStorage, MaskingMode, MixtureParams};
@@ -140,14 +140,14 @@ fn shading_point_queries_equal_those_of_a_fresh_patch() {
     }
 }
 
-/// Shading points at random views on `patch` (eval_pdf at two wi, a sample, its eval_pdf), each
-/// value compared with a fresh copy's `eval` and `pdf`.
+/// Shading points at random views on `patch` prepared for each view (eval_pdf at two wi, a sample,
+/// its eval_pdf), each value compared with the unprepared patch's `eval` and `pdf`.
 fn shade_and_compare(patch: &brdf::glint::MixturePatch, seed: u64) {
     let mut rng = support::rng(100 + seed);
-    let brdf = MicrofacetBrdf::new(patch, NoFresnel);
+    let fresh = MicrofacetBrdf::new(patch, NoFresnel);
     for _ in 0..150 {
         let wo = support::dir(rng.random_range(0.0..89.0), rng.random_range(0.0..360.0));
-        let fresh = MicrofacetBrdf::new(patch.clone(), NoFresnel);
+        let brdf = MicrofacetBrdf::new(patch.clone().with_view(wo), NoFresnel);
         for _ in 0..2 {
             let wi = support::dir(rng.random_range(0.0..89.0), rng.random_range(0.0..360.0));
             let pair = (fresh.eval(wo, wi), fresh.pdf(wo, wi));

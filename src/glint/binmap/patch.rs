@@ -12,7 +12,7 @@ use super::footprint_moments::footprint_moments;
 use super::forest::QueryStats;
 use super::masking::{Buf, ExactMasking, PatchBin};
 use super::{BinMap, PatchOptions};
-use crate::glint::kernels::view_memo::ViewMemo;
+use crate::glint::kernels::prepared_view::PreparedView;
 use crate::glint::scratch::Lent;
 use crate::glint::{Footprint, GlintScratch, HemisphereBins, MIN_WIDTH_TEXELS};
 use crate::ndf::SlopeGaussian;
@@ -104,9 +104,10 @@ pub struct BinMapPatch<'a> {
     pub(super) exact: Option<ExactMasking<'a>>,
     /// Smoothing lobes' slope σ, if any.
     pub(super) sigma: Option<f64>,
-    /// The last bin mass a forest query gave (keyed by the bin): D and the sampler's pdf at one
-    /// direction, as `sample` and `eval_pdf` ask them, query the forest once.
-    mass_memo: ViewMemo,
+    /// With exact terms, V(wo) and the visible sampler's normalisation at the view the patch was
+    /// prepared for ([`BinMapPatch::with_view`]).
+    pub(super) view_area: PreparedView,
+    pub(super) view_total: PreparedView,
 }
 
 /// The buffers of one patch under construction: the footprint's periodic images and, for
@@ -197,8 +198,31 @@ impl<'a> BinMapPatch<'a> {
             lobe,
             exact,
             sigma,
-            mass_memo: ViewMemo::default(),
+            view_area: PreparedView::NONE,
+            view_total: PreparedView::NONE,
         }
+    }
+
+    /// The patch prepared for the view direction `wo` (shading frame): with exact masking terms,
+    /// V(wo) and the visible sampler's normalisation (each a pass over the footprint's bins or
+    /// smoothing lobes), computed here once and read by the queries at that wo
+    /// (`view_visible_area`, `sample_visible`, `pdf_visible`); queries at any other view compute
+    /// their own. Every value is the one the unprepared patch returns, bit for bit. Without exact
+    /// terms there is nothing to prepare (V is the moment lobe's, O(1)). `Material::bsdf` prepares
+    /// its glint patches for the shading point's wo.
+    pub fn with_view(mut self, wo: Vec3) -> Self {
+        self.view_area = PreparedView::NONE;
+        self.view_total = PreparedView::NONE;
+        if let Some(e) = &self.exact
+            && wo.z > 0.0
+            && wo.is_finite()
+        {
+            let area = e.visible_area(&self.map.bins, wo) as f64;
+            let total = self.visible_total_pass(e, wo);
+            self.view_area = PreparedView::new(wo, area);
+            self.view_total = PreparedView::new(wo, total);
+        }
+        self
     }
 
     /// The translations (−p·W, −q·H) of every tile (p, q) that A's bounding box meets (W × H the
@@ -292,7 +316,7 @@ impl<'a> BinMapPatch<'a> {
         let (n, nr) = (bins.n(), grid.n());
         let mut out = vec![0.0f64; grid.len()];
         for bin in 0..bins.len() {
-            let mass = self.listed_or_forest_mass(bin);
+            let mass = self.bin_mass(bin);
             if mass <= 0.0 {
                 continue;
             }
@@ -329,22 +353,10 @@ impl<'a> BinMapPatch<'a> {
 
     /// mass_j = Σ_k I_{H_j}(t_k) |A ∩ T_k| / |A| = ∫_{H_j} D cos θ dω for the unsmoothed patch
     /// (\[Atanasov2020\] §2, times |H|). Σ_j mass_j = 1. Read from the footprint's listed bins when
-    /// the patch has exact masking terms (they hold the same sums), otherwise one forest query, kept
-    /// for the next call with the same bin (D and the sampler's pdf at one direction, as `sample`
-    /// and `eval_pdf` ask them).
+    /// the patch has exact masking terms (they hold the same sums), otherwise one forest query (D
+    /// and the sampler's density at one direction share it: `MicrofacetBrdf` hands the density the
+    /// D it evaluated, [`Ndf::pdf_normal_given_d`](crate::ndf::Ndf::pdf_normal_given_d)).
     pub fn bin_mass(&self, bin: usize) -> f64 {
-        if let Some(mass) = self.exact.as_ref().and_then(|e| e.bin_mass(bin)) {
-            return mass;
-        }
-        let Ok(key) = u32::try_from(bin) else {
-            return 0.0;
-        };
-        self.mass_memo
-            .get_or_key([key, 0, 0], || self.forest_mass(bin))
-    }
-
-    /// mass_j from the listed bins or one forest query, not kept: for loops over many bins.
-    fn listed_or_forest_mass(&self, bin: usize) -> f64 {
         match self.exact.as_ref().and_then(|e| e.bin_mass(bin)) {
             Some(mass) => mass,
             None => self.forest_mass(bin),
@@ -417,7 +429,7 @@ impl<'a> BinMapPatch<'a> {
             let (dx, dy) = (sx - c.x as f64, sy - c.y as f64);
             let q = dx * dx + dy * dy;
             if q <= r * r {
-                let mass = self.listed_or_forest_mass(bin);
+                let mass = self.bin_mass(bin);
                 if mass > 0.0 {
                     sum += mass * norm * (-q * inv2s2).exp();
                 }

@@ -149,6 +149,12 @@ impl Ndf for BinMapPatch<'_> {
         }
     }
 
+    /// [`Ndf::visible_area`]`(wo)`, the prepared value at the view the patch was prepared for
+    /// ([`BinMapPatch::with_view`](super::BinMapPatch::with_view)).
+    fn view_visible_area(&self, wo: Vec3) -> f32 {
+        self.view_area.get_or(wo, || self.visible_area(wo) as f64) as f32
+    }
+
     /// A point of A from `u`, its texel's bin through 𝓑, a direction in the bin (or the bin's
     /// smoothing lobe) from numbers hashed from `u` (type docs).
     fn sample_normal(&self, u: Vec2) -> Vec3 {
@@ -161,18 +167,14 @@ impl Ndf for BinMapPatch<'_> {
 
     /// The density of [`Ndf::sample_normal`]: mass_j / |H| (unsmoothed) or D(m) cos θ_m (smoothed).
     fn pdf_normal(&self, m: Vec3) -> f32 {
-        if !(m.is_finite() && m.z > 0.0) {
-            return 0.0;
-        }
-        let Some(m) = m.try_normalize() else {
-            return 0.0;
-        };
-        match self.sigma {
-            None => self.map.bins.bin_of(m).map_or(0.0, |b| {
-                finite_or_zero(self.bin_mass(b) / self.map.bins.solid_angle())
-            }),
-            Some(_) => finite_or_zero(self.d_f64(m) * m.z as f64),
-        }
+        self.pdf_normal_with(m, None)
+    }
+
+    /// [`Ndf::pdf_normal`] with D(m) = `d_m` given: without exact terms the density is formed from
+    /// it (D c̄_j = mass_j / |H| unsmoothed, D cos θ_m smoothed), so that D and its density at one
+    /// direction cost one forest query (or one window of them), not two.
+    fn pdf_normal_given_d(&self, m: Vec3, d_m: f32) -> f32 {
+        self.pdf_normal_with(m, Some(d_m))
     }
 
     /// A normal visible from `wo` (type docs, "Sampling"): for patches with exact masking terms a
@@ -198,19 +200,44 @@ impl Ndf for BinMapPatch<'_> {
     /// views nothing faces). 0 for an invalid wo (at or below the horizon, zero, non-finite), as
     /// for every NDF, though the sampler still returns a normal there.
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
-        self.pdf_visible_with(wo, m, || self.d(m))
+        self.pdf_visible_with(wo, m, None)
     }
 
     /// [`Ndf::pdf_visible`] with D_P(m) = `d_m` given (the smoothed support check uses it).
     fn pdf_visible_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
-        self.pdf_visible_with(wo, m, || d_m)
+        self.pdf_visible_with(wo, m, Some(d_m))
     }
 }
 
 impl BinMapPatch<'_> {
-    /// [`Ndf::pdf_visible`], with `d` giving D_P(m) where the smoothed density checks its support.
+    /// [`Ndf::pdf_normal`], with D(m) = `d_m` when the caller has it (`None`: evaluated here where
+    /// needed). With exact terms the unsmoothed density reads the listed bins' mass (exact, cheap);
+    /// without them it is formed from D: mass_j / |H| = D c̄_j for the bin j ∋ m (to `f32` rounding
+    /// of D), D cos θ_m smoothed.
+    fn pdf_normal_with(&self, m: Vec3, d_m: Option<f32>) -> f32 {
+        if !(m.is_finite() && m.z > 0.0) {
+            return 0.0;
+        }
+        let Some(m) = m.try_normalize() else {
+            return 0.0;
+        };
+        let d_m = d_m.filter(|_| self.exact.is_none());
+        match self.sigma {
+            None => self.map.bins.bin_of(m).map_or(0.0, |b| match d_m {
+                Some(d) => finite_or_zero(d as f64 * self.map.facets[b].mean.z as f64),
+                None => finite_or_zero(self.bin_mass(b) / self.map.bins.solid_angle()),
+            }),
+            Some(_) => {
+                let d = d_m.map_or_else(|| self.d_f64(m), f64::from);
+                finite_or_zero(d * m.z as f64)
+            }
+        }
+    }
+
+    /// [`Ndf::pdf_visible`], with D_P(m) = `d_m` when the caller has it (the smoothed density's
+    /// support check, and the normal density where the sampler falls back to it).
     #[inline]
-    fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
+    fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d_m: Option<f32>) -> f32 {
         if !(wo.is_finite() && wo.z > 0.0) {
             return 0.0;
         }
@@ -221,9 +248,11 @@ impl BinMapPatch<'_> {
             // The smoothed D leaves out each lobe beyond its truncation radius (SMOOTH_TAIL), the
             // lobes' own samplers do not: where D is 0 the density is 0 too (a draw there, at most
             // 10⁻⁶ of a lobe's mass, gets pdf 0 and `MicrofacetBrdf::sample` returns `None`).
-            Some((e, total)) if d() > 0.0 => pdf_visible_lobes(e, wo, total, m),
+            Some((e, total)) if d_m.unwrap_or_else(|| self.d(m)) > 0.0 => {
+                pdf_visible_lobes(e, wo, total, m)
+            }
             Some(_) => 0.0,
-            None => self.pdf_normal(m),
+            None => self.pdf_normal_with(m, d_m),
         }
     }
 }
@@ -238,7 +267,16 @@ impl BinMapPatch<'_> {
         if !(wo.is_finite() && wo.z > 0.0) {
             return None;
         }
-        let total = if e.lobes.as_slice().is_empty() {
+        let total = self
+            .view_total
+            .get_or(wo, || self.visible_total_pass(e, wo));
+        (total > 0.0 && total.is_finite()).then_some((e, total))
+    }
+
+    /// The pass behind [`Self::visible_total`]: Σ_j s_j ν_j(wo) over the listed bins (unsmoothed)
+    /// or Σ_j mass_j V_j(wo) over the smoothing lobes, for a valid upper `wo`.
+    pub(super) fn visible_total_pass(&self, e: &ExactMasking<'_>, wo: Vec3) -> f64 {
+        if e.lobes.as_slice().is_empty() {
             let radius = bin_lipschitz_radius(&self.map.bins);
             e.bins
                 .as_slice()
@@ -251,8 +289,7 @@ impl BinMapPatch<'_> {
                 .iter()
                 .map(|(m, lobe)| *m as f64 * lobe.visible_area(wo) as f64)
                 .sum::<f64>()
-        };
-        (total > 0.0 && total.is_finite()).then_some((e, total))
+        }
     }
 
     fn sample_visible_bins(&self, e: &ExactMasking<'_>, wo: Vec3, total: f64, u: Vec2) -> Vec3 {

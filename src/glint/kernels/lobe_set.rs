@@ -17,6 +17,7 @@
 //! ([`Few::One`]) or a set lent by the caller's scratch ([`Few::Set`]), so that neither a patch's
 //! size nor a shading loop's allocations grow with the set.
 
+use super::prepared_view::PreparedView;
 use crate::glint::scratch::Lent;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Vec2, Vec3};
@@ -31,6 +32,9 @@ pub(crate) struct LobeSet {
     boxes: Vec<[f32; 4]>,
     /// Per lobe, √(Σxx + Σyy) ≥ the largest standard deviation of its slope along any direction.
     spread: Vec<f32>,
+    /// V(wo) at the view the set was prepared for ([`LobeSet::prepare_view`]); reset by every
+    /// change of the set.
+    view: PreparedView,
 }
 
 /// Mass of a lobe left outside its slope box: 10⁻⁶, the mixture's default slope tail.
@@ -71,6 +75,7 @@ impl LobeSet {
         self.g.clear();
         self.boxes.clear();
         self.spread.clear();
+        self.view = PreparedView::NONE;
     }
 
     /// Adds a lobe of weight `w` (ignored unless `w` is positive and finite).
@@ -90,16 +95,28 @@ impl LobeSet {
                 .push([m.x - half.x, m.y - half.y, m.x + half.x, m.y + half.y]);
             self.spread.push(half.length() / box_sigmas());
             self.n += 1;
+            self.view = PreparedView::NONE;
         }
     }
 
     /// Scales the weights to sum to 1 (an empty set stays empty).
     pub fn normalise(&mut self) {
+        self.view = PreparedView::NONE;
         let sum: f32 = self.weights().iter().sum();
         if sum > 0.0 {
             for w in &mut self.w[..self.n] {
                 *w /= sum;
             }
+        }
+    }
+
+    /// Prepares the set for the view direction `wo`: V(wo), an O(lobes) pass, computed here once
+    /// and read by the queries at that wo (`view_visible_area`, the visible densities); queries at
+    /// any other view compute their own, and every value is the unprepared set's, bit for bit.
+    pub fn prepare_view(&mut self, wo: Vec3) {
+        self.view = PreparedView::NONE;
+        if self.n > 1 && wo.z > 0.0 && wo.is_finite() {
+            self.view = PreparedView::new(wo, self.visible_area(wo) as f64);
         }
     }
 
@@ -231,6 +248,11 @@ impl Ndf for LobeSet {
         if v.is_finite() { v } else { 0.0 }
     }
 
+    /// V(wo): the prepared value at the prepared view ([`LobeSet::prepare_view`]), else one pass.
+    fn view_visible_area(&self, wo: Vec3) -> f32 {
+        self.view.get_or(wo, || self.visible_area(wo) as f64) as f32
+    }
+
     fn sample_normal(&self, u: Vec2) -> Vec3 {
         if let Some(g) = self.single() {
             return g.sample_normal(u);
@@ -274,7 +296,7 @@ impl Ndf for LobeSet {
         if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
             return 0.0;
         }
-        let v = self.visible_area(wo);
+        let v = self.view_visible_area(wo);
         if v.is_nan() || v <= 0.0 {
             return 0.0;
         }
@@ -290,7 +312,7 @@ impl Ndf for LobeSet {
         if !(wo.is_finite() && m.is_finite()) {
             return 0.0;
         }
-        crate::ndf::visible_over_cos(wo, m, d_m, self.visible_area(wo))
+        crate::ndf::visible_over_cos(wo, m, d_m, self.view_visible_area(wo))
     }
 }
 
@@ -301,6 +323,13 @@ impl Few<'_> {
             Few::None => Vec::new(),
             Few::One(g) => vec![(1.0, *g)],
             Few::Set(s) => s.iter().map(|(w, g)| (w, *g)).collect(),
+        }
+    }
+
+    /// Prepares a set for the view `wo` ([`LobeSet::prepare_view`]); one lobe needs nothing.
+    pub fn prepare_view(&mut self, wo: Vec3) {
+        if let Few::Set(s) = self {
+            s.prepare_view(wo);
         }
     }
 
@@ -343,6 +372,10 @@ impl Ndf for Few<'_> {
 
     fn visible_area(&self, w: Vec3) -> f32 {
         with_few!(self, 0.0, |n| n.visible_area(w))
+    }
+
+    fn view_visible_area(&self, wo: Vec3) -> f32 {
+        with_few!(self, 0.0, |n| n.view_visible_area(wo))
     }
 
     fn sample_normal(&self, u: Vec2) -> Vec3 {

@@ -7,7 +7,7 @@
 //!   gmm_residual.rs its nodes' residuals, gmm_store.rs the chain in a model's file.
 //! - lobe_set.rs: a small weighted set of slope Gaussians, the few-lobe patches' P-NDF.
 //! - mip.rs: trilinear addressing of mip chains over a lobe grid.
-//! - view_memo.rs: a patch's V(wo) kept for the queries of one shading point (lock-free).
+//! - prepared_view.rs: a value a patch computes once for the view it is prepared for (V(wo)).
 //! - slope_tree.rs: the implicit quadtree of slope boxes over a regular grid of elements (the
 //!   mixture's lobes, the position-normal elements).
 
@@ -19,5 +19,5 @@ pub(crate) mod gmm_residual;
 pub(crate) mod gmm_store;
 pub(crate) mod lobe_set;
 pub(crate) mod mip;
+pub(crate) mod prepared_view;
 pub(crate) mod slope_tree;
-pub(crate) mod view_memo;

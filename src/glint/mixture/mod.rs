@@ -36,7 +36,7 @@
 //!    lane kernels and the walk to them), `simd.rs` (the baseline and AVX2 copies of the block loops);
 //! 4. `hierarchy.rs` (slope boxes, moment mip chain), `levels.rs` (merged levels of detail and
 //!    their error bounds); the filtered mixture's kernels (a few weighted lobes evaluated by brute
-//!    force, its mip chain, its measured error, the view memo) are shared with the position-normal
+//!    force, its mip chain, its measured error, the prepared view) are shared with the position-normal
 //!    map in src/glint/kernels/;
 //! 5. `storage.rs` (the crate-private storage interface `LobeStore` / `LevelView`), `sub_texel.rs`
 //!    (the sub-texel limit lobe), `full.rs` and `compact.rs` (its two implementations),

@@ -22,7 +22,7 @@ use crate::glint::GlintScratch;
 use crate::glint::kernels::cdf::invert_cdf;
 use crate::glint::kernels::cut::CutStats;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
-use crate::glint::kernels::view_memo::ViewMemo;
+use crate::glint::kernels::prepared_view::PreparedView;
 use crate::math::{finite_f32, finite_or_zero};
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Vec2, Vec3};
@@ -84,7 +84,7 @@ impl PatchLevel<'_> {
 ///   (src/glint/kernels/gmm.rs) where its measured TV to the full mixture
 ///   ([`BeckmannMixture::filtered_mixture_errors`]) is within
 ///   [`PatchOptions::filtered_tolerance`], and beyond the cost cap; compact storage serves the
-///   single filtered lobe there. Their masking is exact (V = Σ w_i V_i, V(wo) kept per view).
+///   single filtered lobe there. Their masking is exact (V = Σ w_i V_i, V(wo) prepared per view).
 /// - Level of detail otherwise: the patch is made of the nodes of one level l of merged lobes
 ///   (src/glint/mixture/levels.rs; l = 0 is the lobes themselves): the coarsest level whose nodes
 ///   are no wider than half the footprint's smaller standard deviation and whose bound
@@ -92,13 +92,14 @@ impl PatchLevel<'_> {
 ///   P-NDFs blurred by N(0, r² I)) is at most `lod_tolerance`, then moved coarser if the footprint
 ///   still covers more than `lod_lobes` nodes (the filtered lobe alone if no level is coarse
 ///   enough). D_P, both masking modes, both samplers and their pdfs all use that one level.
-/// - Cost per shading point: the patch keeps the exact V_P of the last view it was asked about
-///   (through [`Ndf::view_visible_area`], `pdf_visible` or `sample_visible`; lock-free, so a patch
-///   shared by threads stays `Send + Sync`), and takes the D_P(h) that `MicrofacetBrdf::eval_pdf`
-///   already evaluated ([`Ndf::pdf_visible_given_d`]). A renderer's `eval_pdf` at k directions and
-///   one `sample` at one wo then cost k + 1 D_P walks, k + 1 untruncated passes (the pdfs), one
-///   V_P(wo) pass, the sampler's pick pass and, with exact masking, k + 1 V_P(wi) passes; every
-///   value is the one the separate queries return.
+/// - Cost per shading point: a patch prepared for its view ([`MixturePatch::with_view`], which
+///   `Material::bsdf` calls with the shading point's wo) holds the exact V_P(wo), computed once by
+///   that explicit step (nothing is kept lazily: a patch that was not prepared computes V_P(wo) per
+///   query), and takes the D_P(h) that `MicrofacetBrdf::eval_pdf` already evaluated
+///   ([`Ndf::pdf_visible_given_d`]). A renderer's `eval_pdf` at k directions and one `sample` at the
+///   prepared wo then cost k + 1 D_P walks, k + 1 untruncated passes (the pdfs), one V_P(wo) pass,
+///   the sampler's pick pass and, with exact masking, k + 1 V_P(wi) passes; every value is the one
+///   an unprepared patch returns.
 /// - What approximate masking cannot make O(1): the densities. `pdf_visible` and `pdf_normal` are
 ///   sums over the lobes at m (one pass; the density of a mixture is the sum of its lobes'), and
 ///   `sample_visible` picks a lobe ∝ W_i V_i(wo), which needs the exact V_P(wo) (one pass per
@@ -130,9 +131,9 @@ pub struct MixturePatch<'a> {
     cut: Option<CutStats>,
     /// The compiled copy of the block loops the patch runs ([`Simd::detected`]).
     simd: Simd,
-    /// The exact V_P of the last view direction (`pdf_visible`, `sample_visible`,
-    /// `view_visible_area`): one pass over the lobes per wo, not one per query.
-    view: ViewMemo,
+    /// The exact V_P at the view the patch was prepared for ([`MixturePatch::with_view`]; read by
+    /// `pdf_visible`, `sample_visible` and `view_visible_area` at that wo).
+    view: PreparedView,
 }
 
 impl<'a> MixturePatch<'a> {
@@ -199,13 +200,35 @@ impl<'a> MixturePatch<'a> {
             few: set.map_or(Few::None, |(s, _, _)| s),
             cut,
             simd: Simd::detected(),
-            view: ViewMemo::default(),
+            view: PreparedView::NONE,
         }
     }
 
     /// The masking mode.
     pub fn masking(&self) -> MaskingMode {
         self.masking
+    }
+
+    /// The patch prepared for the view direction `wo` (shading frame): the exact V_P(wo) that the
+    /// queries at that wo share (`view_visible_area`, `pdf_visible`, `sample_visible`, the
+    /// densities `MicrofacetBrdf` forms), computed here once, an O(lobes) pass. Queries at `wo` (the
+    /// same bits) then read it; queries at any other view compute their own. Every value is the
+    /// one the unprepared patch returns, bit for bit. `Material::bsdf` prepares its glint patches
+    /// for the shading point's wo.
+    pub fn with_view(mut self, wo: Vec3) -> Self {
+        self.view = PreparedView::NONE;
+        if !(wo.z > 0.0 && wo.is_finite()) {
+            return self;
+        }
+        let v = match (&self.gathered, self.masking, &self.few) {
+            (Some(g), MaskingMode::Exact, _) => Some(self.exact_visible_area(g, wo)),
+            (None, _, Few::Set(set)) => Some(set.visible_area(wo) as f64),
+            _ => None,
+        };
+        if let Some(v) = v {
+            self.view = PreparedView::new(wo, v);
+        }
+        self
     }
 
     /// Whether the level of detail replaced the mixture by the single filtered lobe (the
@@ -360,8 +383,8 @@ impl<'a> MixturePatch<'a> {
         ))
     }
 
-    /// [`MixturePatch::exact_visible_area`] at a view direction: the value kept for `wo` if it is
-    /// the last view the patch was asked about ([`ViewMemo`]), else one pass, kept.
+    /// [`MixturePatch::exact_visible_area`] at a view direction: the prepared value if `wo` is the
+    /// view the patch was prepared for ([`MixturePatch::with_view`]), else one pass.
     fn view_exact_visible_area(&self, g: &Gathered, wo: Vec3) -> f64 {
         if !(wo.z > 0.0 && wo.is_finite()) {
             return 0.0;
@@ -558,9 +581,9 @@ impl Ndf for MixturePatch<'_> {
         self.pdf_visible_over_cos_with(wo, m, || d_m)
     }
 
-    /// [`Ndf::visible_area`] at the view: the exact V_P kept for the queries that follow at the
-    /// same `wo` ([`MaskingMode::Exact`]); Scarf's bound, O(1), is not kept
-    /// ([`MaskingMode::Approximate`]).
+    /// [`Ndf::visible_area`] at the view: the exact V_P prepared for `wo` if the patch was
+    /// prepared for it ([`MaskingMode::Exact`]; [`MixturePatch::with_view`]); Scarf's bound, O(1),
+    /// is never prepared ([`MaskingMode::Approximate`]).
     fn view_visible_area(&self, wo: Vec3) -> f32 {
         match (&self.gathered, self.masking) {
             (Some(g), MaskingMode::Exact) => finite_or_zero(self.view_exact_visible_area(g, wo)),

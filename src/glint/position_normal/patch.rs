@@ -4,8 +4,9 @@
 //! Per-footprint work (done once when the patch is built): the level of detail (the filtered
 //! mixture, filtered.rs, where the options serve it: then nothing else), else the footprint's
 //! geometry (geometry.rs), the rectangle of elements that can be within `weight_sigmas` of the
-//! footprint, their total weight and the P-NDF's first and second slope moments. The per-element
-//! lobes used by the samplers are built on first use; the exact V(wo) of the last view is kept.
+//! footprint, their total weight and the P-NDF's first and second slope moments, and the kept
+//! elements' weights and lobes (the samplers', masking's and densities'). The exact V(wo) is
+//! computed once for the view the patch is prepared for ([`PositionNormalPatch::with_view`]).
 
 use super::build::slope_box;
 use super::filtered::footprint_in_elements;
@@ -17,8 +18,8 @@ use crate::glint::GlintScratch;
 use crate::glint::kernels::cdf::{invert_cdf, pick_streaming};
 use crate::glint::kernels::cut::CutStats;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
+use crate::glint::kernels::prepared_view::PreparedView;
 use crate::glint::kernels::slope_tree::contains;
-use crate::glint::kernels::view_memo::ViewMemo;
 use crate::glint::scratch::Lent;
 use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
@@ -91,9 +92,9 @@ pub struct PositionNormalPatch<'a> {
     few: Few<'a>,
     /// What the cut did, when a cut serves the patch.
     cut: Option<CutStats>,
-    /// The exact V(wo) of the last view asked for (`view_visible_area`, `pdf_visible`,
-    /// `sample_visible`): one pass per wo instead of one per query.
-    view: ViewMemo,
+    /// The exact V(wo) at the view the patch was prepared for ([`PositionNormalPatch::with_view`];
+    /// read by `view_visible_area`, `pdf_visible` and `sample_visible` at that wo).
+    view: PreparedView,
 }
 
 /// Largest patch (number of elements kept) whose masking terms use the exact V(w) = Σ W_i V_i(w);
@@ -165,8 +166,21 @@ impl<'a> PositionNormalPatch<'a> {
             slots: Lent::new(None),
             few: Few::Set(set),
             cut,
-            view: ViewMemo::default(),
+            view: PreparedView::NONE,
         }
+    }
+
+    /// The patch prepared for the view direction `wo` (shading frame): the exact V(wo) that the
+    /// queries at that wo share (`view_visible_area`, `pdf_visible`, `sample_visible`), computed
+    /// here once, an O(elements) pass. Queries at `wo` (the same bits) then read it; queries at any
+    /// other view compute their own. Every value is the one the unprepared patch returns, bit for
+    /// bit. `Material::bsdf` prepares its glint patches for the shading point's wo.
+    pub fn with_view(mut self, wo: Vec3) -> Self {
+        self.view = PreparedView::NONE;
+        if wo.z > 0.0 && wo.is_finite() {
+            self.view = PreparedView::new(wo, self.exact_visible_area(wo));
+        }
+        self
     }
 
     /// Whether the filtered mixture serves the patch (module docs of
@@ -241,7 +255,7 @@ impl<'a> PositionNormalPatch<'a> {
             slots,
             few: Few::None,
             cut: None,
-            view: ViewMemo::default(),
+            view: PreparedView::NONE,
         }
     }
 
@@ -379,8 +393,8 @@ impl<'a> PositionNormalPatch<'a> {
         finite_or_zero(self.exact_visible_area(w))
     }
 
-    /// The exact V(wo) at the view, through the view memo (the same value as
-    /// [`Self::exact_visible_area`]).
+    /// The exact V(wo) at the view: the prepared value at the prepared wo, else one pass (the same
+    /// value as [`Self::exact_visible_area`]).
     fn view_exact_visible_area(&self, wo: Vec3) -> f64 {
         if !(wo.z > 0.0 && wo.is_finite()) {
             return 0.0;
@@ -463,8 +477,8 @@ impl Ndf for PositionNormalPatch<'_> {
         }
     }
 
-    /// [`Ndf::visible_area`]`(wo)`, the exact V kept in the patch's view memo for the queries that
-    /// follow at the same wo.
+    /// [`Ndf::visible_area`]`(wo)`, the exact V as prepared for the patch's view
+    /// ([`PositionNormalPatch::with_view`]) at that wo.
     fn view_visible_area(&self, wo: Vec3) -> f32 {
         if self.count <= EXACT_MASKING_ELEMENTS {
             finite_or_zero(self.view_exact_visible_area(wo))

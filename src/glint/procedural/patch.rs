@@ -8,7 +8,7 @@ use crate::glint::kernels::lobe_set::{Few, LobeSet, box_half_widths};
 use crate::glint::scratch::Lent;
 use crate::glint::{Footprint, GlintScratch};
 use crate::ndf::{SlopeGaussian, forward_ndf};
-use glam::{Mat2, Vec2};
+use glam::{Mat2, Vec2, Vec3};
 
 /// The P-NDF of one footprint of a [`ProceduralGlints`](super::ProceduralGlints) surface: an
 /// [`Ndf`](crate::ndf::Ndf) with D_P(m) = (1 − b) Σ_i w_i D_i(m) + b D_lim(m).
@@ -60,6 +60,16 @@ impl ProceduralPatch<'_> {
             limit_weight: 1.0,
             distance: distance as f32,
         }
+    }
+
+    /// The patch prepared for the view direction `wo` (shading frame): the exact V(wo) that the
+    /// queries at that wo share (`view_visible_area`, the visible densities), computed here once,
+    /// an O(lobes) pass. Queries at `wo` (the same bits) then read it; queries at any other view
+    /// compute their own. Every value is the one the unprepared patch returns, bit for bit.
+    /// `Material::bsdf` prepares its glint patches for the shading point's wo.
+    pub fn with_view(mut self, wo: Vec3) -> Self {
+        self.few.prepare_view(wo);
+        self
     }
 
     /// The number of lobes the patch holds (the limit lobe included): at most a few tens, whatever

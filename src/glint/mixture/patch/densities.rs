@@ -1,6 +1,6 @@
 //! The patch's densities ([`Ndf::pdf_normal`], [`Ndf::pdf_visible`] and its per-cosine form)
 //! and its few-lobe view: the exact sums over every gathered lobe, 0 where D_P is (the density
-//! contract), V(wo) through the patch's view memo.
+//! contract), V(wo) prepared for the patch's view.
 
 use super::MixturePatch;
 use crate::glint::kernels::lobe_set::Few;
@@ -8,8 +8,8 @@ use crate::ndf::Ndf;
 use glam::Vec3;
 
 impl MixturePatch<'_> {
-    /// The few-lobe patch's V(wo) at the view: a set's kept in the view memo (a shading point
-    /// asks for V(wo) at every density and sample), a single lobe's directly.
+    /// The few-lobe patch's V(wo) at the view: a set's prepared value at the prepared wo (a shading
+    /// point asks for V(wo) at every density and sample), else its pass; a single lobe's directly.
     pub(super) fn few_view_visible_area(&self, wo: Vec3) -> f32 {
         match &self.few {
             Few::Set(set) if wo.z > 0.0 && wo.is_finite() => {
@@ -20,7 +20,7 @@ impl MixturePatch<'_> {
     }
 
     /// The few-lobe patch's visible-normal density ⟨wo, m⟩⁺ D(m) / V(wo) with D(m) = `d()` and
-    /// V(wo) through the view memo for a set (the same value its own `pdf_visible` computes); a
+    /// V(wo) as prepared for a set (the same value its own `pdf_visible` computes); a
     /// single lobe's own density. Without the factor ⟨wo, m⟩ where `over_cos`
     /// ([`Ndf::pdf_visible_over_cos_given_d`]).
     fn few_pdf_visible(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32, over_cos: bool) -> f32 {
@@ -59,7 +59,7 @@ impl MixturePatch<'_> {
     }
 
     /// [`Ndf::pdf_visible`], with `d` giving D_P(m) for the density contract's check and V_P(wo)
-    /// through the patch's [`ViewMemo`].
+    /// as prepared for the patch's view ([`MixturePatch::with_view`]).
     #[inline]
     pub(super) fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
         self.visible_density(wo, m, d, false)
