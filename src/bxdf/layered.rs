@@ -20,7 +20,7 @@
 //! narrow lobes, chosen by the first coordinate, and the four distinct first coordinates pick the
 //! same four lobes a 4 × 4 grid picks (the same R̂ on glint patches at a quarter of the passes; on a
 //! smooth analytic lobe the quadrature error grows from ~0.007 to ~0.011 RMS up to 75°). A layer
-//! prepared for its view ([`LayeredBrdf::with_view`], which `Material::bsdf` calls with the shading
+//! prepared for its view ([`LayeredBrdf::prepare_view`], which `Material::bsdf` calls with the shading
 //! point's wo) computes R̂(wo) once (a renderer evaluates many `wi` for one `wo`); an unprepared one
 //! estimates it per query. Nothing is kept lazily.
 //!
@@ -78,7 +78,7 @@ const MIN_LOBE_PROBABILITY: f32 = 0.05;
 pub struct LayeredBrdf<D, F> {
     specular: MicrofacetBrdf<D, F>,
     base: Vec3,
-    /// R̂(wo) at the view the layer was prepared for ([`LayeredBrdf::with_view`]): the bits of
+    /// R̂(wo) at the view the layer was prepared for ([`LayeredBrdf::prepare_view`]): the bits of
     /// wo and the value.
     view: Option<([u32; 3], Vec3)>,
 }
@@ -114,22 +114,22 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
         self.base
     }
 
-    /// The layer prepared for the view direction `wo`: R̂(wo) ([`TRANSMISSION_SAMPLES`] visible
+    /// Prepares the layer for the view direction `wo`: R̂(wo) ([`TRANSMISSION_SAMPLES`] visible
     /// normals of the specular layer) computed here once and read by every query at that wo (the
     /// same bits); queries at any other view estimate their own, and every value is the
-    /// unprepared layer's, bit for bit. Prepare the specular layer's NDF for `wo` first where it
-    /// has a view step of its own (a glint patch's `with_view`), as `Material::bsdf` does.
-    pub fn with_view(mut self, wo: Vec3) -> Self {
+    /// unprepared layer's, bit for bit. A second call replaces the first view. Prepare the specular
+    /// layer's NDF for `wo` first where it has a view step of its own (a glint patch's
+    /// `prepare_view`), as `Material::bsdf` does.
+    pub fn prepare_view(&mut self, wo: Vec3) {
         self.view = None;
         if is_upper(wo) {
             self.view = Some((key_of(wo), self.estimate_reflectance(wo)));
         }
-        self
     }
 
     /// R̂(wo): the specular layer's first-bounce reflectance ∫ F(wo·m) D_wo(m) dm, estimated on
     /// [`TRANSMISSION_SAMPLES`] lattice-stratified visible normals (module docs); the prepared value
-    /// at the prepared view ([`LayeredBrdf::with_view`]). In [0, 1] per channel; 1 for invalid `wo`
+    /// at the prepared view ([`LayeredBrdf::prepare_view`]). In [0, 1] per channel; 1 for invalid `wo`
     /// (nothing transmitted).
     pub fn first_bounce_reflectance(&self, wo: Vec3) -> Vec3 {
         if !is_upper(wo) {

@@ -90,15 +90,15 @@ macro_rules! glint_models {
         )+
 
         impl GlintPatch<'_> {
-            /// The patch prepared for the view direction `wo` (shading frame): what every query at
+            /// Prepares the patch for the view direction `wo` (shading frame): what every query at
             /// that wo shares (the exact V(wo), and the bin map's visible normalisation), computed
-            /// here once by the variant's own `with_view`; queries at any other view compute their
-            /// own, and every value is the unprepared patch's, bit for bit. `Material::bsdf` calls
-            /// it with the shading point's wo; a renderer that builds patches itself calls it once
-            /// per shading point before its `eval_pdf` and `sample` queries.
-            pub fn with_view(self, wo: Vec3) -> Self {
+            /// here once by the variant's own `prepare_view`; queries at any other view compute
+            /// their own, and every value is the unprepared patch's, bit for bit. `Material::bsdf`
+            /// calls it with the shading point's wo; a renderer that builds patches itself calls
+            /// it once per shading point before its `eval_pdf` and `sample` queries.
+            pub fn prepare_view(&mut self, wo: Vec3) {
                 match self {
-                    $( GlintPatch::$variant(p) => GlintPatch::$variant(p.with_view(wo)), )+
+                    $( GlintPatch::$variant(p) => p.prepare_view(wo), )+
                 }
             }
         }

@@ -40,7 +40,7 @@ pub(super) enum Plain<'a> {
     Microfacet(&'a MicrofacetBrdf<AnalyticNdf, AnyFresnel>),
     Compensated(&'a EnergyCompensated<AnalyticNdf, AnyFresnel>),
     /// A copy per shading point, prepared for its view (R̂(wo) computed once:
-    /// [`LayeredBrdf::with_view`]).
+    /// [`LayeredBrdf::prepare_view`]).
     Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
     Mirror(&'a SpecularReflection<AnyFresnel>),
 }

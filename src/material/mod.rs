@@ -183,16 +183,16 @@ impl Material {
         Bsdf(match self {
             Material::Glint(g) => {
                 let fp = g.map_footprint(footprint);
-                let patch = g
-                    .model()
-                    .patch_with(&fp, g.options(), Some(scratch))
-                    .with_view(wo);
+                let mut patch = g.model().patch_with(&fp, g.options(), Some(scratch));
+                patch.prepare_view(wo);
                 let layer = MicrofacetBrdf::new(patch, g.fresnel());
                 match g.base() {
                     None => Inner::Glint(layer),
                     // Validated by `GlintMaterial::over_base`.
                     Some(base) => {
-                        Inner::GlintCoat(LayeredBrdf::with_valid_base(layer, base).with_view(wo))
+                        let mut coat = LayeredBrdf::with_valid_base(layer, base);
+                        coat.prepare_view(wo);
+                        Inner::GlintCoat(coat)
                     }
                 }
             }
@@ -207,7 +207,11 @@ impl Material {
                     (Some(n), NormalMapping::Tilt) => Inner::Tilt(NormalMapTilt::new(base, n)),
                 }
             }
-            Material::Layered(b) => Inner::Plain(Plain::Layered(b.clone().with_view(wo))),
+            Material::Layered(b) => {
+                let mut layered = b.clone();
+                layered.prepare_view(wo);
+                Inner::Plain(Plain::Layered(layered))
+            }
             // Every other material is footprint-independent (`plain` is `Some`).
             plain => Inner::Plain(plain.plain().unwrap_or(Plain::Lambert(&Lambert::BLACK))),
         })

@@ -94,7 +94,7 @@ fn reciprocity_and_sample_eval_pdf_agreement() {
 
 #[test]
 fn shading_point_queries_equal_those_of_a_fresh_patch() {
-    // A patch prepared for a view (`with_view`: V_P(wo) computed once, shared by eval, pdf and
+    // A patch prepared for a view (`prepare_view`: V_P(wo) computed once, shared by eval, pdf and
     // sample at that wo) and `eval_pdf` handing D(h) to the pdf: every value must be the one the
     // unprepared patch returns through the separate `eval` and `pdf`, bit for bit, also when
     // threads share the patches.
@@ -147,7 +147,9 @@ fn shade_and_compare(patch: &brdf::glint::MixturePatch, seed: u64) {
     let fresh = MicrofacetBrdf::new(patch, NoFresnel);
     for _ in 0..150 {
         let wo = support::dir(rng.random_range(0.0..89.0), rng.random_range(0.0..360.0));
-        let brdf = MicrofacetBrdf::new(patch.clone().with_view(wo), NoFresnel);
+        let mut prepared = patch.clone();
+        prepared.prepare_view(wo);
+        let brdf = MicrofacetBrdf::new(prepared, NoFresnel);
         for _ in 0..2 {
             let wi = support::dir(rng.random_range(0.0..89.0), rng.random_range(0.0..360.0));
             let pair = (fresh.eval(wo, wi), fresh.pdf(wo, wi));

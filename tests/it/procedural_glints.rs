@@ -243,6 +243,9 @@ fn samplers_match_their_densities() {
             .unwrap();
         for theta in [0.0, 60.0, 85.0] {
             let wo = support::dir(theta, 20.0);
+            // Prepared for the view: V(wo) once for the draws and the density's quadrature.
+            let mut p = p.clone();
+            p.prepare_view(wo);
             cfg(format!("procedural {area} texels visible {theta}"))
                 .run(
                     |_, u| Some(p.sample_visible(wo, u)).filter(|&m| p.pdf_visible(wo, m) > 0.0),

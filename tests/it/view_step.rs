@@ -1,4 +1,4 @@
-//! The view step: a glint patch of every registered model (through `GlintPatch::with_view`), a
+//! The view step: a glint patch of every registered model (through `GlintPatch::prepare_view`), a
 //! `LayeredBrdf` and a `Material`'s `Bsdf` prepared for a view answer every query bit for bit as
 //! the unprepared ones, at the prepared view and at every other view. What the step computes (a
 //! patch's V(wo), the bin map's visible normalisation, a layer's R̂(wo)) is only shared, never
@@ -73,17 +73,21 @@ fn prepared_patches_answer_as_unprepared_ones() {
             let fp = Footprint::isotropic_texels(c, area, 64, 64);
             let plain = ex.model.patch_with(&fp, &ex.options, None);
             for (v, &wo) in views.iter().enumerate() {
-                let prepared = plain.clone().with_view(wo);
+                let mut prepared = plain.clone();
+                prepared.prepare_view(wo);
                 let other = views[(v + 1) % views.len()];
                 let seed = (e * 100 + k * 10 + v) as u64;
                 same_patch(&prepared, &plain, wo, other, seed);
             }
             // A patch prepared for one view and then for another holds the second.
-            let twice = plain.clone().with_view(views[1]).with_view(views[2]);
+            let mut twice = plain.clone();
+            twice.prepare_view(views[1]);
+            twice.prepare_view(views[2]);
             same_patch(&twice, &plain, views[2], views[1], 7);
             // Invalid views prepare nothing and stay total.
             for bad in [Vec3::new(0.0, 0.0, -1.0), Vec3::NAN, Vec3::ZERO] {
-                let p = plain.clone().with_view(bad);
+                let mut p = plain.clone();
+                p.prepare_view(bad);
                 same_patch(&p, &plain, views[1], views[3], 9);
                 assert_eq!(
                     p.view_visible_area(bad),
@@ -106,7 +110,8 @@ fn prepared_layers_answer_as_unprepared_ones() {
     let plain = LayeredBrdf::new(coat, Vec3::new(0.7, 0.3, 0.1)).unwrap();
     let mut rng = support::rng(11);
     for wo in views() {
-        let prepared = plain.clone().with_view(wo);
+        let mut prepared = plain.clone();
+        prepared.prepare_view(wo);
         for w in [wo, support::dir(50.0, 10.0)] {
             assert_eq!(
                 prepared.first_bounce_reflectance(w),

@@ -105,7 +105,7 @@ pub struct BinMapPatch<'a> {
     /// Smoothing lobes' slope σ, if any.
     pub(super) sigma: Option<f64>,
     /// With exact terms, V(wo) and the visible sampler's normalisation at the view the patch was
-    /// prepared for ([`BinMapPatch::with_view`]).
+    /// prepared for ([`BinMapPatch::prepare_view`]).
     pub(super) view_area: PreparedView,
     pub(super) view_total: PreparedView,
 }
@@ -203,14 +203,14 @@ impl<'a> BinMapPatch<'a> {
         }
     }
 
-    /// The patch prepared for the view direction `wo` (shading frame): with exact masking terms,
+    /// Prepares the patch for the view direction `wo` (shading frame): with exact masking terms,
     /// V(wo) and the visible sampler's normalisation (each a pass over the footprint's bins or
     /// smoothing lobes), computed here once and read by the queries at that wo
     /// (`view_visible_area`, `sample_visible`, `pdf_visible`); queries at any other view compute
     /// their own. Every value is the one the unprepared patch returns, bit for bit. Without exact
-    /// terms there is nothing to prepare (V is the moment lobe's, O(1)). `Material::bsdf` prepares
-    /// its glint patches for the shading point's wo.
-    pub fn with_view(mut self, wo: Vec3) -> Self {
+    /// terms there is nothing to prepare (V is the moment lobe's, O(1)). A second call replaces the
+    /// first view. `Material::bsdf` prepares its glint patches for the shading point's wo.
+    pub fn prepare_view(&mut self, wo: Vec3) {
         self.view_area = PreparedView::NONE;
         self.view_total = PreparedView::NONE;
         if let Some(e) = &self.exact
@@ -222,7 +222,6 @@ impl<'a> BinMapPatch<'a> {
             self.view_area = PreparedView::new(wo, area);
             self.view_total = PreparedView::new(wo, total);
         }
-        self
     }
 
     /// The translations (−p·W, −q·H) of every tile (p, q) that A's bounding box meets (W × H the

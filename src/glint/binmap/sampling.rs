@@ -150,7 +150,7 @@ impl Ndf for BinMapPatch<'_> {
     }
 
     /// [`Ndf::visible_area`]`(wo)`, the prepared value at the view the patch was prepared for
-    /// ([`BinMapPatch::with_view`](super::BinMapPatch::with_view)).
+    /// ([`BinMapPatch::prepare_view`](super::BinMapPatch::prepare_view)).
     fn view_visible_area(&self, wo: Vec3) -> f32 {
         self.view_area.get_or(wo, || self.visible_area(wo) as f64) as f32
     }

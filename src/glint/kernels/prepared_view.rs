@@ -1,5 +1,5 @@
 //! [`PreparedView`]: a value a patch computes once for the view direction it is prepared for, by
-//! an explicit step (the patches' `with_view`, called by `Material::bsdf` with the shading point's
+//! an explicit step (the patches' `prepare_view`, called by `Material::bsdf` with the shading point's
 //! wo), so that the queries a renderer makes at one shading point and one wo (`eval_pdf` at a few
 //! wi, `sample`, the densities) pay the pass over the patch's lobes once instead of once per query.
 //!

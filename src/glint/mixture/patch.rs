@@ -92,7 +92,7 @@ impl PatchLevel<'_> {
 ///   P-NDFs blurred by N(0, r² I)) is at most `lod_tolerance`, then moved coarser if the footprint
 ///   still covers more than `lod_lobes` nodes (the filtered lobe alone if no level is coarse
 ///   enough). D_P, both masking modes, both samplers and their pdfs all use that one level.
-/// - Cost per shading point: a patch prepared for its view ([`MixturePatch::with_view`], which
+/// - Cost per shading point: a patch prepared for its view ([`MixturePatch::prepare_view`], which
 ///   `Material::bsdf` calls with the shading point's wo) holds the exact V_P(wo), computed once by
 ///   that explicit step (nothing is kept lazily: a patch that was not prepared computes V_P(wo) per
 ///   query), and takes the D_P(h) that `MicrofacetBrdf::eval_pdf` already evaluated
@@ -131,7 +131,7 @@ pub struct MixturePatch<'a> {
     cut: Option<CutStats>,
     /// The compiled copy of the block loops the patch runs ([`Simd::detected`]).
     simd: Simd,
-    /// The exact V_P at the view the patch was prepared for ([`MixturePatch::with_view`]; read by
+    /// The exact V_P at the view the patch was prepared for ([`MixturePatch::prepare_view`]; read by
     /// `pdf_visible`, `sample_visible` and `view_visible_area` at that wo).
     view: PreparedView,
 }
@@ -209,16 +209,16 @@ impl<'a> MixturePatch<'a> {
         self.masking
     }
 
-    /// The patch prepared for the view direction `wo` (shading frame): the exact V_P(wo) that the
+    /// Prepares the patch for the view direction `wo` (shading frame): the exact V_P(wo) that the
     /// queries at that wo share (`view_visible_area`, `pdf_visible`, `sample_visible`, the
     /// densities `MicrofacetBrdf` forms), computed here once, an O(lobes) pass. Queries at `wo` (the
     /// same bits) then read it; queries at any other view compute their own. Every value is the
-    /// one the unprepared patch returns, bit for bit. `Material::bsdf` prepares its glint patches
-    /// for the shading point's wo.
-    pub fn with_view(mut self, wo: Vec3) -> Self {
+    /// one the unprepared patch returns, bit for bit. A second call replaces the first view.
+    /// `Material::bsdf` prepares its glint patches for the shading point's wo.
+    pub fn prepare_view(&mut self, wo: Vec3) {
         self.view = PreparedView::NONE;
         if !(wo.z > 0.0 && wo.is_finite()) {
-            return self;
+            return;
         }
         let v = match (&self.gathered, self.masking, &self.few) {
             (Some(g), MaskingMode::Exact, _) => Some(self.exact_visible_area(g, wo)),
@@ -228,7 +228,6 @@ impl<'a> MixturePatch<'a> {
         if let Some(v) = v {
             self.view = PreparedView::new(wo, v);
         }
-        self
     }
 
     /// Whether the level of detail replaced the mixture by the single filtered lobe (the
@@ -384,7 +383,7 @@ impl<'a> MixturePatch<'a> {
     }
 
     /// [`MixturePatch::exact_visible_area`] at a view direction: the prepared value if `wo` is the
-    /// view the patch was prepared for ([`MixturePatch::with_view`]), else one pass.
+    /// view the patch was prepared for ([`MixturePatch::prepare_view`]), else one pass.
     fn view_exact_visible_area(&self, g: &Gathered, wo: Vec3) -> f64 {
         if !(wo.z > 0.0 && wo.is_finite()) {
             return 0.0;
@@ -582,7 +581,7 @@ impl Ndf for MixturePatch<'_> {
     }
 
     /// [`Ndf::visible_area`] at the view: the exact V_P prepared for `wo` if the patch was
-    /// prepared for it ([`MaskingMode::Exact`]; [`MixturePatch::with_view`]); Scarf's bound, O(1),
+    /// prepared for it ([`MaskingMode::Exact`]; [`MixturePatch::prepare_view`]); Scarf's bound, O(1),
     /// is never prepared ([`MaskingMode::Approximate`]).
     fn view_visible_area(&self, wo: Vec3) -> f32 {
         match (&self.gathered, self.masking) {

@@ -6,7 +6,7 @@
 //! geometry (geometry.rs), the rectangle of elements that can be within `weight_sigmas` of the
 //! footprint, their total weight and the P-NDF's first and second slope moments, and the kept
 //! elements' weights and lobes (the samplers', masking's and densities'). The exact V(wo) is
-//! computed once for the view the patch is prepared for ([`PositionNormalPatch::with_view`]).
+//! computed once for the view the patch is prepared for ([`PositionNormalPatch::prepare_view`]).
 
 use super::build::slope_box;
 use super::filtered::footprint_in_elements;
@@ -92,7 +92,7 @@ pub struct PositionNormalPatch<'a> {
     few: Few<'a>,
     /// What the cut did, when a cut serves the patch.
     cut: Option<CutStats>,
-    /// The exact V(wo) at the view the patch was prepared for ([`PositionNormalPatch::with_view`];
+    /// The exact V(wo) at the view the patch was prepared for ([`PositionNormalPatch::prepare_view`];
     /// read by `view_visible_area`, `pdf_visible` and `sample_visible` at that wo).
     view: PreparedView,
 }
@@ -170,17 +170,17 @@ impl<'a> PositionNormalPatch<'a> {
         }
     }
 
-    /// The patch prepared for the view direction `wo` (shading frame): the exact V(wo) that the
+    /// Prepares the patch for the view direction `wo` (shading frame): the exact V(wo) that the
     /// queries at that wo share (`view_visible_area`, `pdf_visible`, `sample_visible`), computed
     /// here once, an O(elements) pass. Queries at `wo` (the same bits) then read it; queries at any
     /// other view compute their own. Every value is the one the unprepared patch returns, bit for
-    /// bit. `Material::bsdf` prepares its glint patches for the shading point's wo.
-    pub fn with_view(mut self, wo: Vec3) -> Self {
+    /// bit. A second call replaces the first view. `Material::bsdf` prepares its glint patches for
+    /// the shading point's wo.
+    pub fn prepare_view(&mut self, wo: Vec3) {
         self.view = PreparedView::NONE;
         if wo.z > 0.0 && wo.is_finite() {
             self.view = PreparedView::new(wo, self.exact_visible_area(wo));
         }
-        self
     }
 
     /// Whether the filtered mixture serves the patch (module docs of
@@ -478,7 +478,7 @@ impl Ndf for PositionNormalPatch<'_> {
     }
 
     /// [`Ndf::visible_area`]`(wo)`, the exact V as prepared for the patch's view
-    /// ([`PositionNormalPatch::with_view`]) at that wo.
+    /// ([`PositionNormalPatch::prepare_view`]) at that wo.
     fn view_visible_area(&self, wo: Vec3) -> f32 {
         if self.count <= EXACT_MASKING_ELEMENTS {
             finite_or_zero(self.view_exact_visible_area(wo))

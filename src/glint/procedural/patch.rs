@@ -62,14 +62,14 @@ impl ProceduralPatch<'_> {
         }
     }
 
-    /// The patch prepared for the view direction `wo` (shading frame): the exact V(wo) that the
+    /// Prepares the patch for the view direction `wo` (shading frame): the exact V(wo) that the
     /// queries at that wo share (`view_visible_area`, the visible densities), computed here once,
     /// an O(lobes) pass. Queries at `wo` (the same bits) then read it; queries at any other view
-    /// compute their own. Every value is the one the unprepared patch returns, bit for bit.
-    /// `Material::bsdf` prepares its glint patches for the shading point's wo.
-    pub fn with_view(mut self, wo: Vec3) -> Self {
+    /// compute their own. Every value is the one the unprepared patch returns, bit for bit. A
+    /// second call replaces the first view. `Material::bsdf` prepares its glint patches for the
+    /// shading point's wo.
+    pub fn prepare_view(&mut self, wo: Vec3) {
         self.few.prepare_view(wo);
-        self
     }
 
     /// The number of lobes the patch holds (the limit lobe included): at most a few tens, whatever

@@ -59,7 +59,7 @@ impl MixturePatch<'_> {
     }
 
     /// [`Ndf::pdf_visible`], with `d` giving D_P(m) for the density contract's check and V_P(wo)
-    /// as prepared for the patch's view ([`MixturePatch::with_view`]).
+    /// as prepared for the patch's view ([`MixturePatch::prepare_view`]).
     #[inline]
     pub(super) fn pdf_visible_with(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
         self.visible_density(wo, m, d, false)
