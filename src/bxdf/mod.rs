@@ -22,6 +22,7 @@ mod albedo_anisotropic;
 mod albedo_tables;
 mod blinn_phong;
 mod clear_coat;
+mod coat_albedo;
 mod compensated;
 mod lambert;
 #[cfg(feature = "std")]
@@ -40,8 +41,9 @@ pub use albedo_anisotropic::{
     ANISO_PHI_NODES, AnisotropicAlbedo, AnisotropicAlbedoTable, encode_albedo,
 };
 pub use blinn_phong::{BlinnPhongLobe, BlinnPhongNormalization};
-pub use clear_coat::{
-    BaseAlbedo, COAT_ALBEDO_DIRECTIONS, COAT_ALBEDO_GRID, ClearCoat, MAX_COAT_ETA, MAX_ROUND_TRIP,
+pub use clear_coat::ClearCoat;
+pub use coat_albedo::{
+    BaseAlbedo, COAT_ALBEDO_DIRECTIONS, COAT_ALBEDO_GRID, MAX_COAT_ETA, MAX_ROUND_TRIP,
     MIN_COAT_ETA, diffuse_external_reflectance, diffuse_internal_reflectance,
 };
 pub use compensated::{
