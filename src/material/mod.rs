@@ -36,9 +36,11 @@
 //! [`Material::Microfacet`] over GGX or Beckmann, [`Material::Compensated`] with the energy of
 //! multiple scattering given back, [`Material::Layered`]), the smooth limit
 //! ([`Material::Mirror`], a delta lobe), glints ([`GlintMaterial`]: any glint model, alone or as a
-//! coat over a Lambertian base) and normal mapping ([`NormalMappedMaterial`]: any
+//! coat over a Lambertian base), normal mapping ([`NormalMappedMaterial`]: any
 //! footprint-independent material about a normal map's normals, through microfacet-based or
-//! conventional normal mapping).
+//! conventional normal mapping) and a smooth clear coat over any of them
+//! ([`ClearCoatMaterial`], [`Material::clear_coated`]: car paint is glint flakes over paint under
+//! the coat).
 //!
 //! ## Design
 //! [`Material`] is a closed enum dispatched by `match`, not a trait object: its BSDF at a shading
