@@ -89,8 +89,8 @@ fn main() -> Res<()> {
             "A small path tracer (point light + sky, next-event estimation with MIS, a few bounces) \
              shading one sphere with analytic gold, a perfect mirror, two glint conductors (a \
              procedural scratched map and a PNG normal map the example writes first), a glint \
-             clear coat over red paint and glittering car paint (a clear coat of procedural glints, \
-             no normal map, over dark blue paint), every material a `brdf::Material`, through the \
+             coat over red paint and car paint (procedural aluminium flakes over dark blue paint, no \
+             normal map, under a smooth clear coat), every material a `brdf::Material`, through the \
              public API only (the render example, quick setting).",
             common::render::showcase::run,
         ),

@@ -8,9 +8,9 @@
 //! Writes into DIR (default `target/brdf-out/`) a hammered normal map PNG (generated from a height
 //! field, then loaded back like any asset) and six tone-mapped renders of the same scene: analytic
 //! gold, a silver mirror, scratched silver glints (procedural map), hammered copper glints (the PNG
-//! map), a glint clear coat over red paint (layered), and glittering car paint (a clear coat of
-//! procedural glints, no normal map, over dark blue paint). `--quick` is the gallery's small, fast
-//! setting.
+//! map), a glint clear coat over red paint (layered), and car paint (procedural aluminium flakes,
+//! no normal map, over dark blue paint, under a smooth clear coat: `Material::clear_coated`).
+//! `--quick` is the gallery's small, fast setting.
 //!
 //! `--timing` instead measures frame times: analytic GGX, the four glint models at their defaults
 //! and conventional normal mapping on one scratched map at three map scales, alternating, and writes

@@ -1,10 +1,12 @@
 //! Instructions per shading point (callgrind): Material::bsdf + 2 eval_pdf + 1 sample at one wo.
 use brdf::Vec2;
+use brdf::bxdf::Bxdf;
 use brdf::fresnel::ConductorFresnel;
 use brdf::glint::procedural::{ProceduralGlints, ProceduralParams};
-use brdf::glint::{BeckmannMixture, BinMap, Footprint, GlintModel, GlintScratch, PositionNormalMap};
+use brdf::glint::{
+    BeckmannMixture, BinMap, Footprint, GlintModel, GlintScratch, PositionNormalMap,
+};
 use brdf::material::{GlintMaterial, Material};
-use brdf::bxdf::Bxdf;
 use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
 use std::sync::Arc;
@@ -36,14 +38,27 @@ fn shade_all(m: &Material, area: f32, n: usize, size: usize, scratch: &GlintScra
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
-    let (which, area, n) = (a[1].as_str(), a[2].parse::<f32>().unwrap(), a[3].parse::<usize>().unwrap());
+    let (which, area, n) = (
+        a[1].as_str(),
+        a[2].parse::<f32>().unwrap(),
+        a[3].parse::<usize>().unwrap(),
+    );
     let size = 256;
     let map = brdf::glint::scratched(size, size, Default::default(), 3).unwrap();
     let model: GlintModel = match which {
-        "mixture" => BeckmannMixture::build(&map, Default::default()).unwrap().into(),
+        "mixture" => BeckmannMixture::build(&map, Default::default())
+            .unwrap()
+            .into(),
         "binmap" => BinMap::build(&map, Default::default()).unwrap().into(),
-        "pn" => PositionNormalMap::build(&map, Default::default()).unwrap().into(),
-        _ => ProceduralGlints::new(ProceduralParams { resolution: [size, size], ..Default::default() }).unwrap().into(),
+        "pn" => PositionNormalMap::build(&map, Default::default())
+            .unwrap()
+            .into(),
+        _ => ProceduralGlints::new(ProceduralParams {
+            resolution: [size, size],
+            ..Default::default()
+        })
+        .unwrap()
+        .into(),
     };
     let m: Material = GlintMaterial::new(Arc::new(model), ConductorFresnel::GOLD).into();
     let scratch = GlintScratch::default();

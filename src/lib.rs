@@ -109,7 +109,9 @@
 //!
 //! - **No normal map** (smooth to rough metal, plastic): [`Material::microfacet`] over [`Ggx`] or
 //!   [`Beckmann`] ([`Material::microfacet_compensated`] to keep the energy of multiple scattering),
-//!   [`Material::layered`] for a coat, [`Material::mirror`] for the smooth limit: closed forms.
+//!   [`Material::layered`] for a rough coat over a diffuse base, [`Material::clear_coated`] for a
+//!   smooth varnish over any material (car paint: glint flakes over paint under the coat),
+//!   [`Material::mirror`] for the smooth limit: closed forms.
 //! - **A normal map, no glints** (the look is smooth): [`material::NormalMappedMaterial`]
 //!   (microfacet-based normal mapping), one map lookup per shading point.
 //! - **Glints**: a glint model of the map, at its defaults. Each chooses its own form per footprint

@@ -8,7 +8,8 @@
 //! [`BlinnPhongLobe`]; and [`MicrofacetBrdf`], generic over any [`crate::ndf::Ndf`] (centred NDFs,
 //! non-centred lobes, glint patches) and any [`crate::fresnel::Fresnel`], with opt-in multiple-scattering
 //! energy compensation in [`EnergyCompensated`] (tables: [`AlbedoTable`]); [`LayeredBrdf`], a microfacet
-//! layer over a Lambertian base; [`SpecularReflection`], the smooth limit (a delta lobe, see the
+//! layer over a Lambertian base; [`ClearCoat`], a smooth dielectric coat over any base BxDF (car
+//! paint: flakes under a varnish); [`SpecularReflection`], the smooth limit (a delta lobe, see the
 //! convention on [`Bxdf`]); and the shading-normal adapters [`NormalMapTilt`] (conventional normal
 //! mapping) and [`NormalMapMicrofacet`] (microfacet-based normal mapping), each wrapping any inner
 //! [`Bxdf`]. Which are reciprocal and which conserve or normalise energy: docs/bxdf.md.
@@ -20,6 +21,8 @@ mod albedo;
 mod albedo_anisotropic;
 mod albedo_tables;
 mod blinn_phong;
+mod clear_coat;
+mod coat_albedo;
 mod compensated;
 mod lambert;
 mod layered;
@@ -37,6 +40,13 @@ pub use albedo_anisotropic::{
     ANISO_PHI_NODES, AnisotropicAlbedo, AnisotropicAlbedoTable, encode_albedo,
 };
 pub use blinn_phong::{BlinnPhongLobe, BlinnPhongNormalization};
+pub use clear_coat::ClearCoat;
+#[cfg(feature = "std")]
+pub(crate) use clear_coat::inside_view;
+pub use coat_albedo::{
+    BaseAlbedo, COAT_ALBEDO_DIRECTIONS, COAT_ALBEDO_GRID, MAX_COAT_ETA, MAX_ROUND_TRIP,
+    MIN_COAT_ETA, diffuse_external_reflectance, diffuse_internal_reflectance,
+};
 pub use compensated::{
     EnergyCompensated, TabulatedAlbedo, average_fresnel, multiple_scattering_fresnel,
 };

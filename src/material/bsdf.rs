@@ -3,8 +3,8 @@
 
 use super::{AnalyticNdf, AnyFresnel};
 use crate::bxdf::{
-    BlinnPhongLobe, EnergyCompensated, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet,
-    NormalMapTilt, OriginalPhong, Phong, SpecularReflection, forward_bxdf,
+    BlinnPhongLobe, ClearCoat, EnergyCompensated, Lambert, LayeredBrdf, MicrofacetBrdf,
+    NormalMapMicrofacet, NormalMapTilt, OriginalPhong, Phong, SpecularReflection, forward_bxdf,
 };
 use crate::glint::GlintPatch;
 
@@ -18,9 +18,17 @@ use crate::glint::GlintPatch;
 /// `Bsdf`s of one scratch can be alive at once (one per path vertex, say). Building one allocates
 /// nothing once the scratch is warm.
 #[derive(Debug)]
-pub struct Bsdf<'a>(pub(super) Inner<'a>);
+pub struct Bsdf<'a>(pub(super) Coat<'a>);
 
-/// The BRDF behind a [`Bsdf`].
+/// The BRDF behind a [`Bsdf`]: a material's own, or that under a clear coat (one level: coats do
+/// not nest, so the type is not recursive and needs no allocation).
+#[derive(Debug)]
+pub(super) enum Coat<'a> {
+    Bare(Inner<'a>),
+    Coated(ClearCoat<Inner<'a>>),
+}
+
+/// The BRDF of a material without its clear coat.
 #[derive(Debug)]
 pub(super) enum Inner<'a> {
     Plain(Plain<'a>),
@@ -61,10 +69,10 @@ macro_rules! forward_plain {
     };
 }
 
-/// Forwards one `Bxdf` method to the BRDF behind a [`Bsdf`].
-macro_rules! forward {
+/// Forwards one `Bxdf` method to the BRDF behind an [`Inner`].
+macro_rules! forward_inner {
     ($self_:ident, $b:ident => $e:expr) => {
-        match &$self_.0 {
+        match $self_ {
             Inner::Plain($b) => $e,
             Inner::Glint($b) => $e,
             Inner::GlintCoat($b) => $e,
@@ -76,4 +84,16 @@ macro_rules! forward {
 
 forward_bxdf!(['a] Plain<'a>, forward_plain);
 
-forward_bxdf!(['a] Bsdf<'a>, forward);
+/// Forwards one `Bxdf` method to the BRDF behind a [`Bsdf`].
+macro_rules! forward_coat {
+    ($self_:ident, $b:ident => $e:expr) => {
+        match &$self_.0 {
+            Coat::Bare($b) => $e,
+            Coat::Coated($b) => $e,
+        }
+    };
+}
+
+forward_bxdf!(['a] Inner<'a>, forward_inner);
+
+forward_bxdf!(['a] Bsdf<'a>, forward_coat);

@@ -36,9 +36,11 @@
 //! [`Material::Microfacet`] over GGX or Beckmann, [`Material::Compensated`] with the energy of
 //! multiple scattering given back, [`Material::Layered`]), the smooth limit
 //! ([`Material::Mirror`], a delta lobe), glints ([`GlintMaterial`]: any glint model, alone or as a
-//! coat over a Lambertian base) and normal mapping ([`NormalMappedMaterial`]: any
+//! coat over a Lambertian base), normal mapping ([`NormalMappedMaterial`]: any
 //! footprint-independent material about a normal map's normals, through microfacet-based or
-//! conventional normal mapping).
+//! conventional normal mapping) and a smooth clear coat over any of them
+//! ([`ClearCoatMaterial`], [`Material::clear_coated`]: car paint is glint flakes over paint under
+//! the coat).
 //!
 //! ## Design
 //! [`Material`] is a closed enum dispatched by `match`, not a trait object: its BSDF at a shading
@@ -55,23 +57,26 @@
 
 mod analytic;
 mod bsdf;
+mod clear_coat;
 mod fresnel;
 mod glint;
 mod normal_mapped;
 
 pub use analytic::AnalyticNdf;
 pub use bsdf::Bsdf;
+pub use clear_coat::ClearCoatMaterial;
 pub use fresnel::AnyFresnel;
 pub use glint::GlintMaterial;
 pub use normal_mapped::{NormalMappedMaterial, NormalMapping};
 
+use crate::bxdf::inside_view;
 use crate::bxdf::{
-    BlinnPhongLobe, EnergyCompensated, Lambert, LayeredBrdf, MicrofacetBrdf, NormalMapMicrofacet,
-    NormalMapTilt, OriginalPhong, Phong, SpecularReflection,
+    BlinnPhongLobe, ClearCoat, EnergyCompensated, Lambert, LayeredBrdf, MicrofacetBrdf,
+    NormalMapMicrofacet, NormalMapTilt, OriginalPhong, Phong, SpecularReflection,
 };
 use crate::error::Result;
 use crate::glint::{Footprint, GlintNdf, GlintScratch};
-use bsdf::{Inner, Plain};
+use bsdf::{Coat, Inner, Plain};
 use glam::Vec3;
 
 /// Any BRDF of the crate, chosen at run time (module docs): build it with the constructors or
@@ -102,6 +107,9 @@ pub enum Material {
     /// A footprint-independent material shaded about a normal map's normals
     /// ([`NormalMappedMaterial`]).
     NormalMapped(NormalMappedMaterial),
+    /// Any other material under a smooth dielectric clear coat ([`ClearCoatMaterial`],
+    /// [`crate::bxdf::ClearCoat`]): car paint, varnish.
+    ClearCoat(ClearCoatMaterial),
 }
 
 impl Material {
@@ -137,6 +145,19 @@ impl Material {
         Ok(Material::Layered(LayeredBrdf::new(specular, base)?))
     }
 
+    /// `inner` under a smooth dielectric clear coat of relative index `eta`
+    /// ([`Material::ClearCoat`]): the coat's mirror reflection, and `inner` seen through the
+    /// coat with its internal reflections (docs/bxdf.md, "Clear coat"). Car paint is metallic
+    /// glint flakes over a paint base ([`GlintMaterial::over_base`]) under a coat of η = 1.5.
+    ///
+    /// # Errors
+    /// Those of [`ClearCoatMaterial::new`]: `eta` outside (1, 3], or an `inner` that is itself
+    /// clear-coated.
+    pub fn clear_coated(inner: impl Into<Material>, eta: f32) -> Result<Material> {
+        let inner: Material = inner.into();
+        Ok(Material::ClearCoat(ClearCoatMaterial::new(inner, eta)?))
+    }
+
     /// A perfectly smooth reflector with Fresnel term `fresnel` (a delta lobe: [`Material::Mirror`]).
     pub fn mirror(fresnel: impl Into<AnyFresnel>) -> Material {
         Material::Mirror(SpecularReflection::new(fresnel.into()))
@@ -146,7 +167,11 @@ impl Material {
     /// use all of it, normal-mapped materials its centre): a renderer may skip computing ray
     /// differentials or cones for the others.
     pub fn uses_footprint(&self) -> bool {
-        matches!(self, Material::Glint(_) | Material::NormalMapped(_))
+        match self {
+            Material::Glint(_) | Material::NormalMapped(_) => true,
+            Material::ClearCoat(c) => c.inner().uses_footprint(),
+            _ => false,
+        }
     }
 
     /// The BRDF of a footprint-independent material (`None` for glint and normal-mapped ones).
@@ -160,7 +185,9 @@ impl Material {
             Material::Compensated(b) => Plain::Compensated(b),
             Material::Layered(b) => Plain::Layered(b.clone()),
             Material::Mirror(b) => Plain::Mirror(b),
-            Material::Glint(_) | Material::NormalMapped(_) => return None,
+            Material::Glint(_) | Material::NormalMapped(_) | Material::ClearCoat(_) => {
+                return None;
+            }
         })
     }
 
@@ -181,6 +208,28 @@ impl Material {
         scratch: &'a GlintScratch,
     ) -> Bsdf<'a> {
         Bsdf(match self {
+            Material::ClearCoat(c) => {
+                // The coat asks its base at the view refracted into it: the base is prepared there.
+                let view = inside_view(wo, c.eta());
+                let inner = c.inner().uncoated_bsdf(footprint, view, scratch);
+                // η was validated by `ClearCoatMaterial::new`.
+                Coat::Coated(ClearCoat::from_valid(inner, c.eta(), c.base_albedo()))
+            }
+            uncoated => Coat::Bare(uncoated.uncoated_bsdf(footprint, wo, scratch)),
+        })
+    }
+
+    /// The BRDF of a material that is not clear-coated (a clear-coated one gives its inner
+    /// material's; coats do not nest, `ClearCoatMaterial::new` rejects it), prepared for the view
+    /// `wo`.
+    fn uncoated_bsdf<'a>(
+        &'a self,
+        footprint: &Footprint,
+        wo: Vec3,
+        scratch: &'a GlintScratch,
+    ) -> Inner<'a> {
+        match self {
+            Material::ClearCoat(c) => c.inner().uncoated_bsdf(footprint, wo, scratch),
             Material::Glint(g) => {
                 let fp = g.map_footprint(footprint);
                 let mut patch = g.model().patch_with(&fp, g.options(), Some(scratch));
@@ -214,7 +263,7 @@ impl Material {
             }
             // Every other material is footprint-independent (`plain` is `Some`).
             plain => Inner::Plain(plain.plain().unwrap_or(Plain::Lambert(&Lambert::BLACK))),
-        })
+        }
     }
 }
 
@@ -242,6 +291,7 @@ material_from! {
     Compensated(EnergyCompensated<AnalyticNdf, AnyFresnel>),
     Layered(LayeredBrdf<AnalyticNdf, AnyFresnel>),
     Glint(GlintMaterial),
+    ClearCoat(ClearCoatMaterial),
 }
 
 #[cfg(test)]

@@ -43,17 +43,18 @@ impl NormalMappedMaterial {
     /// # Errors
     /// [`Error::InvalidParameter`] naming `base` when the base depends on the footprint itself
     /// (a glint or an already normal-mapped material): a glint model already resolves the
-    /// normal map, and adapters do not nest.
+    /// normal map, and adapters do not nest; or when it is clear-coated (a coat is flat over
+    /// its base: put the normal-mapped material under the coat instead).
     pub fn new(
         map: impl Into<Arc<NormalMap>>,
         base: impl Into<Arc<Material>>,
     ) -> Result<NormalMappedMaterial> {
         let base = base.into();
-        if base.uses_footprint() {
+        if base.uses_footprint() || matches!(*base, Material::ClearCoat(_)) {
             return Err(Error::InvalidParameter {
                 name: "base",
                 value: f64::NAN,
-                reason: "must not be a glint or normal-mapped material",
+                reason: "must not be a glint, normal-mapped or clear-coated material",
             });
         }
         Ok(NormalMappedMaterial {

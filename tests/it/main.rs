@@ -21,6 +21,8 @@ mod bxdf_microfacet;
 mod bxdf_phong;
 mod bxdf_reciprocity;
 mod bxdf_sampling;
+mod clear_coat;
+mod clear_coat_material;
 mod density_contract;
 mod density_contract_glint;
 mod docs_figures;

@@ -1,10 +1,10 @@
 //! The showcase of the render example: six materials on the same sphere (analytic gold, a mirror,
-//! two glint conductors, a glint coat over paint, procedural glints over paint), the normal map PNG it
-//! writes first, tone mapping and the progress bar.
+//! two glint conductors, a glint coat over paint, car paint: procedural metallic flakes over paint
+//! under a clear coat), the normal map PNG it writes first, tone mapping and the progress bar.
 
 use super::{Camera, Checker, Image, PointLight, Scene, Sky, render};
 use crate::common::{Artifact, Res, save_rgb};
-use brdf::fresnel::{ConductorFresnel, DielectricFresnel};
+use brdf::fresnel::{ConductorFresnel, DielectricFresnel, SchlickFresnel};
 use brdf::glint::mixture::MixtureParams;
 use brdf::glint::procedural::{ProceduralGlints, ProceduralParams};
 use brdf::glint::{
@@ -70,7 +70,7 @@ pub fn glint_material(map: &NormalMap, fresnel: impl Into<AnyFresnel>) -> Res<Gl
     Ok(GlintMaterial::new(model, fresnel))
 }
 
-/// The glittering car paint's procedural glints, `n` texels per uv period (the showcase's map
+/// The car paint's procedural flakes, `n` texels per uv period (the showcase's map
 /// size, so that its tiling puts the same ~3 texels per pixel on the sphere as the maps'): facets
 /// tilted widely (α = 0.5), so that sparkles spread far from the highlight as metallic flakes do;
 /// each facet nearly flat (α_f = 0.01, a point-like sparkle); 8 facets per texel, ~70 per pixel,
@@ -87,6 +87,12 @@ pub fn car_paint_params(n: usize) -> ProceduralParams {
 
 /// The car paint's Lambert base: a deep blue.
 const CAR_PAINT_BASE: Vec3 = Vec3::new(0.005, 0.01, 0.07);
+
+/// The fraction of the car paint's area its aluminium flakes cover.
+const FLAKE_COVERAGE: f32 = 0.2;
+
+/// The car paint's clear coat: a varnish of index 1.5.
+const CLEAR_COAT_ETA: f32 = 1.5;
 
 /// A hammered-metal height field (overlapping parabolic dents, the deepest wins), `n` × `n`, tiled,
 /// heights in texels; slopes up to ~0.3.
@@ -186,9 +192,12 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
         3,
     )?;
     let flakes = glint_material(&flakes, DielectricFresnel::new(1.5)?)?;
-    let glitter = GlintMaterial::new(
+    // Metallic flakes in the paint, under a clear coat (below). The glint layer covers the whole
+    // surface, while a metallic paint's flakes cover a fraction of it: aluminium's reflectance
+    // (F0 ≈ 0.91) on a fifth of the area is a Schlick term of f0 = 0.18.
+    let flakes_in_paint = GlintMaterial::new(
         GlintModel::from(ProceduralGlints::new(car_paint_params(n))?),
-        DielectricFresnel::new(1.5)?,
+        SchlickFresnel::new(Vec3::splat(FLAKE_COVERAGE) * ConductorFresnel::ALUMINIUM.f0())?,
     );
     type Make = Box<dyn FnOnce(Vec2) -> Res<Material>>;
     let shots: [(&str, &str, Make); 6] = [
@@ -227,11 +236,15 @@ pub fn run_with(out: &Path, opts: &Options) -> Res<Vec<Artifact>> {
         ),
         (
             "render_car_paint.png",
-            "glittering car paint: a procedural glint clear coat (no normal map: α = 0.5, facets of \
-             α_f = 0.01, 8 per texel; η = 1.5) over dark blue Lambert paint",
+            "car paint: procedural metallic flakes (no normal map: α = 0.5, facets of α_f = 0.01, 8 \
+             per texel; aluminium on a fifth of the area, Schlick f0 = 0.18) over dark blue Lambert \
+             paint, under a smooth clear coat (η = 1.5)",
             Box::new(move |tiles| {
-                let coat = glitter.with_uv_scale(tiles)?;
-                Ok(coat.over_base(CAR_PAINT_BASE)?.into())
+                let flakes = flakes_in_paint.with_uv_scale(tiles)?;
+                Ok(Material::clear_coated(
+                    flakes.over_base(CAR_PAINT_BASE)?,
+                    CLEAR_COAT_ETA,
+                )?)
             }),
         ),
     ];
