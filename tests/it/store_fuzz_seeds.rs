@@ -126,6 +126,7 @@ fn write_fuzz_seeds() {
                 density: 0.4,
                 resolution: [48, 20],
                 seed: u64::MAX,
+                ..ProceduralParams::default()
             },
         ),
     ];
