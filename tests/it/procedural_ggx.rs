@@ -138,7 +138,7 @@ fn ggx_tail(x: f64) -> f64 {
     0.5 - x / (2.0 * (1.0 + x * x).sqrt())
 }
 
-/// The mean of the P-NDF over the random field (footprint positions and 16 seeds) is GGX at every
+/// The mean of the P-NDF over the random field (footprint positions and seeds) is GGX at every
 /// footprint size: bin masses of the slope drawn from the patch's own normal sampler (chi-square
 /// tested below), one draw per random footprint, against GGX's (the second moment is infinite for
 /// GGX: only bounded test functions), each within 5 standard errors.
@@ -149,9 +149,6 @@ fn mean_over_positions_is_ggx() {
         alpha: Vec2::new(0.3, 0.2),
         ..params(0)
     };
-    let surfaces: Vec<ProceduralGlints> = (0..16)
-        .map(|seed| ProceduralGlints::new(ProceduralParams { seed, ..p }).unwrap())
-        .collect();
     let mut rng = support::rng(8);
     let n = 40_000;
     type SlopeFunction<'a> = Box<dyn Fn([f64; 2]) -> f64 + 'a>;
@@ -169,10 +166,14 @@ fn mean_over_positions_is_ggx() {
         ("P(|t| < 2)", Box::new(move |t| (r2(t) < 4.0) as u8 as f64), ggx_disc(2.0)),
         ("P(|t| > 6)", Box::new(move |t| (r2(t) > 36.0) as u8 as f64), 1.0 - ggx_disc(6.0)),
     ];
-    for area in AREAS {
+    for (a, area) in AREAS.into_iter().enumerate() {
         let mut sums = [(0.0f64, 0.0f64); 7];
         for k in 0..n {
-            let surface = &surfaces[k % surfaces.len()];
+            // A surface of its own per draw (a seed of the field): at coarse levels a period holds
+            // few cells, and draws from a few seeds would share their lobes' variance scales (the
+            // heavy tail of v makes that sharing visible), so that the draws were not independent.
+            let seed = (a * n + k) as u64;
+            let surface = ProceduralGlints::new(ProceduralParams { seed, ..p }).unwrap();
             let uv = Vec2::new(rng.random(), rng.random());
             let patch = surface.patch(&fp(uv, area));
             let m = patch.sample_normal(Vec2::new(rng.random(), rng.random()));
@@ -229,7 +230,7 @@ fn converges_to_the_limit() {
 
 /// Chi-square of both samplers at a small, a medium and a blended footprint (GGX and lobes), 10⁶
 /// draws each; draws where the density is 0 (beyond a lobe's slope box) count as `None`, as in
-/// procedural_glints.rs.
+/// procedural_glints.rs; normals beyond θ = 60° form the overflow cell (below).
 #[test]
 fn samplers_match_their_densities() {
     let s = surface(5);
@@ -243,7 +244,16 @@ fn samplers_match_their_densities() {
         if area > 1000.0 {
             assert!(p.limit_weight() > 0.0 && p.limit_weight() < 1.0);
         }
-        let cfg = |name: String| Chi2::new(name, family);
+        // Normals beyond θ = 60° (z < 0.5, slopes above 1.7) are one overflow cell, tested in
+        // aggregate: a GGX surface has narrow facet lobes (β = σ_f, a wide cell's lobe) far out,
+        // where a slope deviation of 0.014 is 8·10⁻⁴ rad at slope 4 and less beyond: 1/25 of a cell
+        // or less, between the points of the harness's 6 × 6 rule, which then agrees with its 4 × 4
+        // rule on nothing and misses the lobe (measured: 9 draws in cells expecting 0.008 with
+        // z_min 0.2). Within 60° a lobe is at least 3.6·10⁻³ rad wide, as the Beckmann surface's.
+        let cfg = |name: String| Chi2 {
+            z_min: Some(0.5),
+            ..Chi2::new(name, family)
+        };
         cfg(format!("procedural GGX {area} texels normals"))
             .run(
                 |_, u| Some(p.sample_normal(u)).filter(|&m| p.pdf_normal(m) > 0.0),

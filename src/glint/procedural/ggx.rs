@@ -28,10 +28,11 @@
 //! for isotropic α). For isotropic α this is (1/K)((1 − r)/2 + r (3/2 (σ̂²/σ_f² + e^(−α²/α_f²)) − 1)):
 //! the second term is what the footprint's n facets carry, min(1/K, 1/n)(3/2 σ̂²/σ_f² − 1) (as
 //! n facets of roughness σ_f drawn around GGX are from it), the first, (1 − r)/(2K), is the lobes'
-//! own: K Gaussians of random widths are not GGX however many facets each stands for. The limit
-//! blend is driven by the facets' part ([`facet_distance`]), so that large footprints reach GGX;
-//! before it the patch keeps the lobes' floor √((1 − r)/(2K)) (docs/procedural.md, "The GGX
-//! limit").
+//! own: K Gaussians of random widths are not GGX however many facets each stands for. So GGX is
+//! blended in twice ([`limit_weight`]): with the weight b_f that brings the patch's expected
+//! distance down to the facets' part (G deterministic: E‖(1 − b)L + bG − G‖² = (1 − b)² E‖L − G‖²),
+//! and, as for Beckmann, by the tolerance on the facets' part ([`facet_distance`]), so that large
+//! footprints are GGX alone (docs/procedural.md, "The GGX limit").
 
 /// Largest variance scale v a cell draws: 10⁵ (v exceeds it with probability 1 − e^(−1/(2·10⁵)) ≈
 /// 5·10⁻⁶), so that σ_i = √v α ≤ 633 and a lobe's mean (≤ 5.4 σ_i) stay within the range of a
@@ -86,6 +87,23 @@ pub(super) fn facet_distance(sigma: [f64; 2], sigma_f: f64, r: f64, k: f64) -> f
     ((total - 0.5 * (1.0 - r)).max(0.0) / k.max(1e-300)).sqrt()
 }
 
+/// The weight b of GGX in a GGX surface's patch: 1 − (1 − b_f)(1 − `b_tol`), with `b_tol` the
+/// tolerance's weight (0 above 2 tol, 1 below tol) and b_f the weight that makes the patch as far
+/// from GGX as its footprint's facets are (module docs): (1 − b_f)² (ρ_f² + (1 − r)/(2K)) = ρ_f²,
+/// i.e. 1 − b_f = ρ_f / √(ρ_f² + (1 − r)/(2K)), for ρ_f = `facet` ([`facet_distance`]), r and
+/// the kernel's effective lobe count `k`. b_f = 0 where r = 1 (a footprint of fewer facets than
+/// lobes).
+pub(super) fn limit_weight(facet: f64, r: f64, k: f64, b_tol: f32) -> f32 {
+    let floor2 = 0.5 * (1.0 - r.clamp(0.0, 1.0)) / k.max(1e-300);
+    let total = facet * facet + floor2;
+    let keep = if total > 0.0 {
+        facet / total.sqrt()
+    } else {
+        1.0
+    };
+    (1.0 - keep * (1.0 - b_tol as f64)).clamp(0.0, 1.0) as f32
+}
+
 /// The same distance for the footprint's n facets alone (r = 1, K = n): the bound a patch's
 /// [`facet_distance`] does not exceed for isotropic α, known before any lobe is gathered.
 pub(super) fn footprint_distance(sigma: [f64; 2], sigma_f: f64, n: f64) -> f64 {
@@ -134,6 +152,19 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The floor's weight: the blend (1 − b_f)² (ρ_f² + (1 − r)/(2K)) = ρ_f², none where r = 1,
+    /// the tolerance's weight on top.
+    #[test]
+    fn limit_weight_brings_the_distance_to_the_facets() {
+        let (f, r, k) = (0.2, 0.1, 12.0);
+        let b = limit_weight(f, r, k, 0.0) as f64;
+        let d2 = (1.0 - b).powi(2) * (f * f + 0.5 * (1.0 - r) / k);
+        assert!((d2 / (f * f) - 1.0).abs() < 1e-6, "{b} {d2}");
+        assert_eq!(limit_weight(f, 1.0, k, 0.0), 0.0);
+        assert_eq!(limit_weight(f, 1.0, k, 0.25), 0.25);
+        assert_eq!(limit_weight(f, r, k, 1.0), 1.0);
     }
 
     /// For isotropic α the facet distance is min(1/K, 1/n)(3/2 (ratio + e) − 1) (module docs).

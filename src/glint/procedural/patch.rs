@@ -270,8 +270,9 @@ fn beckmann_patch<'a>(
 }
 
 /// The patch of a GGX surface from its gathered lobes `cand` (weights summing to `sum`): each lobe
-/// its own width from its variance scale (src/glint/procedural/ggx.rs), blended with GGX by the
-/// facets' expected distance.
+/// its own width from its variance scale, blended with GGX so that the patch is as far from GGX as
+/// its footprint's facets are, and handed over to GGX by the tolerance
+/// (src/glint/procedural/ggx.rs).
 fn ggx_patch<'a>(
     cand: &Candidates,
     sum: f64,
@@ -283,7 +284,7 @@ fn ggx_patch<'a>(
     let x = wd.level;
     let r = wd.r.min(1.0);
     let distance = ggx::facet_distance(wd.sigma, wd.sigma_f, r, wd.k);
-    let b = wd.limit_weight(distance);
+    let b = ggx::limit_weight(distance, r, wd.k, wd.limit_weight(distance));
     if b >= 1.0 || cand.len == 0 {
         return ProceduralPatch::limit_alone(LimitNdf::Ggx(limit), x, distance);
     }
