@@ -1,6 +1,7 @@
 //! Procedural glints (`brdf::glint::procedural`) measured against their limit: how far a
-//! footprint's P-NDF is from the limit NDF (Beckmann or GGX) as the footprint grows, whether the mean of the
-//! P-NDF over positions is the limit at every size, and what one renderer shading point costs.
+//! footprint's P-NDF is from the limit NDF (Beckmann or GGX) as the footprint grows, whether the
+//! mean of the P-NDF over positions is the limit at every size, and what one renderer shading
+//! point costs.
 //!
 //! Five surfaces on the default 1024² grid (facet α_f = 0.02, seed 1): the default (α 0.3, one
 //! facet per texel), density 0.1 and 16 facets per texel, α 0.1, and the default of the GGX limit
@@ -407,7 +408,7 @@ fn chart(path: &Path, rows: &[Row], names: &[&'static str], quick: bool) -> Res<
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         root.fill(&WHITE)?;
         let root = root.titled(
-            "Procedural glints: TV of a footprint's P-NDF to the limit Beckmann NDF",
+            "Procedural glints: TV of a footprint's P-NDF to the limit NDF (Beckmann; GGX for the GGX limit)",
             ("sans-serif", 24),
         )?;
         let (left, right) = root.split_horizontally(w / 2);
@@ -560,7 +561,7 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
         ),
         Artifact::new(
             png,
-            "Procedural glints: TV of a footprint's P-NDF to the limit Beckmann NDF against the \
+            "Procedural glints: TV of a footprint's P-NDF to the limit NDF (Beckmann or GGX) against the \
              footprint (mean over random centres, ±2 standard errors), and of the mean P-NDF over \
              random centres.",
         ),

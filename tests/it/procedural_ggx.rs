@@ -160,11 +160,31 @@ fn mean_over_positions_is_ggx() {
             Box::new(|t| (t[0] > 0.0 && t[1] > 0.0) as u8 as f64),
             0.25,
         ),
-        ("P(tx > 1)", Box::new(|t| (t[0] > 1.0) as u8 as f64), ggx_tail(1.0)),
-        ("P(ty < −0.5)", Box::new(|t| (t[1] < -0.5) as u8 as f64), ggx_tail(0.5)),
-        ("P(|t| < 0.5)", Box::new(move |t| (r2(t) < 0.25) as u8 as f64), ggx_disc(0.5)),
-        ("P(|t| < 2)", Box::new(move |t| (r2(t) < 4.0) as u8 as f64), ggx_disc(2.0)),
-        ("P(|t| > 6)", Box::new(move |t| (r2(t) > 36.0) as u8 as f64), 1.0 - ggx_disc(6.0)),
+        (
+            "P(tx > 1)",
+            Box::new(|t| (t[0] > 1.0) as u8 as f64),
+            ggx_tail(1.0),
+        ),
+        (
+            "P(ty < −0.5)",
+            Box::new(|t| (t[1] < -0.5) as u8 as f64),
+            ggx_tail(0.5),
+        ),
+        (
+            "P(|t| < 0.5)",
+            Box::new(move |t| (r2(t) < 0.25) as u8 as f64),
+            ggx_disc(0.5),
+        ),
+        (
+            "P(|t| < 2)",
+            Box::new(move |t| (r2(t) < 4.0) as u8 as f64),
+            ggx_disc(2.0),
+        ),
+        (
+            "P(|t| > 6)",
+            Box::new(move |t| (r2(t) > 36.0) as u8 as f64),
+            1.0 - ggx_disc(6.0),
+        ),
     ];
     for (a, area) in AREAS.into_iter().enumerate() {
         let mut sums = [(0.0f64, 0.0f64); 7];
@@ -177,7 +197,10 @@ fn mean_over_positions_is_ggx() {
             let uv = Vec2::new(rng.random(), rng.random());
             let patch = surface.patch(&fp(uv, area));
             let m = patch.sample_normal(Vec2::new(rng.random(), rng.random()));
-            let t = [(-m.x / m.z) as f64 / alpha[0], (-m.y / m.z) as f64 / alpha[1]];
+            let t = [
+                (-m.x / m.z) as f64 / alpha[0],
+                (-m.y / m.z) as f64 / alpha[1],
+            ];
             for (acc, (_, f, _)) in sums.iter_mut().zip(&functions) {
                 let v = f(t);
                 acc.0 += v;
@@ -401,7 +424,10 @@ fn ggx_surfaces_survive_a_file() {
     beckmann.save(&mut old).unwrap();
     assert_eq!(u32::from_le_bytes(old[12..16].try_into().unwrap()), 6);
     // The same header but for the kind, the same payload (the checksums differ).
-    assert_eq!((old.len(), &old[..12], &old[16..64]), (72, &bytes[..12], &bytes[16..64]));
+    assert_eq!(
+        (old.len(), &old[..12], &old[16..64]),
+        (72, &bytes[..12], &bytes[16..64])
+    );
     let back = ProceduralGlints::load(&mut &old[..]).unwrap();
     assert_eq!(back.params().limit, ProceduralLimit::Beckmann);
 }

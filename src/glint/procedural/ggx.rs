@@ -120,7 +120,13 @@ mod tests {
     #[test]
     fn gaussian_scale_mixture_is_ggx() {
         let (ax, ay) = (0.3f64, 0.15f64);
-        for s in [[0.0, 0.0], [0.1, -0.05], [0.5, 0.2], [2.0, -1.0], [8.0, 3.0]] {
+        for s in [
+            [0.0, 0.0],
+            [0.1, -0.05],
+            [0.5, 0.2],
+            [2.0, -1.0],
+            [8.0, 3.0],
+        ] {
             let q = s[0] * s[0] / (ax * ax) + s[1] * s[1] / (ay * ay);
             let exact = 1.0 / (std::f64::consts::PI * ax * ay * (1.0 + q) * (1.0 + q));
             // E = x / (1 + q): the integrand's scale in x is 1 whatever q.
