@@ -448,3 +448,30 @@ fn large_footprints_are_ggx() {
         assert_eq!(p.d(m).to_bits(), g.d(m).to_bits());
     }
 }
+
+/// The density contract through `MicrofacetBrdf` (tests/it/density_contract.rs): eval > 0 ⇒
+/// pdf > 0, every value finite, visible-sample weights at most F, for GGX patches below a facet,
+/// of lobes, blended with GGX and GGX alone, over the contract's directions of cos θ 1 to 10⁻³⁰
+/// (a subset of its grid, as density_contract_glint.rs) and every draw of its `u` grid.
+#[test]
+fn ggx_patches_keep_the_density_contract() {
+    use crate::density_contract::{VISIBLE_BOUND, case, grid, run, u_grid};
+    let s: &'static ProceduralGlints = Box::leak(Box::new(surface(17)));
+    let cases: Vec<_> = [0.5f32, 256.0, 60000.0, 262144.0]
+        .into_iter()
+        .map(|area| {
+            let patch = s.patch(&fp(Vec2::new(0.43, 0.61), area));
+            case(
+                format!("procedural GGX {area} texels"),
+                MicrofacetBrdf::new(patch, NoFresnel),
+                Some(VISIBLE_BOUND),
+            )
+        })
+        .collect();
+    let cosines = [1.0f32, 0.5, 0.1, 1e-2, 1e-4, 1e-7, 1e-15, 1e-30];
+    let g: Vec<Vec3> = grid()
+        .into_iter()
+        .filter(|w| cosines.contains(&w.z))
+        .collect();
+    run(&cases, &g, &g, &u_grid());
+}

@@ -4,9 +4,11 @@
 //! **The scale mixture.** The anisotropic GGX slope density is a bivariate Student-t with two
 //! degrees of freedom, hence a Gaussian scale mixture:
 //!
-//!     P22(s) = 1 / (π αx αy (1 + sx²/αx² + sy²/αy²)²) = ∫ N(s; 0, v diag(αx², αy²)) g(v) dv,
+//! ```text
+//! P22(s) = 1 / (π αx αy (1 + sx²/αx² + sy²/αy²)²) = ∫ N(s; 0, v diag(αx², αy²)) g(v) dv,
+//! ```
 //!
-//! g = InverseGamma(shape 1, scale 1/2), i.e. v = 1/(2E) with E ~ Exp(1) (\[Heitz2014\] §5.4 gives
+//! g = InverseGamma(shape 1, scale 1/2), i.e. v = 1/(2E) with E ~ Exp(1) (\[Heitz2014\] gives
 //! GGX's slopes as this Student-t; the mixture is the Student-t's standard one: with q the
 //! Mahalanobis norm and w = 1/v ~ Exp(mean 2), ∫ w/(2π αx αy) e^(−q w/2) · e^(−w/2)/2 dw =
 //! 1/(4π αx αy) · 4/(1 + q)², checked by quadrature in `tests`). So a cell whose lobe draws v from
