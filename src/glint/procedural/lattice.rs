@@ -10,7 +10,8 @@
 //! n_l = density · spacing_l² facets of its cell: β_l is chosen so that the expected squared L2
 //! distance of the lobe to the limit equals that of n_l facets of roughness σ_f with means drawn
 //! from N(0, σ² − σ_f²) (docs/procedural.md, "Levels"):
-//! 1/β_l² = 1/σ² + (1/σ_f² − 1/σ²) / n_l.
+//! 1/β_l² = 1/σ² + (1/σ_f² − 1/σ²) / n_l. A surface of the GGX limit reads a third uniform per
+//! cell, its lobe's variance scale (src/glint/procedural/ggx.rs).
 
 use super::params::ProceduralParams;
 

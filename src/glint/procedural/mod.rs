@@ -4,15 +4,16 @@
 //! a few numbers a user understands ([`ProceduralParams`]): the roughness α the glints
 //! converge to, the facets' own roughness α_f (the size of one glint), their density per texel and
 //! the resolution that footprints are measured in, and which NDF it converges to
-//! ([`ProceduralLimit`]: Beckmann, or GGX as a Gaussian scale mixture, src/glint/procedural/ggx.rs). Nothing is stored per texel: a stateless hash
+//! ([`ProceduralLimit`]: Beckmann, or GGX as a Gaussian scale mixture,
+//! src/glint/procedural/ggx.rs). Nothing is stored per texel: a stateless hash
 //! places one lobe per cell of a multiscale lattice (src/glint/procedural/lattice.rs), and a
 //! footprint reads the one or two levels whose cells match its size.
 //!
 //! - [`ProceduralGlints::new`] validates the parameters and tabulates the levels (a few dozen
 //!   numbers).
 //! - [`GlintNdf::patch_with`] turns a [`Footprint`] into a [`ProceduralPatch`] of at most a few tens
-//!   of lobes (the kernel's anisotropy is capped), blending into the limit Beckmann lobe as the
-//!   footprint grows: bounded work at every footprint size.
+//!   of lobes (the kernel's anisotropy is capped), blending into the limit NDF as the footprint
+//!   grows: bounded work at every footprint size.
 //! - The mean of the P-NDF over positions is the limit NDF at every footprint size; the patch's
 //!   distance to it falls as 1/√(facets seen) (docs/procedural.md, with the method, its parameters,
 //!   its limits and its measurements).

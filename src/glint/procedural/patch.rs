@@ -34,6 +34,11 @@ use glam::{Mat2, Vec2};
 /// Every lobe has mean NDF D_lim (β² + τ² = σ², with β, τ depending on the footprint only), and the
 /// kernel weights do not depend on the lobes' slopes, so the mean of D_P over the random field is
 /// D_lim at every footprint size.
+///
+/// For a surface of the GGX limit (src/glint/procedural/ggx.rs) each lobe has its own variance
+/// scale v_i and width (σ_i² = v_i α²), D_lim is the crate's [`Ggx`] held beside the lobes (not a
+/// slope Gaussian: src/glint/procedural/limit.rs), and b also holds the share of GGX that brings
+/// the patch to its facets' expected distance; ρ is then that facets' part.
 #[derive(Clone, Debug)]
 pub struct ProceduralPatch<'a> {
     body: Body<'a>,
@@ -100,13 +105,14 @@ impl ProceduralPatch<'_> {
         self.level
     }
 
-    /// The weight b of the limit lobe in the patch (0: facets only; 1: the limit NDF alone).
+    /// The weight b of the limit NDF in the patch (0: facets only; 1: the limit NDF alone).
     pub fn limit_weight(&self) -> f32 {
         self.limit_weight
     }
 
     /// The expected relative L2 distance ρ of a patch of this footprint to the limit NDF
-    /// (what [`PatchOptions::tolerance`] is compared with).
+    /// (what [`PatchOptions::tolerance`] is compared with; for the GGX limit, the part of it that
+    /// the footprint's facets carry, src/glint/procedural/ggx.rs).
     pub fn expected_distance(&self) -> f32 {
         self.distance
     }
