@@ -251,18 +251,19 @@ fn converges_to_the_limit() {
     }
 }
 
-/// Chi-square of both samplers at a small, a medium and a blended footprint (GGX and lobes), 10⁶
-/// draws each; draws where the density is 0 (beyond a lobe's slope box) count as `None`, as in
-/// procedural_glints.rs; normals beyond θ = 60° form the overflow cell (below).
-#[test]
-fn samplers_match_their_densities() {
+/// The sampler checks at a small (1 texel), a medium (256) and a blended footprint (60,000: GGX
+/// and lobes): which of them `cases` selects as (area index, sampler: None normals, Some(θo)
+/// visible). 10⁶ draws each; draws where the density is 0 (beyond a lobe's slope box) count as
+/// `None`, as in procedural_glints.rs; normals beyond θ = 60° form the overflow cell (below).
+fn chi2_samplers(cases: &[(usize, Option<f64>)]) {
     let s = surface(5);
-    let family = 12;
-    for (area, uv) in [
+    let footprints = [
         (1.0f32, Vec2::new(0.31, 0.62)),
         (256.0, Vec2::new(0.77, 0.12)),
         (60000.0, Vec2::new(0.5, 0.5)),
-    ] {
+    ];
+    for &(k, sampler) in cases {
+        let (area, uv) = footprints[k];
         let p = s.patch(&fp(uv, area));
         if area > 1000.0 {
             assert!(p.limit_weight() > 0.0 && p.limit_weight() < 1.0);
@@ -275,46 +276,84 @@ fn samplers_match_their_densities() {
         // z_min 0.2). Within 60° a lobe is at least 3.6·10⁻³ rad wide, as the Beckmann surface's.
         let cfg = |name: String| Chi2 {
             z_min: Some(0.5),
-            ..Chi2::new(name, family)
+            ..Chi2::new(name, cases.len())
         };
-        cfg(format!("procedural GGX {area} texels normals"))
-            .run(
+        match sampler {
+            None => cfg(format!("procedural GGX {area} texels normals")).run(
                 |_, u| Some(p.sample_normal(u)).filter(|&m| p.pdf_normal(m) > 0.0),
                 |m| p.pdf_normal(m) as f64,
-            )
-            .unwrap();
-        for theta in [0.0, 60.0, 85.0] {
-            let wo = support::dir(theta, 20.0);
-            cfg(format!("procedural GGX {area} texels visible {theta}"))
-                .run(
+            ),
+            Some(theta) => {
+                let wo = support::dir(theta, 20.0);
+                cfg(format!("procedural GGX {area} texels visible {theta}")).run(
                     |_, u| Some(p.sample_visible(wo, u)).filter(|&m| p.pdf_visible(wo, m) > 0.0),
                     |m| p.pdf_visible(wo, m) as f64,
                 )
-                .unwrap();
+            }
         }
+        .unwrap();
     }
 }
 
-/// The white furnace the way a renderer computes it, F = 1: at most one at every footprint size
-/// and view (small, medium, blended, GGX alone).
+/// Chi-square, the default subset: the visible sampler at a small footprint (60°), the normal
+/// sampler at a medium one and the visible sampler of the blend at a grazing view (85°).
 #[test]
-fn furnace_is_at_most_one() {
+fn samplers_match_their_densities() {
+    chi2_samplers(&[(0, Some(60.0)), (1, None), (2, Some(85.0))]);
+}
+
+/// Chi-square, the full grid: both samplers (visible at 0°, 60°, 85°) at the three footprints.
+/// `cargo test --release --test it procedural_ggx::samplers_match_their_densities_everywhere --
+/// --ignored` (~25 s).
+#[test]
+#[ignore = "the full grid (~25 s); the default run checks a subset"]
+fn samplers_match_their_densities_everywhere() {
+    let cases: Vec<_> = (0..3)
+        .flat_map(|k| [None, Some(0.0), Some(60.0), Some(85.0)].map(|s| (k, s)))
+        .collect();
+    chi2_samplers(&cases);
+}
+
+/// The white furnace the way a renderer computes it, F = 1, at the footprints and views of
+/// `cases` (small, medium, blended, GGX alone).
+fn furnaces(cases: &[(usize, f64)]) {
     let s = surface(6);
     let mut rng = support::rng(12);
-    for (area, uv) in [
+    let footprints = [
         (1.0f32, Vec2::new(0.4, 0.4)),
         (256.0, Vec2::new(0.2, 0.9)),
         (60000.0, Vec2::new(0.6, 0.3)),
         (262144.0, Vec2::new(0.1, 0.5)),
-    ] {
+    ];
+    for &(k, theta) in cases {
+        let (area, uv) = footprints[k];
         let brdf = MicrofacetBrdf::new(s.patch(&fp(uv, area)), NoFresnel);
         support::bxdf::assert_half_vector_furnaces(
             &brdf,
-            [0.0, 45.0, 70.0, 85.0],
+            [theta],
             &mut rng,
             &format!("procedural GGX {area} texels"),
         );
     }
+}
+
+/// The furnace is at most one, the default subset: a small footprint at 45°, a medium one at 85°,
+/// the blend at 70°.
+#[test]
+fn furnace_is_at_most_one() {
+    furnaces(&[(0, 45.0), (1, 85.0), (2, 70.0)]);
+}
+
+/// The furnace everywhere: four footprints × views 0°, 45°, 70°, 85°.
+/// `cargo test --release --test it procedural_ggx::furnace_is_at_most_one_everywhere -- --ignored`
+/// (~17 s).
+#[test]
+#[ignore = "the full grid (~17 s); the default run checks a subset"]
+fn furnace_is_at_most_one_everywhere() {
+    let cases: Vec<_> = (0..4)
+        .flat_map(|k| [0.0, 45.0, 70.0, 85.0].map(|t| (k, t)))
+        .collect();
+    furnaces(&cases);
 }
 
 /// Reciprocity in the patch's own measure (src/bxdf/microfacet.rs), as for the Beckmann limit.
