@@ -96,6 +96,7 @@ fn procedural() -> ProceduralGlints {
         density: 2.5,
         resolution: [24, 40],
         seed: u64::MAX - 3,
+        limit: brdf::glint::procedural::ProceduralLimit::Ggx,
     })
     .unwrap()
 }

@@ -1,9 +1,11 @@
 //! Procedural glints (`brdf::glint::procedural`) measured against their limit: how far a
-//! footprint's P-NDF is from the limit Beckmann NDF as the footprint grows, whether the mean of the
-//! P-NDF over positions is the limit at every size, and what one renderer shading point costs.
+//! footprint's P-NDF is from the limit NDF (Beckmann or GGX) as the footprint grows, whether the
+//! mean of the P-NDF over positions is the limit at every size, and what one renderer shading
+//! point costs.
 //!
-//! Four surfaces on the default 1024² grid (facet α_f = 0.02, seed 1): the default (α 0.3, one
-//! facet per texel), density 0.1 and 16 facets per texel, and α 0.1. Isotropic footprints of 0.25
+//! Five surfaces on the default 1024² grid (facet α_f = 0.02, seed 1): the default (α 0.3, one
+//! facet per texel), density 0.1 and 16 facets per texel, α 0.1, and the default of the GGX limit
+//! (its "limit" is GGX: its TV and L2 are to GGX). Isotropic footprints of 0.25
 //! to 2²⁰ texels (factor 4; `--quick`: factor 16 and the largest). Per (surface, footprint):
 //!
 //! - **TV to the limit**: the total variation between the normal densities D cos θ of the patch
@@ -34,7 +36,7 @@
 use super::shading_points::{Point, points, shade};
 use super::{Artifact, Res, register_font};
 use brdf::fresnel::ConductorFresnel;
-use brdf::glint::procedural::{ProceduralGlints, ProceduralParams};
+use brdf::glint::procedural::{ProceduralGlints, ProceduralLimit, ProceduralParams};
 use brdf::glint::{Footprint, GlintModel, GlintNdf, GlintScratch};
 use brdf::material::{GlintMaterial, Material};
 use brdf::ndf::{Ggx, Ndf};
@@ -67,6 +69,13 @@ fn surfaces() -> Vec<(&'static str, ProceduralParams)> {
             "α 0.1",
             ProceduralParams {
                 alpha: Vec2::splat(0.1),
+                ..d
+            },
+        ),
+        (
+            "GGX limit (α 0.3, 1/texel)",
+            ProceduralParams {
+                limit: ProceduralLimit::Ggx,
                 ..d
             },
         ),
@@ -376,12 +385,13 @@ fn table(rows: &[Row]) -> Res<String> {
     Ok(s)
 }
 
-/// Colours of the surfaces (Okabe-Ito: blue, vermillion, bluish green, reddish purple).
-const COLOURS: [RGBColor; 4] = [
+/// Colours of the surfaces (Okabe-Ito: blue, vermillion, bluish green, reddish purple, orange).
+const COLOURS: [RGBColor; 5] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(0, 158, 115),
     RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
 ];
 
 /// Two panels against the footprint (log x), linear TV on the left, log TV on the right (where the
@@ -398,7 +408,7 @@ fn chart(path: &Path, rows: &[Row], names: &[&'static str], quick: bool) -> Res<
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         root.fill(&WHITE)?;
         let root = root.titled(
-            "Procedural glints: TV of a footprint's P-NDF to the limit Beckmann NDF",
+            "Procedural glints: TV of a footprint's P-NDF to the limit NDF (Beckmann; GGX for the GGX limit)",
             ("sans-serif", 24),
         )?;
         let (left, right) = root.split_horizontally(w / 2);
@@ -551,7 +561,7 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
         ),
         Artifact::new(
             png,
-            "Procedural glints: TV of a footprint's P-NDF to the limit Beckmann NDF against the \
+            "Procedural glints: TV of a footprint's P-NDF to the limit NDF (Beckmann or GGX) against the \
              footprint (mean over random centres, ±2 standard errors), and of the mean P-NDF over \
              random centres.",
         ),

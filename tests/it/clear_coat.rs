@@ -60,6 +60,7 @@ fn procedural() -> ProceduralGlints {
         density: 8.0,
         resolution: [256, 256],
         seed: 5,
+        ..ProceduralParams::default()
     })
     .unwrap()
 }

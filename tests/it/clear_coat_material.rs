@@ -21,6 +21,7 @@ fn flakes_over_paint() -> GlintMaterial {
         density: 8.0,
         resolution: [256, 256],
         seed: 5,
+        ..ProceduralParams::default()
     })
     .unwrap();
     GlintMaterial::new(GlintModel::from(glints), ConductorFresnel::ALUMINIUM)

@@ -66,6 +66,7 @@ mod position_normal_cut;
 mod position_normal_filtered;
 mod position_normal_pndf;
 mod position_normal_tables;
+mod procedural_ggx;
 mod procedural_glints;
 mod ray_cone;
 mod reference;

@@ -269,6 +269,7 @@ fn regression_lobe_set_projected_area_of_huge_directions() {
         density: 0.2,
         resolution: [48, 16],
         seed: 5_927_300_059_587_086_911,
+        ..ProceduralParams::default()
     })
     .unwrap();
     let fp = Footprint::from_differentials(

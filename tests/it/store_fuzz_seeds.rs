@@ -107,9 +107,9 @@ fn write_fuzz_seeds() {
             write("store_binmap", &format!("bm{n}_{bins}"), file);
         }
     }
-    // Procedural glints (model kind 6): the defaults, and a surface with no two parameters alike
-    // (anisotropic, non-square, under one facet per texel), also under format version 2 (the
-    // payload is the same in every version).
+    // Procedural glints (model kinds 6 and 7): the defaults, a surface with no two parameters alike
+    // (anisotropic, non-square, under one facet per texel) and the GGX limit (kind 7), also under
+    // format version 2 (the payload is the same in every version).
     let procedural = [
         (
             "procedural",
@@ -126,6 +126,15 @@ fn write_fuzz_seeds() {
                 density: 0.4,
                 resolution: [48, 20],
                 seed: u64::MAX,
+                ..ProceduralParams::default()
+            },
+        ),
+        (
+            "procedural_ggx",
+            ProceduralParams {
+                seed: 2,
+                limit: brdf::glint::procedural::ProceduralLimit::Ggx,
+                ..ProceduralParams::default()
             },
         ),
     ];

@@ -89,7 +89,7 @@ fn foreign_bytes_are_not_a_glint_file() {
 /// loader, over every byte).
 #[test]
 fn a_damaged_header_field_is_corrupted_through_glint_model() {
-    let glint_kind = |code: u32| (2..=6).contains(&code);
+    let glint_kind = |code: u32| (2..=7).contains(&code);
     for (kind, file, _) in small_files() {
         if kind == "normal map" {
             continue;

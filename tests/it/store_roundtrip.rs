@@ -378,6 +378,7 @@ fn procedural_round_trip_is_exact() {
             density: 0.37,
             resolution: [300, 77],
             seed: u64::MAX,
+            ..ProceduralParams::default()
         },
     ];
     let loose = procedural::PatchOptions { tolerance: 0.3 };

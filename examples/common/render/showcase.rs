@@ -82,6 +82,7 @@ pub fn car_paint_params(n: usize) -> ProceduralParams {
         density: 8.0,
         resolution: [n, n],
         seed: 5,
+        ..ProceduralParams::default()
     }
 }
 

@@ -16,7 +16,8 @@
 //!   through the tilt adapter (the map's interpolated normal at the footprint's centre);
 //! - procedural glints (`ProceduralGlints`, no map): the Beckmann limit of the same α as the
 //!   analytic GGX, one facet per texel of a `map_size`² grid (the map's texels, so that the texels
-//!   per pixel are the same), facet roughness 0.02, silver Fresnel;
+//!   per pixel are the same), facet roughness 0.02, silver Fresnel; and the same surface of the GGX
+//!   limit ("procedural glints (GGX)", converging to the analytic GGX itself);
 //! - the mixture as a glint clear coat (dielectric Fresnel η = 1.5) over red Lambert paint
 //!   (`GlintMaterial::over_base`, a `LayeredBrdf`): its time against the plain mixture's is the
 //!   cost of the coat's first-bounce reflectance R̂(wo).
@@ -34,7 +35,7 @@ use brdf::fresnel::{ConductorFresnel, DielectricFresnel};
 use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::MixtureParams;
 use brdf::glint::position_normal::PositionNormalParams;
-use brdf::glint::procedural::{ProceduralGlints, ProceduralParams};
+use brdf::glint::procedural::{ProceduralGlints, ProceduralLimit, ProceduralParams};
 use brdf::glint::{
     BeckmannMixture, BinMap, Footprint, GlintModel, GlintOptions, NormalMap, NormalRepair,
     PositionNormalMap, ScratchedParams, TangentConvention, scratched,
@@ -334,6 +335,16 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         };
         Ok(ProceduralGlints::new(params)?.into())
     })?;
+    let procedural_ggx = timed_build(&["procedural glints (GGX)"], &mut || {
+        let params = ProceduralParams {
+            alpha: Vec2::splat(alpha),
+            resolution: [n, n],
+            seed: opts.seed,
+            limit: ProceduralLimit::Ggx,
+            ..Default::default()
+        };
+        Ok(ProceduralGlints::new(params)?.into())
+    })?;
     println!(
         "builds ({n}² {what}, default parameters, wall time, with the measured errors of \
          the levels of detail):\n{builds}"
@@ -419,6 +430,7 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         }),
         coat,
         entry("procedural glints", &procedural),
+        entry("procedural glints (GGX)", &procedural_ggx),
     ];
     let entries: Vec<Entry> = all
         .into_iter()

@@ -61,8 +61,10 @@ pub(crate) enum Kind {
     /// [`crate::glint::BeckmannMixture`] in compact storage
     /// ([`crate::glint::mixture::LobeStorage::Compact`]).
     BeckmannMixtureCompact = 5,
-    /// [`crate::glint::ProceduralGlints`].
+    /// [`crate::glint::ProceduralGlints`] of the Beckmann limit.
     ProceduralGlints = 6,
+    /// [`crate::glint::ProceduralGlints`] of the GGX limit (the payload of kind 6).
+    ProceduralGlintsGgx = 7,
 }
 
 impl Kind {
@@ -74,6 +76,7 @@ impl Kind {
             4 => "BinMap".into(),
             5 => "BeckmannMixture (compact)".into(),
             6 => "ProceduralGlints".into(),
+            7 => "ProceduralGlints (GGX)".into(),
             c => format!("unknown kind {c}"),
         }
     }

@@ -10,7 +10,8 @@
 //! n_l = density · spacing_l² facets of its cell: β_l is chosen so that the expected squared L2
 //! distance of the lobe to the limit equals that of n_l facets of roughness σ_f with means drawn
 //! from N(0, σ² − σ_f²) (docs/procedural.md, "Levels"):
-//! 1/β_l² = 1/σ² + (1/σ_f² − 1/σ²) / n_l.
+//! 1/β_l² = 1/σ² + (1/σ_f² − 1/σ²) / n_l. A surface of the GGX limit reads a third uniform per
+//! cell, its lobe's variance scale (src/glint/procedural/ggx.rs).
 
 use super::params::ProceduralParams;
 
@@ -115,6 +116,13 @@ fn mean_z(h: u64) -> [f32; 2] {
     uniforms(mix(h.wrapping_add(GOLDEN.wrapping_mul(2)))).map(normal_quantile)
 }
 
+/// A third uniform in (0, 1) from the cell's hash, independent of its jitter and mean: the variance
+/// scale of a GGX surface's lobe (src/glint/procedural/ggx.rs).
+#[inline]
+fn scale_uniform(h: u64) -> f32 {
+    uniforms(mix(h.wrapping_add(GOLDEN.wrapping_mul(3))))[0]
+}
+
 /// A footprint kernel: centre and covariance (texels), its principal axes.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Kernel {
@@ -186,12 +194,15 @@ impl Kernel {
     }
 }
 
-/// The lobes a patch gathers before their width is known: kernel weight and standard-normal mean
-/// coordinates, at most [`Candidates::CAPACITY`] (on the stack: a patch allocates nothing).
+/// The lobes a patch gathers before their width is known: kernel weight, standard-normal mean
+/// coordinates and (for a GGX surface) the uniform of the variance scale, at most
+/// [`Candidates::CAPACITY`] (on the stack: a patch allocates nothing).
 pub(super) struct Candidates {
     pub len: usize,
     pub w: [f32; Candidates::CAPACITY],
     pub z: [[f32; 2]; Candidates::CAPACITY],
+    /// The cell's third uniform (0.5 where the gather was asked for none).
+    pub u: [f32; Candidates::CAPACITY],
 }
 
 impl Candidates {
@@ -204,6 +215,7 @@ impl Candidates {
             len: 0,
             w: [0.0; Candidates::CAPACITY],
             z: [[0.0; 2]; Candidates::CAPACITY],
+            u: [0.5; Candidates::CAPACITY],
         }
     }
 }
@@ -211,13 +223,15 @@ impl Candidates {
 /// Adds the lobes of `level` under `kernel` to `out`, their weights
 /// k(p) = exp(−q/2) − exp(−R²/2) (q < R², continuous at the truncation) normalised over the level
 /// and scaled by `scale`. The kernel is floored at the level's cell: both its standard deviations at
-/// least half a cell, so that a cell's lobe always lies within R of the centre.
+/// least half a cell, so that a cell's lobe always lies within R of the centre. With `scales`, each
+/// lobe's third uniform (the variance scale of a GGX surface) is read too.
 pub(super) fn gather_level(
     levels: &[Level],
     index: usize,
     seed: u64,
     kernel: &Kernel,
     scale: f32,
+    scales: bool,
     out: &mut Candidates,
 ) {
     let level = &levels[index];
@@ -277,6 +291,9 @@ pub(super) fn gather_level(
             if w > 0.0 {
                 out.w[out.len] = w;
                 out.z[out.len] = mean_z(h);
+                if scales {
+                    out.u[out.len] = scale_uniform(h);
+                }
                 out.len += 1;
                 sum += w as f64;
             }

@@ -1,17 +1,19 @@
 //! Procedural glints: a glint NDF without a normal map, in constant time per footprint.
 //!
 //! A [`ProceduralGlints`] surface is a stationary random field of facets defined by a seed and
-//! a few numbers a user understands ([`ProceduralParams`]): the Beckmann roughness α the glints
+//! a few numbers a user understands ([`ProceduralParams`]): the roughness α the glints
 //! converge to, the facets' own roughness α_f (the size of one glint), their density per texel and
-//! the resolution that footprints are measured in. Nothing is stored per texel: a stateless hash
+//! the resolution that footprints are measured in, and which NDF it converges to
+//! ([`ProceduralLimit`]: Beckmann, or GGX as a Gaussian scale mixture,
+//! src/glint/procedural/ggx.rs). Nothing is stored per texel: a stateless hash
 //! places one lobe per cell of a multiscale lattice (src/glint/procedural/lattice.rs), and a
 //! footprint reads the one or two levels whose cells match its size.
 //!
 //! - [`ProceduralGlints::new`] validates the parameters and tabulates the levels (a few dozen
 //!   numbers).
 //! - [`GlintNdf::patch_with`] turns a [`Footprint`] into a [`ProceduralPatch`] of at most a few tens
-//!   of lobes (the kernel's anisotropy is capped), blending into the limit Beckmann lobe as the
-//!   footprint grows: bounded work at every footprint size.
+//!   of lobes (the kernel's anisotropy is capped), blending into the limit NDF as the footprint
+//!   grows: bounded work at every footprint size.
 //! - The mean of the P-NDF over positions is the limit NDF at every footprint size; the patch's
 //!   distance to it falls as 1/√(facets seen) (docs/procedural.md, with the method, its parameters,
 //!   its limits and its measurements).
@@ -20,20 +22,23 @@
 //! of Kemppinen et al. 2025 and the count-based levels of Deliot and Belcour 2023 in spirit; the
 //! construction (lobe widths matched in L2, the exact mean) is the crate's own (docs/procedural.md).
 
+mod ggx;
 mod lattice;
+mod limit;
 mod params;
 mod patch;
 mod store;
 
+pub use limit::LimitNdf;
 pub use params::{
     DEFAULT_TOLERANCE, MAX_ALPHA, MAX_CELLS_PER_SIDE, MAX_RESOLUTION, MIN_ALPHA, MIN_FACET_ALPHA,
-    PatchOptions, ProceduralParams,
+    PatchOptions, ProceduralLimit, ProceduralParams,
 };
 pub use patch::ProceduralPatch;
 
 use crate::error::Result;
 use crate::glint::{Footprint, GlintNdf, GlintScratch};
-use crate::ndf::SlopeGaussian;
+use crate::ndf::{Ggx, SlopeGaussian};
 use lattice::Level;
 
 /// A procedural glint surface (module docs): its parameters and its tabulated lattice levels.
@@ -55,7 +60,7 @@ use lattice::Level;
 pub struct ProceduralGlints {
     params: ProceduralParams,
     levels: Vec<Level>,
-    limit: SlopeGaussian,
+    limit: LimitNdf,
 }
 
 impl PartialEq for ProceduralGlints {
@@ -73,7 +78,11 @@ impl ProceduralGlints {
     pub fn new(params: ProceduralParams) -> Result<Self> {
         params.validate()?;
         let levels = lattice::levels(&params);
-        let limit = SlopeGaussian::beckmann(params.alpha.x, params.alpha.y)?;
+        let (ax, ay) = (params.alpha.x, params.alpha.y);
+        let limit = match params.limit {
+            ProceduralLimit::Beckmann => LimitNdf::Beckmann(SlopeGaussian::beckmann(ax, ay)?),
+            ProceduralLimit::Ggx => LimitNdf::Ggx(Ggx::new(ax, ay)?),
+        };
         Ok(ProceduralGlints {
             params,
             levels,
@@ -86,9 +95,10 @@ impl ProceduralGlints {
         &self.params
     }
 
-    /// The limit NDF: the centred anisotropic Beckmann lobe of roughness `alpha`, the mean of every
-    /// patch over positions and the patch of every large footprint.
-    pub fn limit(&self) -> SlopeGaussian {
+    /// The limit NDF ([`ProceduralParams::limit`]): the centred anisotropic Beckmann lobe or the
+    /// GGX NDF of roughness `alpha`, the mean of every patch over positions and the patch of every
+    /// large footprint.
+    pub fn limit(&self) -> LimitNdf {
         self.limit
     }
 

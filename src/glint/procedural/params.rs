@@ -24,15 +24,30 @@ pub const MAX_RESOLUTION: usize = 1 << 20;
 /// footprint's P-NDF to the limit NDF below which the patch is the limit lobe alone.
 pub const DEFAULT_TOLERANCE: f32 = 0.05;
 
+/// The NDF a procedural glint surface converges to (its mean over positions at every footprint, and
+/// its patch at large footprints): [`ProceduralParams::limit`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ProceduralLimit {
+    /// The anisotropic Beckmann NDF of roughness α (slope deviations σ = α/√2 per axis): every
+    /// lobe's mean is drawn with one shared spread (docs/procedural.md).
+    #[default]
+    Beckmann,
+    /// The anisotropic GGX NDF of roughness α, as a Gaussian scale mixture: each lattice cell draws
+    /// its own variance scale v (docs/procedural.md, "The GGX limit").
+    Ggx,
+}
+
 /// What defines a procedural glint surface (validated by
 /// [`ProceduralGlints::new`](super::ProceduralGlints::new)). `Default` gives the documented
 /// associated `DEFAULT_*` values.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProceduralParams {
-    /// Roughness (αx, αy) of the anisotropic Beckmann NDF the glints converge to (each in
+    /// Roughness (αx, αy) of the anisotropic NDF the glints converge to (each in
     /// [[`MIN_ALPHA`], [`MAX_ALPHA`]]): the mean of the P-NDF over positions at every footprint,
     /// and its limit for large footprints.
     pub alpha: Vec2,
+    /// Which NDF of roughness `alpha` the glints converge to: Beckmann (the default) or GGX.
+    pub limit: ProceduralLimit,
     /// The facets' own Beckmann roughness α_f (isotropic; in [[`MIN_FACET_ALPHA`], min(αx, αy))):
     /// the angular size of one glint.
     pub facet_alpha: f32,
@@ -111,6 +126,7 @@ impl Default for ProceduralParams {
     fn default() -> Self {
         ProceduralParams {
             alpha: Vec2::splat(Self::DEFAULT_ALPHA),
+            limit: ProceduralLimit::Beckmann,
             facet_alpha: Self::DEFAULT_FACET_ALPHA,
             density: Self::DEFAULT_DENSITY,
             resolution: Self::DEFAULT_RESOLUTION,

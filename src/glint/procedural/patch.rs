@@ -2,12 +2,14 @@
 //! footprint reads, weighted by its kernel, blended into the limit lobe as the footprint grows;
 //! every term of the [`Ndf`](crate::ndf::Ndf) exact over those lobes (src/glint/kernels/lobe_set.rs).
 
+use super::ggx;
 use super::lattice::{CELL_SIGMAS, Candidates, Kernel, Level, gather_level, lobe_widths};
+use super::limit::{GgxBlend, LimitNdf};
 use super::params::{PatchOptions, ProceduralParams};
 use crate::glint::kernels::lobe_set::{Few, LobeSet, box_half_widths};
 use crate::glint::scratch::Lent;
 use crate::glint::{Footprint, GlintScratch};
-use crate::ndf::{SlopeGaussian, forward_ndf};
+use crate::ndf::{Ggx, SlopeGaussian, forward_ndf};
 use glam::{Mat2, Vec2, Vec3};
 
 /// The P-NDF of one footprint of a [`ProceduralGlints`](super::ProceduralGlints) surface: an
@@ -32,53 +34,82 @@ use glam::{Mat2, Vec2, Vec3};
 /// Every lobe has mean NDF D_lim (β² + τ² = σ², with β, τ depending on the footprint only), and the
 /// kernel weights do not depend on the lobes' slopes, so the mean of D_P over the random field is
 /// D_lim at every footprint size.
+///
+/// For a surface of the GGX limit (src/glint/procedural/ggx.rs) each lobe has its own variance
+/// scale v_i and width (σ_i² = v_i α²), D_lim is the crate's [`Ggx`] held beside the lobes (not a
+/// slope Gaussian: src/glint/procedural/limit.rs), and b also holds the share of GGX that brings
+/// the patch to its facets' expected distance; ρ is then that facets' part.
 #[derive(Clone, Debug)]
 pub struct ProceduralPatch<'a> {
-    few: Few<'a>,
+    body: Body<'a>,
     level: f32,
     limit_weight: f32,
     distance: f32,
 }
 
-/// Binds the patch's lobes to `$n` (for [`forward_ndf`]).
-macro_rules! to_few {
-    ($s:ident, $n:ident => $e:expr) => {{
-        let $n = &$s.few;
-        $e
-    }};
+/// What a patch holds: slope Gaussians (the facet lobes, with a Beckmann surface's limit lobe among
+/// them), GGX alone, or facet lobes blended with GGX.
+#[derive(Clone, Debug)]
+enum Body<'a> {
+    Lobes(Few<'a>),
+    Ggx(Ggx),
+    Blend(GgxBlend<'a>),
 }
 
-forward_ndf!(['a] ProceduralPatch<'a>, to_few);
+/// Binds the patch's NDF to `$n` (for [`forward_ndf`]).
+macro_rules! to_body {
+    ($s:ident, $n:ident => $e:expr) => {
+        match &$s.body {
+            Body::Lobes($n) => $e,
+            Body::Ggx($n) => $e,
+            Body::Blend($n) => $e,
+        }
+    };
+}
+
+forward_ndf!(['a] ProceduralPatch<'a>, to_body);
 
 impl ProceduralPatch<'_> {
-    /// The patch that is the limit lobe alone, at continuous level `level` and expected distance
+    /// The patch that is the limit NDF alone, at continuous level `level` and expected distance
     /// `distance`.
-    fn limit_alone(limit: SlopeGaussian, level: f64, distance: f64) -> Self {
+    fn limit_alone(limit: LimitNdf, level: f64, distance: f64) -> Self {
         ProceduralPatch {
-            few: Few::One(limit),
+            body: match limit {
+                LimitNdf::Beckmann(g) => Body::Lobes(Few::One(g)),
+                LimitNdf::Ggx(g) => Body::Ggx(g),
+            },
             level: level as f32,
             limit_weight: 1.0,
             distance: distance as f32,
         }
     }
 
-    /// Prepares the patch for the view direction `wo` (shading frame): the exact V(wo) that the
-    /// queries at that wo share (`view_visible_area`, the visible densities), computed here once,
-    /// an O(lobes) pass. Queries at `wo` (the same bits) then read it; queries at any other view
-    /// compute their own. Every value is the one the unprepared patch returns, bit for bit. A
-    /// second call replaces the first view. `Material::bsdf` prepares its glint patches for the
-    /// shading point's wo.
+    /// Prepares the patch for the view direction `wo` (shading frame): the exact V(wo) of its
+    /// lobes that the queries at that wo share (`view_visible_area`, the visible densities, the
+    /// visible sampler's pick between GGX and the lobes), computed here once, an O(lobes) pass.
+    /// Queries at `wo` (the same bits) then read it; queries at any other view compute their own.
+    /// Every value is the one the unprepared patch returns, bit for bit. A second call replaces the
+    /// first view. `Material::bsdf` prepares its glint patches for the shading point's wo.
     pub fn prepare_view(&mut self, wo: Vec3) {
-        self.few.prepare_view(wo);
+        match &mut self.body {
+            Body::Lobes(few) => few.prepare_view(wo),
+            Body::Ggx(_) => {}
+            Body::Blend(blend) => blend.prepare_view(wo),
+        }
     }
 
-    /// The number of lobes the patch holds (the limit lobe included): at most a few tens, whatever
-    /// the footprint.
+    /// The number of lobes the patch holds (the limit NDF included, as one lobe): at most a few
+    /// tens, whatever the footprint.
     pub fn lobe_count(&self) -> usize {
-        match &self.few {
+        let count = |few: &Few<'_>| match few {
             Few::None => 0,
             Few::One(_) => 1,
             Few::Set(s) => s.len(),
+        };
+        match &self.body {
+            Body::Lobes(few) => count(few),
+            Body::Ggx(_) => 1,
+            Body::Blend(blend) => count(blend.lobes()) + 1,
         }
     }
 
@@ -88,24 +119,25 @@ impl ProceduralPatch<'_> {
         self.level
     }
 
-    /// The weight b of the limit lobe in the patch (0: facets only; 1: the limit NDF alone).
+    /// The weight b of the limit NDF in the patch (0: facets only; 1: the limit NDF alone).
     pub fn limit_weight(&self) -> f32 {
         self.limit_weight
     }
 
     /// The expected relative L2 distance ρ of a patch of this footprint to the limit NDF
-    /// (what [`PatchOptions::tolerance`] is compared with).
+    /// (what [`PatchOptions::tolerance`] is compared with; for the GGX limit, the part of it that
+    /// the footprint's facets carry, src/glint/procedural/ggx.rs).
     pub fn expected_distance(&self) -> f32 {
         self.distance
     }
 }
 
 /// Builds the patch of `footprint` on the surface of parameters `p`, levels `levels` and limit
-/// lobe `limit` (the model's `patch_with`).
+/// NDF `limit` (the model's `patch_with`).
 pub(super) fn make_patch<'a>(
     p: &ProceduralParams,
     levels: &[Level],
-    limit: SlopeGaussian,
+    limit: LimitNdf,
     footprint: &Footprint,
     options: &PatchOptions,
     scratch: Option<&'a GlintScratch>,
@@ -124,7 +156,8 @@ pub(super) fn make_patch<'a>(
         (width.min(height) as f64).powi(2),
     );
     // The facets the footprint holds, n = density · 4π √det Σ (the effective count of a Gaussian
-    // kernel), and the distance to the limit of n facets, ρ² = (σx σy / σ_f² − 1) / n.
+    // kernel), and the distance to the limit of n facets: ρ² = (σx σy / σ_f² − 1) / n for
+    // Beckmann, its GGX form (src/glint/procedural/ggx.rs) for GGX.
     let n = p.density as f64
         * 4.0
         * std::f64::consts::PI
@@ -133,13 +166,16 @@ pub(super) fn make_patch<'a>(
     let sigma_f = p.facet_alpha as f64 / std::f64::consts::SQRT_2;
     let ratio = sigma[0] * sigma[1] / (sigma_f * sigma_f);
     let tol = options.clamped_tolerance();
-    let footprint_distance = ((ratio - 1.0).max(0.0) / n).sqrt();
+    let footprint_distance = match limit {
+        LimitNdf::Beckmann(_) => ((ratio - 1.0).max(0.0) / n).sqrt(),
+        LimitNdf::Ggx(_) => ggx::footprint_distance(sigma, sigma_f, n),
+    };
     // The finer level: cells of CELL_SIGMAS/2 to CELL_SIGMAS minor standard deviations
     // (x = log2(CELL_SIGMAS σ_minor / s0) ≥ 0).
     let x = (CELL_SIGMAS * kernel.lambda[1].sqrt() / s0).log2().max(0.0);
     if footprint_distance <= tol {
         // The patch's own distance is at most this one (exactly so for isotropic α): the
-        // limit lobe alone.
+        // limit alone.
         return ProceduralPatch::limit_alone(limit, x, footprint_distance);
     }
     let top = levels.len() - 1;
@@ -149,31 +185,77 @@ pub(super) fn make_patch<'a>(
         let f = x.floor();
         (f as usize, (x - f) as f32)
     };
+    let scales = matches!(limit, LimitNdf::Ggx(_));
     let mut cand = Candidates::new();
     if t < 1.0 {
-        gather_level(levels, fine, p.seed, &kernel, 1.0 - t, &mut cand);
+        gather_level(levels, fine, p.seed, &kernel, 1.0 - t, scales, &mut cand);
     }
     if t > 0.0 {
-        gather_level(levels, fine + 1, p.seed, &kernel, t, &mut cand);
+        gather_level(levels, fine + 1, p.seed, &kernel, t, scales, &mut cand);
     }
     let weights = &cand.w[..cand.len];
     let sum: f64 = weights.iter().map(|&w| w as f64).sum();
     let sum2: f64 = weights.iter().map(|&w| (w as f64) * (w as f64)).sum();
     // The kernel's effective lobe count K = (Σ w)² / Σ w²; each lobe stands for n / K facets.
     let k = if sum2 > 0.0 { sum * sum / sum2 } else { 1.0 };
-    let (beta2, tau2) = lobe_widths(sigma, sigma_f, k / n);
+    let widths = Widths {
+        sigma,
+        sigma_f,
+        r: k / n,
+        k,
+        tol,
+        level: x,
+    };
+    match limit {
+        LimitNdf::Beckmann(lobe) => beckmann_patch(&cand, sum, &widths, lobe, scratch),
+        LimitNdf::Ggx(g) => ggx_patch(&cand, sum, &widths, p.alpha, g, scratch),
+    }
+}
+
+/// What sets a patch's lobe widths and its limit weight: Beckmann deviations σ = α/√2, facet
+/// deviation σ_f, r = K/n (clamped to 1 where used), the kernel's effective lobe count K, the
+/// clamped tolerance and the continuous level.
+struct Widths {
+    sigma: [f64; 2],
+    sigma_f: f64,
+    r: f64,
+    k: f64,
+    tol: f64,
+    level: f64,
+}
+
+impl Widths {
+    /// The limit weight b of a patch of expected distance `distance`: 0 while ρ ≥ 2 tol, 1 below
+    /// tol, linear in between.
+    fn limit_weight(&self, distance: f64) -> f32 {
+        ((2.0 * self.tol - distance) / self.tol).clamp(0.0, 1.0) as f32
+    }
+}
+
+/// The patch of a Beckmann surface from its gathered lobes `cand` (weights summing to `sum`):
+/// one shared width, the limit lobe among the lobes.
+fn beckmann_patch<'a>(
+    cand: &Candidates,
+    sum: f64,
+    wd: &Widths,
+    limit: SlopeGaussian,
+    scratch: Option<&'a GlintScratch>,
+) -> ProceduralPatch<'a> {
+    let (sigma, x) = (wd.sigma, wd.level);
+    let (beta2, tau2) = lobe_widths(sigma, wd.sigma_f, wd.r);
     let shape = SlopeGaussian::new(
         Vec2::ZERO,
         Mat2::from_diagonal(Vec2::new(beta2[0] as f32, beta2[1] as f32)),
     );
     let (Ok(shape), true) = (shape, cand.len > 0) else {
-        return ProceduralPatch::limit_alone(limit, x, 0.0);
+        return ProceduralPatch::limit_alone(LimitNdf::Beckmann(limit), x, 0.0);
     };
     // The patch's expected distance: ρ² = Σ (w_i/Σw)² (σx σy / (βx βy) − 1).
-    let distance = ((sigma[0] * sigma[1] / (beta2[0] * beta2[1]).sqrt() - 1.0).max(0.0) / k).sqrt();
-    let b = ((2.0 * tol - distance) / tol).clamp(0.0, 1.0) as f32;
+    let distance =
+        ((sigma[0] * sigma[1] / (beta2[0] * beta2[1]).sqrt() - 1.0).max(0.0) / wd.k).sqrt();
+    let b = wd.limit_weight(distance);
     if b >= 1.0 {
-        return ProceduralPatch::limit_alone(limit, x, distance);
+        return ProceduralPatch::limit_alone(LimitNdf::Beckmann(limit), x, distance);
     }
     let few = {
         let tau = tau2.map(|v| v.sqrt() as f32);
@@ -184,7 +266,7 @@ pub(super) fn make_patch<'a>(
         let mut set = Lent::<LobeSet>::new(scratch.map(|s| s.home()));
         set.clear();
         let scale = (1.0 - b) / sum as f32;
-        for (w, z) in weights.iter().zip(&cand.z[..cand.len]) {
+        for (w, z) in cand.w[..cand.len].iter().zip(&cand.z[..cand.len]) {
             if let Some(g) = shape.with_mean(Vec2::new(tau[0] * z[0], tau[1] * z[1])) {
                 set.push_with_half_widths(w * scale, g, half);
             }
@@ -200,7 +282,62 @@ pub(super) fn make_patch<'a>(
         }
     };
     ProceduralPatch {
-        few,
+        body: Body::Lobes(few),
+        level: x as f32,
+        limit_weight: b,
+        distance: distance as f32,
+    }
+}
+
+/// The patch of a GGX surface from its gathered lobes `cand` (weights summing to `sum`): each lobe
+/// its own width from its variance scale, blended with GGX so that the patch is as far from GGX as
+/// its footprint's facets are, and handed over to GGX by the tolerance
+/// (src/glint/procedural/ggx.rs).
+fn ggx_patch<'a>(
+    cand: &Candidates,
+    sum: f64,
+    wd: &Widths,
+    alpha: Vec2,
+    limit: Ggx,
+    scratch: Option<&'a GlintScratch>,
+) -> ProceduralPatch<'a> {
+    let x = wd.level;
+    let r = wd.r.min(1.0);
+    let distance = ggx::facet_distance(wd.sigma, wd.sigma_f, r, wd.k);
+    let b = ggx::limit_weight(distance, r, wd.k, wd.limit_weight(distance));
+    if b >= 1.0 || cand.len == 0 {
+        return ProceduralPatch::limit_alone(LimitNdf::Ggx(limit), x, distance);
+    }
+    let alpha = [alpha.x as f64, alpha.y as f64];
+    let mut set = Lent::<LobeSet>::new(scratch.map(|s| s.home()));
+    set.clear();
+    let scale = 1.0 / sum as f32;
+    for i in 0..cand.len {
+        let v = ggx::variance_scale(cand.u[i]);
+        let (beta2, tau2) = ggx::scaled_lobe_widths(alpha, v, wd.sigma_f, r);
+        let z = cand.z[i];
+        let mean = Vec2::new(
+            (tau2[0].sqrt() * z[0] as f64) as f32,
+            (tau2[1].sqrt() * z[1] as f64) as f32,
+        );
+        let cov = Mat2::from_diagonal(Vec2::new(beta2[0] as f32, beta2[1] as f32));
+        if let Ok(g) = SlopeGaussian::new(mean, cov) {
+            // Slope boxes of 1 − 10⁻¹², as the Beckmann surface's facet lobes.
+            let half = box_half_widths(&g) * std::f32::consts::SQRT_2;
+            set.push_with_half_widths(cand.w[i] * scale, g, half);
+        }
+    }
+    set.normalise();
+    if set.len() == 0 {
+        return ProceduralPatch::limit_alone(LimitNdf::Ggx(limit), x, distance);
+    }
+    let body = if b > 0.0 {
+        Body::Blend(GgxBlend::new(Few::Set(set), b, limit))
+    } else {
+        Body::Lobes(Few::Set(set))
+    };
+    ProceduralPatch {
+        body,
         level: x as f32,
         limit_weight: b,
         distance: distance as f32,

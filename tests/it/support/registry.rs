@@ -101,6 +101,16 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
         })
         .unwrap(),
     );
+    let procedural_ggx = GlintModel::from(
+        ProceduralGlints::new(ProceduralParams {
+            resolution: [map.width(), map.height()],
+            density: 4.0,
+            seed: 4,
+            limit: procedural::ProceduralLimit::Ggx,
+            ..ProceduralParams::default()
+        })
+        .unwrap(),
+    );
     let mut loose = GlintOptions::default();
     loose.procedural = procedural::PatchOptions { tolerance: 0.5 };
     let examples = vec![
@@ -138,6 +148,11 @@ pub fn examples(map: &NormalMap) -> Vec<Example> {
         ),
         example("procedural", procedural.clone(), GlintOptions::default()),
         example("procedural, tolerance 0.5", procedural, loose),
+        example(
+            "procedural, GGX limit",
+            procedural_ggx,
+            GlintOptions::default(),
+        ),
     ];
     for name in GlintModel::NAMES {
         assert!(
