@@ -135,9 +135,10 @@ pub trait Ndf {
     /// V(wo) for the view direction of a shading query: the same number as
     /// [`Ndf::visible_area`]`(wo)`. `MicrofacetBrdf` asks for V at its `wo` through this method
     /// and for V at its `wi` through `visible_area`, so that an NDF whose V costs a pass over many
-    /// lobes may keep what it computes for `wo` for the queries that follow at the same view
-    /// (`pdf_visible`, `sample_visible`, the next `eval` at another `wi`). Never override it with
-    /// another value than `visible_area(wo)`.
+    /// lobes may answer from a V(wo) computed once by an explicit step for the view it was
+    /// prepared for (the glint patches' `prepare_view`; docs/architecture.md, "The view step"),
+    /// never from state a query filled. Never override it with another value than
+    /// `visible_area(wo)`.
     fn view_visible_area(&self, wo: Vec3) -> f32 {
         self.visible_area(wo)
     }
