@@ -22,23 +22,10 @@ use rand::RngExt;
 /// Per channel mean and standard error of `sample().weight()` over `n` draws at `wo` (a missing
 /// sample counts 0; delta samples count with their weight): the furnace a renderer sees.
 pub(crate) fn sampled_furnace(b: &dyn Bxdf, wo: Vec3, n: usize, seed: u64) -> (Vec3, Vec3) {
-    let mut rng = support::rng(seed);
-    let (mut s, mut s2) = ([0.0f64; 3], [0.0f64; 3]);
-    for k in 0..n {
-        let u = Vec2::new((k as f32 + rng.random::<f32>()) / n as f32, rng.random());
-        let w = b
-            .sample(wo, rng.random(), u)
-            .map_or(Vec3::ZERO, |x| x.weight());
-        for c in 0..3 {
-            s[c] += w[c] as f64;
-            s2[c] += (w[c] as f64).powi(2);
-        }
-    }
-    let mean = |c: usize| s[c] / n as f64;
-    let se = |c: usize| ((s2[c] / n as f64 - mean(c).powi(2)).max(0.0) / n as f64).sqrt();
+    let m = support::bxdf::stratified_weight_moments(b, wo, n, seed);
     (
-        Vec3::new(mean(0) as f32, mean(1) as f32, mean(2) as f32),
-        Vec3::new(se(0) as f32, se(1) as f32, se(2) as f32),
+        Vec3::new(m[0].0 as f32, m[1].0 as f32, m[2].0 as f32),
+        Vec3::new(m[0].1 as f32, m[1].1 as f32, m[2].1 as f32),
     )
 }
 

@@ -16,23 +16,8 @@ use support::chi2::Chi2;
 /// Per channel (mean, standard error) of `sample().weight()` over `n` stratified draws: the renderer's
 /// furnace; the channel with the largest mean is returned.
 fn furnace(b: &dyn Bxdf, wo: Vec3, n: usize) -> (f64, f64) {
-    let mut rng = support::rng(3);
-    let (mut s, mut s2) = ([0.0f64; 3], [0.0f64; 3]);
-    for k in 0..n {
-        let u = Vec2::new((k as f32 + rng.random::<f32>()) / n as f32, rng.random());
-        let w = b
-            .sample(wo, rng.random(), u)
-            .map_or(Vec3::ZERO, |x| x.weight());
-        for c in 0..3 {
-            s[c] += w[c] as f64;
-            s2[c] += (w[c] as f64).powi(2);
-        }
-    }
-    (0..3)
-        .map(|c| {
-            let m = s[c] / n as f64;
-            (m, ((s2[c] / n as f64 - m * m).max(0.0) / n as f64).sqrt())
-        })
+    support::bxdf::stratified_weight_moments(b, wo, n, 3)
+        .into_iter()
         .fold((f64::MIN, 0.0), |a, b| if b.0 > a.0 { b } else { a })
 }
 

@@ -8,7 +8,7 @@
 //! `-- --nocapture`).
 
 use crate::support::{self, bxdf::random_upper, chi2::Chi2, density_distances};
-use brdf::bxdf::{Bxdf, MicrofacetBrdf};
+use brdf::bxdf::MicrofacetBrdf;
 use brdf::fresnel::NoFresnel;
 use brdf::glint::procedural::{LimitNdf, ProceduralGlints, ProceduralLimit, ProceduralParams};
 use brdf::glint::{Footprint, GlintModel, GlintNdf};
@@ -359,26 +359,10 @@ fn furnace_is_at_most_one_everywhere() {
 /// Reciprocity in the patch's own measure (src/bxdf/microfacet.rs), as for the Beckmann limit.
 #[test]
 fn reciprocal_in_its_own_measure() {
-    let s = surface(13);
-    let mut rng = support::rng(14);
-    for area in [1.0f32, 256.0, 60000.0] {
-        let patch = s.patch(&fp(Vec2::new(0.3, 0.8), area));
-        let brdf = MicrofacetBrdf::new(&patch, NoFresnel);
-        for _ in 0..2000 {
-            let (wo, wi) = (random_upper(&mut rng), random_upper(&mut rng));
-            let (ao, ai) = (patch.projected_area(wo), patch.projected_area(wi));
-            if !(ao > 0.0 && ai > 0.0) {
-                continue;
-            }
-            let a = brdf.eval(wo, wi).x * wi.z / ai;
-            let r = brdf.eval(wi, wo).x * wo.z / ao;
-            let scale = a.abs().max(r.abs());
-            assert!(
-                (a - r).abs() <= 1e-4 * scale + f32::MIN_POSITIVE,
-                "area {area}: {wo} {wi}: {a} vs {r}"
-            );
-        }
-    }
+    crate::procedural_glints::assert_reciprocal_in_own_measure(
+        &surface(13),
+        &[1.0, 256.0, 60000.0],
+    );
 }
 
 /// Bounded work: at most 48 lobes (GGX counted as one) over random footprints of every size,

@@ -388,9 +388,14 @@ fn density_moves_smoothly_to_the_limit() {
 /// f(wi, wo) cos θo / A(wo) where both projected areas are positive.
 #[test]
 fn reciprocal_in_its_own_measure() {
-    let s = surface(13);
+    assert_reciprocal_in_own_measure(&surface(13), &[1.0, 256.0, 40000.0]);
+}
+
+/// [`reciprocal_in_its_own_measure`] on `s`: 2000 random pairs at footprints of each of `areas`
+/// texels (also the GGX surfaces', procedural_ggx.rs).
+pub(crate) fn assert_reciprocal_in_own_measure(s: &ProceduralGlints, areas: &[f32]) {
     let mut rng = support::rng(14);
-    for area in [1.0f32, 256.0, 40000.0] {
+    for &area in areas {
         let patch = s.patch(&fp(Vec2::new(0.3, 0.8), area));
         let brdf = MicrofacetBrdf::new(&patch, NoFresnel);
         for _ in 0..2000 {

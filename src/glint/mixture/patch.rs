@@ -217,16 +217,13 @@ impl<'a> MixturePatch<'a> {
     /// `Material::bsdf` prepares its glint patches for the shading point's wo.
     pub fn prepare_view(&mut self, wo: Vec3) {
         self.view = PreparedView::NONE;
-        if !(wo.z > 0.0 && wo.is_finite()) {
-            return;
-        }
-        let v = match (&self.gathered, self.masking, &self.few) {
-            (Some(g), MaskingMode::Exact, _) => Some(self.exact_visible_area(g, wo)),
-            (None, _, Few::Set(set)) => Some(set.visible_area(wo) as f64),
-            _ => None,
-        };
-        if let Some(v) = v {
-            self.view = PreparedView::new(wo, v);
+        // A few-lobe set keeps its own (its queries read it through `few_view_visible_area`).
+        self.few.prepare_view(wo);
+        if let (Some(g), MaskingMode::Exact) = (&self.gathered, self.masking)
+            && wo.z > 0.0
+            && wo.is_finite()
+        {
+            self.view = PreparedView::new(wo, self.exact_visible_area(g, wo));
         }
     }
 

@@ -150,6 +150,28 @@ pub fn sampled_albedo(b: &dyn Bxdf, wo: Vec3, n: usize, rng: &mut impl rand::Rng
     )
 }
 
+/// The white furnace per channel the way a renderer integrates it: (mean, standard error) of
+/// `sample().weight()` over `n` draws at `wo`, u.x stratified in n strata, the lobe choice and u.y
+/// random from `seed` (a missing sample counts 0; delta samples count with their weight).
+pub fn stratified_weight_moments(b: &dyn Bxdf, wo: Vec3, n: usize, seed: u64) -> [(f64, f64); 3] {
+    let mut rng = super::rng(seed);
+    let (mut s, mut s2) = ([0.0f64; 3], [0.0f64; 3]);
+    for k in 0..n {
+        let u = Vec2::new((k as f32 + rng.random::<f32>()) / n as f32, rng.random());
+        let w = b
+            .sample(wo, rng.random(), u)
+            .map_or(Vec3::ZERO, |x| x.weight());
+        for c in 0..3 {
+            s[c] += w[c] as f64;
+            s2[c] += (w[c] as f64).powi(2);
+        }
+    }
+    std::array::from_fn(|c| {
+        let m = s[c] / n as f64;
+        (m, ((s2[c] / n as f64 - m * m).max(0.0) / n as f64).sqrt())
+    })
+}
+
 /// The white furnace of a half-vector BRDF (microfacet) at `wo` both ways a renderer integrates
 /// it: [`sampled_albedo`] over `n` draws and the quadrature of eval · cos θi over the half vector
 /// ([`albedo_half_vector`], 256 × 512). Asserts that neither exceeds 1 (within 4 standard errors,

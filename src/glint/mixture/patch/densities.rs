@@ -8,15 +8,11 @@ use crate::ndf::Ndf;
 use glam::Vec3;
 
 impl MixturePatch<'_> {
-    /// The few-lobe patch's V(wo) at the view: a set's prepared value at the prepared wo (a shading
-    /// point asks for V(wo) at every density and sample), else its pass; a single lobe's directly.
+    /// The few-lobe patch's V(wo) at the view: a set's value as prepared for its view
+    /// ([`LobeSet::prepare_view`](crate::glint::kernels::lobe_set::LobeSet::prepare_view)), else
+    /// its pass; a single lobe's directly.
     pub(super) fn few_view_visible_area(&self, wo: Vec3) -> f32 {
-        match &self.few {
-            Few::Set(set) if wo.z > 0.0 && wo.is_finite() => {
-                self.view.get_or(wo, || set.visible_area(wo) as f64) as f32
-            }
-            few => few.visible_area(wo),
-        }
+        self.few.view_visible_area(wo)
     }
 
     /// The few-lobe patch's visible-normal density ⟨wo, m⟩⁺ D(m) / V(wo) with D(m) = `d()` and
