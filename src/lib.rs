@@ -124,7 +124,7 @@
 //!   ([`glint::BinMap`]) its exact or moment-lobe masking; position-normal
 //!   ([`glint::PositionNormalMap`]) its element sum or filtered mixture. Which is first to a given
 //!   error depends on the pixel's footprint on the map (texels per pixel), as below.
-//! - **Memory** (docs/results.md, "Memory per model"): the mixture holds 123 B/texel at the
+//! - **Memory** (docs/results.md, "Memory per model"): the mixture holds 99 B/texel at the
 //!   defaults (at 512²-2048²: lobes, lobe blocks, quadtree, the moment and filtered-mixture mip
 //!   chains, levels of detail), 15.4 B/texel with `LobeStorage::Compact` (1.4-1.8× the query time);
 //!   the bin map 29.2 B/texel at 2048², position-normal 65 (29.3 of elements and quadtree, 36 of

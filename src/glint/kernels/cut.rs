@@ -401,7 +401,7 @@ pub(crate) fn cut(
         if l == 0 {
             set.push(e.mass as f32, lobe0(k));
         } else {
-            pyr.push_node(l, k, e.mass, set);
+            pyr.push_node(l, k, e.mass, &lobe0, set);
         }
         stats.max_error = stats.max_error.max(e.err as f32);
         stats.total_error += e.err as f32;

@@ -19,8 +19,15 @@
 //! footprint's centre, a convex combination of up to 8 nodes, each weight multiplying its node's
 //! component weights (lobe_set.rs holds the result and evaluates it).
 //!
+//! **Level 1 is not stored.** A node of level 1 has at most 4 = [`GMM_LOBES`] children, so its
+//! reduction merges nothing: its components are its lobes, each of weight 1/(children). The chain
+//! keeps level 1's residuals (gmm_residual.rs) and serves its components from the lobes on demand
+//! ([`GmmPyramid::push_node`], [`GmmPyramid::records`]), bit for bit the records the build made,
+//! which saves 24 of the 36 bytes per lobe the chain would otherwise hold.
+//!
 //! Cost: ~20 ns of build per lobe (one reduction of ≤ 4 [`GMM_LOBES`] components per node), 96
-//! bytes per node of the levels ≥ 1 and 12 of residuals (≤ 36 bytes per lobe), and O(1) per query.
+//! bytes per node of the levels ≥ 2 and 12 of residuals per node of the levels ≥ 1 (≤ 12 bytes per
+//! lobe), and O(1) per query.
 
 use super::gmm_residual::{Comp, Residual, node_residual};
 use super::lobe_set::LobeSet;
@@ -209,16 +216,42 @@ fn reduce_uncached(comps: &mut Vec<Comp>, k: usize) {
     }
 }
 
-/// The filtered-mixture mip chain (module docs): levels l ≥ 1, [`GMM_LOBES`] components per node.
+/// The filtered-mixture mip chain (module docs): levels l ≥ 1, [`GMM_LOBES`] components per node,
+/// stored from level 2 (level 1's are its lobes).
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct GmmPyramid {
     sizes: Vec<[usize; 2]>,
-    /// `levels[l - 1]`: level l's nodes, row major, each [`GMM_LOBES`] components (weight 0 pads).
+    /// `levels[l - 2]`: level l ≥ 2's nodes, row major, each [`GMM_LOBES`] components (weight 0
+    /// pads).
     levels: Vec<Vec<[Stored; GMM_LOBES]>>,
     /// `residuals[l - 1]`: level l's nodes' residuals (gmm_residual.rs), row major.
     residuals: Vec<Vec<Residual>>,
     /// The floor σ_min of every stored component's standard deviations.
     sigma_min: f32,
+}
+
+/// The components of node (`x`, `y`) of level 1 over a level-0 grid `[nx, ny]` whose lobe k is
+/// `lobe0(k)`: its (up to) 2 × 2 lobes in row order, each of weight 1/(children), as the build's
+/// reduction leaves them (it merges nothing at ≤ [`GMM_LOBES`] components), weight 0 pads.
+fn level_one_node(
+    [nx, ny]: [usize; 2],
+    x: usize,
+    y: usize,
+    lobe0: impl Fn(usize) -> SlopeGaussian,
+) -> [Stored; GMM_LOBES] {
+    let mut out = [[0.0f32; 6]; GMM_LOBES];
+    let (xs, ys) = ((2 * x)..(2 * x + 2).min(nx), (2 * y)..(2 * y + 2).min(ny));
+    let n = (xs.len() * ys.len()) as f64;
+    let mut i = 0;
+    for cy in ys {
+        for cx in xs.clone() {
+            let mut c = Comp::of_lobe(&lobe0(cy * nx + cx));
+            c.w /= n;
+            out[i] = c.stored();
+            i += 1;
+        }
+    }
+    out
 }
 
 impl GmmPyramid {
@@ -292,6 +325,10 @@ impl GmmPyramid {
             levels.push(level);
             residuals.push(res);
         }
+        // Level 1's components are its lobes (module docs): kept only while level 2 was built.
+        if !levels.is_empty() {
+            levels.remove(0);
+        }
         GmmPyramid {
             sizes,
             levels,
@@ -300,12 +337,31 @@ impl GmmPyramid {
         }
     }
 
-    /// Level l ≥ 1's nodes as records (row major): what a file stores of the chain.
-    pub fn records(&self, l: usize) -> impl ExactSizeIterator<Item = NodeRecord> + '_ {
-        let (nodes, res) = (&self.levels[l - 1], &self.residuals[l - 1]);
-        nodes.iter().zip(res).map(|(n, r)| {
+    /// Node `k`'s components at level `l` ≥ 1: stored from level 2, level 1's from `lobe0`.
+    fn node(
+        &self,
+        l: usize,
+        k: usize,
+        lobe0: impl Fn(usize) -> SlopeGaussian,
+    ) -> [Stored; GMM_LOBES] {
+        if l == 1 {
+            let w = self.sizes[1][0];
+            level_one_node(self.sizes[0], k % w, k / w, lobe0)
+        } else {
+            self.levels[l - 2][k]
+        }
+    }
+
+    /// Level l ≥ 1's nodes as records (row major): what a file stores of the chain. `lobe0(k)` is
+    /// the level-0 lobe k as at the build (level 1's components are its lobes).
+    pub fn records<'a>(
+        &'a self,
+        l: usize,
+        lobe0: impl Fn(usize) -> SlopeGaussian + Copy + 'a,
+    ) -> impl ExactSizeIterator<Item = NodeRecord> + 'a {
+        self.residuals[l - 1].iter().enumerate().map(move |(k, r)| {
             let mut out = [0.0f32; 6 * GMM_LOBES + 3];
-            out[..6 * GMM_LOBES].copy_from_slice(n.as_flattened());
+            out[..6 * GMM_LOBES].copy_from_slice(self.node(l, k, lobe0).as_flattened());
             out[6 * GMM_LOBES..].copy_from_slice(&[r.rho, r.eta, r.norm]);
             out
         })
@@ -314,7 +370,8 @@ impl GmmPyramid {
     /// The chain over an `nx × ny` lobe grid from its levels' records (`levels[l - 1]`: level l's
     /// nodes, row major, as [`GmmPyramid::records`] gives them), read back with standard deviations
     /// floored at `sigma_min`: the chain [`GmmPyramid::build`] made, bit for bit, when the records
-    /// are the ones it wrote.
+    /// are the ones it wrote. Level 1's components are checked as every level's and then dropped
+    /// (the chain serves them from the lobes, module docs); its residuals are kept.
     ///
     /// # Errors
     /// A reason if the level count or a level's node count does not match the grid, or a node's
@@ -367,7 +424,9 @@ impl GmmPyramid {
                     norm: t[2],
                 });
             }
-            levels.push(nodes);
+            if l > 0 {
+                levels.push(nodes);
+            }
             residuals.push(res);
         }
         Ok(GmmPyramid {
@@ -396,7 +455,9 @@ impl GmmPyramid {
     /// Bytes held.
     pub fn bytes(&self) -> usize {
         let nodes: usize = self.levels.iter().map(Vec::len).sum();
-        nodes * (std::mem::size_of::<[Stored; GMM_LOBES]>() + std::mem::size_of::<Residual>())
+        let residuals: usize = self.residuals.iter().map(Vec::len).sum();
+        nodes * std::mem::size_of::<[Stored; GMM_LOBES]>()
+            + residuals * std::mem::size_of::<Residual>()
     }
 
     /// The grid of every level, level 0 (the lobes) first.
@@ -414,9 +475,16 @@ impl GmmPyramid {
     }
 
     /// Pushes node `k` of level `l` ≥ 1 into `set`, its components' weights times `w` (as
-    /// [`GmmPyramid::lookup`] serves them).
-    pub fn push_node(&self, l: usize, k: usize, w: f64, set: &mut LobeSet) {
-        for c in &self.levels[l - 1][k] {
+    /// [`GmmPyramid::lookup`] serves them); `lobe0(k)` is the level-0 lobe k as at the build.
+    pub fn push_node(
+        &self,
+        l: usize,
+        k: usize,
+        w: f64,
+        lobe0: impl Fn(usize) -> SlopeGaussian,
+        set: &mut LobeSet,
+    ) {
+        for c in &self.node(l, k, lobe0) {
             if c[0] > 0.0 {
                 let g = SlopeGaussian::from_moments([c[1], c[2], c[3], c[4], c[5]], self.sigma_min);
                 set.push((w * c[0] as f64) as f32, g);
@@ -449,7 +517,7 @@ impl GmmPyramid {
                 if l == 0 {
                     set.push(wn as f32, lobe0(k));
                 } else {
-                    self.push_node(l, k, wn, set);
+                    self.push_node(l, k, wn, &lobe0, set);
                 }
             }
         };
@@ -498,6 +566,68 @@ mod tests {
             for (x, y) in a.iter().zip(&b) {
                 assert_eq!((x.w, x.mean, x.cov), (y.w, y.mean, y.cov));
             }
+        }
+    }
+
+    /// Level 1 is served from the lobes: every level-1 record holds the node's (up to) 2 × 2 lobes
+    /// in row order, each of weight 1/(children), as mean and raw second moments, then zero pads,
+    /// on an odd grid (edge nodes of 1 and 2 children); and `push_node` serves those lobes.
+    #[test]
+    fn level_one_is_its_lobes() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(7);
+        let (nx, ny) = (5, 3);
+        let lobes: Vec<SlopeGaussian> = (0..nx * ny)
+            .map(|_| {
+                let m = [
+                    rng.random_range(-0.5..0.5f32),
+                    rng.random_range(-0.5..0.5f32),
+                ];
+                let (sx, sy) = (
+                    rng.random_range(0.01..0.2f32),
+                    rng.random_range(0.01..0.2f32),
+                );
+                let r = rng.random_range(-0.8..0.8f32);
+                let (mxx, myy) = (sx * sx + m[0] * m[0], sy * sy + m[1] * m[1]);
+                SlopeGaussian::from_moments(
+                    [m[0], m[1], mxx, myy, r * sx * sy + m[0] * m[1]],
+                    0.005,
+                )
+            })
+            .collect();
+        let pyr = GmmPyramid::build(nx, ny, |k| lobes[k], 0.005);
+        assert_eq!(pyr.sizes()[1], [3, 2]);
+        for (k, rec) in pyr.records(1, |k| lobes[k]).enumerate() {
+            let (x, y) = (k % 3, k / 3);
+            let kids: Vec<usize> = (2 * y..(2 * y + 2).min(ny))
+                .flat_map(|cy| (2 * x..(2 * x + 2).min(nx)).map(move |cx| cy * nx + cx))
+                .collect();
+            for c in 0..GMM_LOBES {
+                let got = &rec[6 * c..6 * c + 6];
+                let Some(&kid) = kids.get(c) else {
+                    assert_eq!(got, &[0.0; 6], "node {k}: pad {c}");
+                    continue;
+                };
+                let (m, s) = (lobes[kid].mean(), lobes[kid].covariance());
+                let m = [m.x as f64, m.y as f64];
+                let want = [
+                    1.0 / kids.len() as f64,
+                    m[0],
+                    m[1],
+                    s.x_axis.x as f64 + m[0] * m[0],
+                    s.y_axis.y as f64 + m[1] * m[1],
+                    s.x_axis.y as f64 + m[0] * m[1],
+                ];
+                for (g, w) in got.iter().zip(want) {
+                    assert!(
+                        (*g as f64 - w).abs() <= 1e-6 * w.abs().max(1e-3),
+                        "node {k}: {got:?}"
+                    );
+                }
+            }
+            let mut set = LobeSet::default();
+            pyr.push_node(1, k, 1.0, |k| lobes[k], &mut set);
+            assert_eq!(set.len(), kids.len());
         }
     }
 

@@ -13,6 +13,7 @@ use super::gmm::{GMM_LOBES, GmmPyramid, NodeRecord};
 use super::slope_tree::level_sizes;
 use crate::Result;
 use crate::glint::io::format::{self, Decoder, Encoder};
+use crate::ndf::SlopeGaussian;
 
 /// What a loader accepts of a stored chain's components: means within ±`mean`, raw second moments
 /// E x̃², E ỹ² in [0, `second`] and E x̃ỹ in ±`second` (each model's bound from what its build can
@@ -31,11 +32,17 @@ pub(crate) struct StoredChain {
     pub errors: Vec<f32>,
 }
 
-/// Writes `chain` and its measured `errors` (one per level of the chain).
-pub(crate) fn save_chain(e: &mut Encoder<'_>, chain: &GmmPyramid, errors: &[f32]) -> Result<()> {
+/// Writes `chain` and its measured `errors` (one per level of the chain); `lobe0(k)` is the
+/// level-0 lobe k as at the build (the chain serves level 1 from its lobes).
+pub(crate) fn save_chain(
+    e: &mut Encoder<'_>,
+    chain: &GmmPyramid,
+    lobe0: impl Fn(usize) -> SlopeGaussian + Copy,
+    errors: &[f32],
+) -> Result<()> {
     e.len(chain.levels() - 1)?;
     for l in 1..chain.levels() {
-        e.array(chain.records(l))?;
+        e.array(chain.records(l, lobe0))?;
     }
     e.array(errors.iter().map(|&v| [v]))
 }

@@ -2,7 +2,7 @@
 //! = the lobes, levels l ≥ 1 the merged lobes of levels.rs) as raw moments (20 bytes per node), lobe
 //! blocks in `f32` (32 bytes, blocks.rs) and the slope-box quadtree from level 1 up, the levels'
 //! merge errors at every resolution of [`super::LOD_RESOLUTIONS`], the moment mip chain of the
-//! lobes for the filtered lobe (hierarchy.rs) and the filtered mixture's chain (gmm.rs): ~119 bytes
+//! lobes for the filtered lobe (hierarchy.rs) and the filtered mixture's chain (gmm.rs): ~99 bytes
 //! per lobe, the fastest queries.
 //!
 //! Files store the moments, the merge errors and the filtered mixture's chain (its Runnalls

@@ -45,9 +45,10 @@ macro_rules! with_storage {
 /// the lobe blocks derived from them (32 bytes: mean, Cholesky factor and its scaled inverse in
 /// `f32`, structure-of-arrays tiles of 4 × 4 lobes that `d`, the exact masking and the samplers
 /// evaluate 16 lanes at a time); the quadtree of slope boxes (~5.3 bytes per lobe), the moment mip
-/// chain (~6.7 bytes per lobe), the filtered mixture's chain with its residuals (36 bytes per lobe) and the levels of
+/// chain (~6.7 bytes per lobe), the filtered mixture's chain with its residuals (12 bytes per lobe:
+/// level 1's components are its lobes, served from them) and the levels of
 /// detail (~23 bytes per lobe for a full chain: merged lobes, blocks, quadtree, merge errors):
-/// ~119 bytes per lobe, see [`BeckmannMixture::memory`] and docs/mixture.md ("Lobe blocks"). Under [`LobeStorage::Compact`] ([`MixtureParams::storage`])
+/// ~99 bytes per lobe, see [`BeckmannMixture::memory`] and docs/mixture.md ("Lobe blocks"). Under [`LobeStorage::Compact`] ([`MixtureParams::storage`])
 /// only compact blocks of every level, their quadtree from level 2 up and one-byte merge errors:
 /// ≤ 16 bytes per lobe, the model defined by the decoded lobes (docs/mixture.md, "Compact
 /// storage").

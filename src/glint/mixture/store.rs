@@ -25,6 +25,7 @@ use crate::glint::MAX_SLOPE;
 use crate::glint::io::format::{self, Decoder, Kind, Stored};
 use crate::glint::kernels::gmm_store::{self, ChainBounds};
 use crate::glint::kernels::slope_tree::level_sizes;
+use crate::ndf::SlopeGaussian;
 use std::io::{Read, Write};
 
 /// Bound on stored mean slopes: 2 · [`MAX_SLOPE`]. Built moments average slopes of at most
@@ -70,7 +71,13 @@ impl BeckmannMixture {
                         )?;
                     }
                     // The filtered mixture's chain and its measured errors (since version 6).
-                    gmm_store::save_chain(e, s.gmm(), self.filtered_mixture_errors())?;
+                    let (lobes, sigma_min) = (s.moments(), p.sigma_min);
+                    gmm_store::save_chain(
+                        e,
+                        s.gmm(),
+                        |k| SlopeGaussian::from_moments(lobes[k], sigma_min),
+                        self.filtered_mixture_errors(),
+                    )?;
                 }
                 Storage::Compact(s) => {
                     e.len(s.levels().len())?;

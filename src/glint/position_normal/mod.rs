@@ -43,8 +43,9 @@ pub struct PositionNormalMemory {
     pub element_bytes: usize,
     /// The slope-box quadtree (levels ≥ 1, 16 bytes per node).
     pub hierarchy_bytes: usize,
-    /// The filtered mixture's chain, built with the map (108 bytes per node of levels ≥ 1 with its
-    /// residual, ≤ 36 bytes per element).
+    /// The filtered mixture's chain, built with the map (96 bytes per node of levels ≥ 2 and a
+    /// 12-byte residual per node of levels ≥ 1, ≤ 12 bytes per element; level 1's components are
+    /// its elements' marginals, served from them).
     pub filtered_bytes: usize,
 }
 

@@ -2,7 +2,8 @@
 //!
 //! Stored: the map size, the build parameters (no per-query options), the elements (slope and
 //! Jacobian, 24 bytes each) and, since format version 6, the filtered mixture's chain with its
-//! residuals and measured errors (kernels/gmm_store.rs, ~36 bytes per element; older files get them
+//! residuals and measured errors (kernels/gmm_store.rs, ~36 bytes per element in the file, level 1's
+//! components included; older files get them
 //! built and measured as a build does). The slope boxes and their hierarchy are rebuilt on load by
 //! the same code as the build (O(elements)), so every query of a loaded map is bit-identical to the
 //! built one.
@@ -31,7 +32,12 @@ impl PositionNormalMap {
             e.put(p.slope_sigmas)?;
             e.array(self.elements.iter().copied())?;
             // The filtered mixture's chain and its measured errors (since version 6).
-            gmm_store::save_chain(e, self.filtered_chain(), self.filtered_mixture_errors())
+            gmm_store::save_chain(
+                e,
+                self.filtered_chain(),
+                |k| self.element_marginal(k),
+                self.filtered_mixture_errors(),
+            )
         })
     }
 
