@@ -8,7 +8,7 @@ use super::gather::{
     Effective, FootprintLobes, Gathered, SlotBuffers, gather, level_range, lod_error_of,
 };
 use super::levels::resolution_index;
-use super::params::PatchOptions;
+use super::params::{MaskingMode, PatchOptions};
 use super::storage::{LevelView, LobeStore};
 use super::sub_texel;
 use crate::glint::kernels::cut::{self, CutKernel, CutStats};
@@ -161,7 +161,14 @@ pub(super) fn footprint_patch<'a, S: LobeStore>(
     Footprinted {
         level,
         filtered,
-        gathered: Some(gather(weight_sigmas, level, &eff, res, bufs)),
+        gathered: Some(gather(
+            weight_sigmas,
+            level,
+            &eff,
+            res,
+            options.masking == MaskingMode::Approximate,
+            bufs,
+        )),
         set: None,
         cut: None,
     }

@@ -223,6 +223,19 @@ impl LevelView for FullLevel<'_> {
         })
     }
 
+    /// The raw moments' mean (the lobe's own, its fallback, for non-finite moments), as
+    /// [`LevelView::mean_cov`] gives it, without the covariance.
+    #[inline]
+    fn mean(&self, k: usize) -> [f64; 2] {
+        let m = &self.data.moments[k];
+        if m.iter().all(|v| v.is_finite()) {
+            [m[0] as f64, m[1] as f64]
+        } else {
+            let mu = self.lobe(k).mean();
+            [mu.x as f64, mu.y as f64]
+        }
+    }
+
     #[inline]
     fn error(&self, k: usize, res: usize) -> f32 {
         self.data
@@ -256,8 +269,16 @@ fn lobe_mean_cov(m: &[f32; 5], s2: f64) -> Option<([f64; 2], [f64; 3])> {
     let [ex, ey, exx, eyy, exy] = m.map(f64::from);
     let vx = (exx - ex * ex).max(s2);
     let vy = (eyy - ey * ey).max(s2);
-    let c_max = ((vx - s2) * (vy - s2)).sqrt();
-    Some(([ex, ey], [vx, (exy - ex * ey).clamp(-c_max, c_max), vy]))
+    let (c, p) = (exy - ex * ey, (vx - s2) * (vy - s2));
+    // |c| < √p for sure when c² < p (1 − 10⁻⁹) (each side rounded once, √ correctly rounded):
+    // the clamp changes nothing and its square root is skipped.
+    let c = if c * c < p * (1.0 - 1e-9) {
+        c
+    } else {
+        let c_max = p.sqrt();
+        c.clamp(-c_max, c_max)
+    };
+    Some(([ex, ey], [vx, c, vy]))
 }
 
 /// The lobe blocks (blocks.rs) and the slope-box quadtree (src/glint/slope_tree.rs) of the lobes

@@ -25,7 +25,7 @@ pub(super) struct AxisSlots {
     /// Number of slots.
     pub len: usize,
     /// Lobes along this axis.
-    n: usize,
+    pub n: usize,
     /// Folded onto [0, n) (slot = lobe index).
     folded: bool,
 }
@@ -164,7 +164,8 @@ pub(super) struct Gathered<'a> {
     pub lod_error: f64,
     /// The patch's slope covariance Σ_P = Σ W_i (Σ_i + μ_i μ_iᵀ) − μ_P μ_Pᵀ, [xx, xy, yy] (f64), with
     /// each lobe's covariance as its D uses it (floored, correlation clamped): the second moment that
-    /// the approximate masking's Scarf bound needs.
+    /// the approximate masking's Scarf bound needs, and only it (zero unless the gather was asked
+    /// for second moments).
     pub slope_cov: [f64; 3],
 }
 
@@ -364,13 +365,15 @@ pub(super) fn lod_error_of<L: LevelView>(
 }
 
 /// The normalised weights of the level's nodes over the footprint (`eff`), their cdf and block
-/// layout, the patch mean slope and covariance and the level-of-detail bound at the resolution of
-/// index `res`, in `bufs`.
+/// layout, the patch mean slope, its covariance when `second_moments` (what the approximate
+/// masking reads; the lobes' covariances are not read otherwise) and the level-of-detail bound at
+/// the resolution of index `res`, in `bufs`.
 pub(super) fn gather<'b, L: LevelView>(
     weight_sigmas: f32,
     lv: L,
     eff: &Effective,
     res: usize,
+    second_moments: bool,
     mut bufs: Lent<'b, SlotBuffers>,
 ) -> Gathered<'b> {
     // Raw weights are summed into the cdf buffer, then normalised and accumulated in place.
@@ -390,27 +393,52 @@ pub(super) fn gather<'b, L: LevelView>(
     let mut m1 = [0.0f64; 2];
     let mut m2 = [0.0f64; 3];
     let mut lod_error = 0.0f64;
-    weights.extend(w.iter_mut().enumerate().map(|(s, wi)| {
-        let wn = *wi * inv;
-        acc += wn;
-        *wi = acc;
-        let k = axes[1].lobe_of_slot(s / lx) * nx + axes[0].lobe_of_slot(s % lx);
-        lod_error += wn * lv.error(k, res) as f64;
-        let (mu, cov) = lv.mean_cov(k);
-        m1[0] += wn * mu[0];
-        m1[1] += wn * mu[1];
-        m2[0] += wn * (cov[0] + mu[0] * mu[0]);
-        m2[1] += wn * (cov[1] + mu[0] * mu[1]);
-        m2[2] += wn * (cov[2] + mu[1] * mu[1]);
-        wn as f32
-    }));
+    // Slots row by row, the lobe index stepped along the row (wrapping at the grid's edge) rather
+    // than divided out of the slot index per lobe; level 0 has no merge error (its term is 0).
+    let merged = lv.level() > 0;
+    let (x_first, grid_x) = (axes[0].lobe_of_slot(0), axes[0].n);
+    weights.reserve(w.len());
+    for (sy, row) in w.chunks_exact_mut(lx).enumerate() {
+        let row_lobe = axes[1].lobe_of_slot(sy) * nx;
+        let mut kx = x_first;
+        for wi in row {
+            let wn = *wi * inv;
+            acc += wn;
+            *wi = acc;
+            let k = row_lobe + kx;
+            kx += 1;
+            if kx == grid_x {
+                kx = 0;
+            }
+            if merged {
+                lod_error += wn * lv.error(k, res) as f64;
+            }
+            if second_moments {
+                let (mu, cov) = lv.mean_cov(k);
+                m1[0] += wn * mu[0];
+                m1[1] += wn * mu[1];
+                m2[0] += wn * (cov[0] + mu[0] * mu[0]);
+                m2[1] += wn * (cov[1] + mu[0] * mu[1]);
+                m2[2] += wn * (cov[2] + mu[1] * mu[1]);
+            } else {
+                let mu = lv.mean(k);
+                m1[0] += wn * mu[0];
+                m1[1] += wn * mu[1];
+            }
+            weights.push(wn as f32);
+        }
+    }
     let (rects, n_rects) = block_weights(&axes, &mut bufs);
     // Σ W = 1 up to rounding; the covariance is floored at 0 against cancellation.
-    let slope_cov = [
-        (m2[0] - m1[0] * m1[0]).max(0.0),
-        m2[1] - m1[0] * m1[1],
-        (m2[2] - m1[1] * m1[1]).max(0.0),
-    ];
+    let slope_cov = if second_moments {
+        [
+            (m2[0] - m1[0] * m1[0]).max(0.0),
+            m2[1] - m1[0] * m1[1],
+            (m2[2] - m1[1] * m1[1]).max(0.0),
+        ]
+    } else {
+        [0.0; 3]
+    };
     Gathered {
         axes,
         bufs,

@@ -50,6 +50,12 @@ pub(super) trait LevelView: Copy + std::fmt::Debug {
     /// correlation clamped).
     fn mean_cov(&self, k: usize) -> ([f64; 2], [f64; 3]);
 
+    /// Node k's mean slope in `f64`: [`LevelView::mean_cov`]'s mean, bit for bit.
+    #[inline]
+    fn mean(&self, k: usize) -> [f64; 2] {
+        self.mean_cov(k).0
+    }
+
     /// The merge-error bound of node k valid at the resolution of index `res` in
     /// [`super::LOD_RESOLUTIONS`] (0 at level 0, which is exact).
     fn error(&self, k: usize, res: usize) -> f32;
