@@ -71,12 +71,12 @@ fn lookups(c: &mut Criterion) {
                 .sum::<f32>()
         })
     });
-    g.bench_function("filtered_moments", |b| {
-        let _ = map.moments(0); // build the pyramid before timing
+    g.bench_function("moment_pyramid_filtered", |b| {
+        let pyramid = map.moment_pyramid(); // built before timing
         b.iter(|| {
             points
                 .iter()
-                .map(|&p| map.filtered_moments(black_box(p), 6.0)[2])
+                .map(|&p| pyramid.filtered(black_box(p), 6.0)[2])
                 .sum::<f32>()
         })
     });

@@ -23,7 +23,8 @@ fuzz_target!(|data: &[u8]| {
         let n = map.normal_at(Vec2::new(0.37, 0.61));
         assert!(n.is_finite() && n.z > 0.0, "interpolated normal {n}");
         assert!(
-            map.filtered_moments(Vec2::new(1.5, 2.5), 3.0)
+            map.moment_pyramid()
+                .filtered(Vec2::new(1.5, 2.5), 3.0)
                 .iter()
                 .all(|m| m.is_finite())
         );

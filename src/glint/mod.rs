@@ -145,8 +145,8 @@ pub use scratch::GlintScratch;
 pub use surface::{
     BrushedParams, FlakesParams, Footprint, MAX_ANISOTROPY, MAX_CARVE_WORK_PER_TEXEL,
     MAX_EXTENT_PERIODS, MAX_GENERATED_TEXELS, MAX_SLOPE, MIN_CELL_TEXELS, MIN_WIDTH_TEXELS,
-    NormalMap, NormalRepair, RayCone, RayDifferential, ScratchedParams, TangentConvention, brushed,
-    bumpy, flakes, moments_mean_covariance, scratched,
+    NormalMap, NormalRepair, RayCone, RayDifferential, ScratchedParams, SlopeMomentPyramid,
+    TangentConvention, brushed, bumpy, flakes, moments_mean_covariance, scratched,
 };
 pub use surface::{
     DEFAULT_LENGTH_TOLERANCE, DEFAULT_MAX_IMAGE_TEXELS, FloatEncoding, HemisphereBins,

@@ -242,15 +242,18 @@ fn moment_levels_preserve_the_map_average() {
                 *m += v / (w * h) as f64;
             }
         }
-        let l0 = map.moments(0).unwrap();
+        let pyramid = map.moment_pyramid();
+        assert_eq!(pyramid.levels(), map.levels());
+        let l0 = pyramid.level(0).unwrap();
         assert_eq!(l0.len(), w * h);
         let s = map.slopes()[1 % (w * h)];
         assert_eq!(l0[1 % (w * h)], [s.x, s.y, s.x * s.x, s.y * s.y, s.x * s.y]);
         assert_eq!(map.level_size(map.levels() - 1), Some((1, 1)));
         assert_eq!(map.level_size(map.levels()), None);
+        assert_eq!(pyramid.level(map.levels()), None);
         for l in 0..map.levels() {
             let (lw, lh) = map.level_size(l).unwrap();
-            let data = map.moments(l).unwrap();
+            let data = pyramid.level(l).unwrap();
             assert_eq!(data.len(), lw * lh);
             // Every level is an area-weighted average, so its texel average is the map average
             // (f32 storage of O(1) values: 1e-5).
@@ -268,30 +271,30 @@ fn moment_levels_preserve_the_map_average() {
 
 #[test]
 fn filtered_moments_levels_and_interpolation() {
-    let map = random_map(8, 8, 1.0, 30);
-    let l0 = map.moments(0).unwrap();
+    let map = random_map(8, 8, 1.0, 30).moment_pyramid();
+    let l0 = map.level(0).unwrap();
     // At a texel centre with a one-texel region: the texel itself.
-    let m = map.filtered_moments(Vec2::new(3.5, 2.5), 0.5);
+    let m = map.filtered(Vec2::new(3.5, 2.5), 0.5);
     for k in 0..5 {
         assert!((m[k] - l0[2 * 8 + 3][k]).abs() < 1e-6);
     }
     // Halfway between two level-0 centres: their average.
-    let m = map.filtered_moments(Vec2::new(4.0, 2.5), 0.25);
+    let m = map.filtered(Vec2::new(4.0, 2.5), 0.25);
     for k in 0..5 {
         let want = 0.5 * (l0[2 * 8 + 3][k] + l0[2 * 8 + 4][k]);
         assert!((m[k] - want).abs() < 1e-6);
     }
     // A region as large as the map: the 1×1 level, i.e. the map average, anywhere.
-    let top = map.moments(map.levels() - 1).unwrap()[0];
+    let top = map.level(map.levels() - 1).unwrap()[0];
     for c in [Vec2::ZERO, Vec2::new(3.3, 7.9), Vec2::new(-100.0, 40.0)] {
-        let m = map.filtered_moments(c, 1e6);
+        let m = map.filtered(c, 1e6);
         for k in 0..5 {
             assert!((m[k] - top[k]).abs() < 1e-6);
         }
     }
     // Radius 1 (λ = 1): exactly level 1 at a level-1 texel centre (level-1 texel (1, 1) is centred at
     // level-0 position (3, 3)), which is the 2×2 box of level-0 texels (2..4)².
-    let m = map.filtered_moments(Vec2::new(3.0, 3.0), 1.0);
+    let m = map.filtered(Vec2::new(3.0, 3.0), 1.0);
     for k in 0..5 {
         let want: f32 = [(2, 2), (3, 2), (2, 3), (3, 3)]
             .iter()
@@ -303,9 +306,251 @@ fn filtered_moments_levels_and_interpolation() {
     // Degenerate arguments stay finite.
     for r in [f32::NAN, -1.0, 0.0, f32::INFINITY] {
         assert!(
-            map.filtered_moments(Vec2::new(f32::NAN, 1.0), r)
+            map.filtered(Vec2::new(f32::NAN, 1.0), r)
                 .iter()
                 .all(|v| v.is_finite())
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The explicit pyramid against independent computations
+// ---------------------------------------------------------------------------------------------
+
+/// A map whose slopes are multiples of 2⁻⁶ in [−2, 2]: the products x̃², ỹ², x̃ỹ are multiples of
+/// 2⁻¹² of magnitude at most 4, so the mean of any 2^k of them is a multiple of 2^−(12+k) of
+/// magnitude at most 4, 15 + k significant bits: exact in `f32` for k ≤ 9 (blocks of up to 512
+/// texels), whatever the order of the sums.
+fn dyadic_map(w: usize, h: usize, seed: u64) -> NormalMap {
+    let mut rng = support::rng(seed);
+    let slopes = (0..w * h)
+        .map(|_| {
+            let mut q = || rng.random_range(-128i32..=128) as f32 / 64.0;
+            Vec2::new(q(), q())
+        })
+        .collect();
+    NormalMap::from_slopes(w, h, slopes).unwrap()
+}
+
+/// The five moments of a slope, in f64 from the f32 slope.
+fn texel_moments(s: Vec2) -> [f64; 5] {
+    let (x, y) = (s.x as f64, s.y as f64);
+    [x, y, x * x, y * y, x * y]
+}
+
+/// Level `l` of a power-of-two map as plain f64 box averages of level-0 texels: level texel (i, j)
+/// averages the bx × by block of level-0 texels at (i bx, j by), bx = W / w_l, by = H / h_l.
+fn box_level(map: &NormalMap, l: usize) -> Vec<[f64; 5]> {
+    let (w, h) = (map.width(), map.height());
+    let (lw, lh) = map.level_size(l).unwrap();
+    assert!(w % lw == 0 && h % lh == 0, "{w}×{h} level {l}");
+    let (bx, by) = (w / lw, h / lh);
+    let mut out = vec![[0.0; 5]; lw * lh];
+    for (t, o) in out.iter_mut().enumerate() {
+        let (i, j) = (t % lw, t / lw);
+        for y in j * by..(j + 1) * by {
+            for x in i * bx..(i + 1) * bx {
+                let m = texel_moments(map.texel_slope(x as i64, y as i64));
+                for k in 0..5 {
+                    o[k] += m[k] / (bx * by) as f64;
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The trilinear lookup written independently in f64 over `levels` (f64 level values):
+/// λ = clamp(log₂(2r), 0, L − 1), bilinear between level texel centres with wrapping, linear in λ.
+fn reference_filtered(map: &NormalMap, levels: &[Vec<[f64; 5]>], c: Vec2, r: f32) -> [f64; 5] {
+    let top = (levels.len() - 1) as f64;
+    let lod = if r > 0.0 {
+        (2.0 * r as f64).log2().clamp(0.0, top)
+    } else {
+        0.0
+    };
+    let at_level = |l: usize| -> [f64; 5] {
+        let (lw, lh) = map.level_size(l).unwrap();
+        let px = c.x as f64 * lw as f64 / map.width() as f64 - 0.5;
+        let py = c.y as f64 * lh as f64 / map.height() as f64 - 0.5;
+        let (fx, fy) = (px - px.floor(), py - py.floor());
+        let mut out = [0.0; 5];
+        for (di, dj, wgt) in [
+            (0, 0, (1.0 - fx) * (1.0 - fy)),
+            (1, 0, fx * (1.0 - fy)),
+            (0, 1, (1.0 - fx) * fy),
+            (1, 1, fx * fy),
+        ] {
+            let i = (px.floor() as i64 + di).rem_euclid(lw as i64) as usize;
+            let j = (py.floor() as i64 + dj).rem_euclid(lh as i64) as usize;
+            for k in 0..5 {
+                out[k] += wgt * levels[l][j * lw + i][k];
+            }
+        }
+        out
+    };
+    let l0 = lod.floor();
+    let (a, b) = (at_level(l0 as usize), at_level(lod.ceil() as usize));
+    std::array::from_fn(|k| a[k] + (lod - l0) * (b[k] - a[k]))
+}
+
+/// Centres (wrapping, off-centre, negative) and radii (λ below 0, integer, fractional, above the
+/// top) for the lookups.
+fn lookups() -> Vec<(Vec2, f32)> {
+    let centres = [
+        Vec2::new(3.0, 5.0),
+        Vec2::new(0.2, 7.7),
+        Vec2::new(-13.4, 2.6),
+        Vec2::new(41.3, -9.1),
+    ];
+    let radii = [0.1, 0.5, 0.8, 1.0, 1.3, 2.0, 3.7, 6.0, 11.0, 1e5];
+    centres
+        .iter()
+        .flat_map(|&c| radii.iter().map(move |&r| (c, r)))
+        .collect()
+}
+
+/// Power-of-two maps: every level equals the f64 box average of its block of level-0 texels bit
+/// for bit (dyadic slopes make every such mean exact in f32, see [`dyadic_map`]), and `filtered`
+/// equals the f64 trilinear lookup over those averages to 1e-6 of the moments' scale (4: the f32
+/// rounding of the result and of λ, computed in f32 by the pyramid).
+#[test]
+fn moment_pyramid_matches_box_averages_on_power_of_two_maps() {
+    for (w, h) in [(16, 16), (32, 8), (4, 16)] {
+        let map = dyadic_map(w, h, 40 + w as u64 + h as u64);
+        let pyramid = map.moment_pyramid();
+        assert_eq!(pyramid.levels(), map.levels());
+        let levels: Vec<Vec<[f64; 5]>> = (0..map.levels()).map(|l| box_level(&map, l)).collect();
+        for (l, want) in levels.iter().enumerate() {
+            let got = pyramid.level(l).unwrap();
+            assert_eq!(got.len(), want.len(), "{w}×{h} level {l}");
+            for (t, (g, e)) in got.iter().zip(want).enumerate() {
+                assert_eq!(*g, e.map(|v| v as f32), "{w}×{h} level {l} texel {t}");
+            }
+        }
+        assert!(pyramid.level(map.levels()).is_none());
+        for (c, r) in lookups() {
+            let got = pyramid.filtered(c, r);
+            let want = reference_filtered(&map, &levels, c, r);
+            for k in 0..5 {
+                assert!(
+                    (got[k] as f64 - want[k]).abs() <= 4e-6,
+                    "{w}×{h} at {c} r {r} moment {k}: {} vs {}",
+                    got[k],
+                    want[k]
+                );
+            }
+        }
+    }
+}
+
+/// Odd sizes: level 1 is the f64 area-weighted average over the exact overlap of its uv rectangle
+/// with the level-0 texels (to f32 rounding of values below 4: 1e-6); at every level and for
+/// `filtered`, the result is a convex combination of level-0 texels with weights ≥ 0 summing to 1,
+/// read through linearity: the moments of a map whose slope x̃ is 1 on one texel t and 0 elsewhere
+/// are the weights of t (E\[x̃\] = E\[x̃²\] = weight).
+#[test]
+fn moment_pyramid_is_a_convex_combination_on_odd_maps() {
+    for (w, h) in [(5, 3), (7, 5), (9, 1), (3, 6)] {
+        let map = random_map(w, h, 1.2, 50 + w as u64);
+        let pyramid = map.moment_pyramid();
+        // Level 1 by exact overlaps.
+        let (lw, lh) = map.level_size(1).unwrap_or((1, 1));
+        let overlap =
+            |a0: f64, a1: f64, k: usize| (a1.min(k as f64 + 1.0) - a0.max(k as f64)).max(0.0);
+        if map.levels() > 1 {
+            let got = pyramid.level(1).unwrap();
+            let (sx, sy) = (w as f64 / lw as f64, h as f64 / lh as f64);
+            for j in 0..lh {
+                for i in 0..lw {
+                    let mut want = [0.0f64; 5];
+                    for y in 0..h {
+                        for x in 0..w {
+                            let a = overlap(i as f64 * sx, (i + 1) as f64 * sx, x)
+                                * overlap(j as f64 * sy, (j + 1) as f64 * sy, y);
+                            let m = texel_moments(map.texel_slope(x as i64, y as i64));
+                            for k in 0..5 {
+                                want[k] += a / (sx * sy) * m[k];
+                            }
+                        }
+                    }
+                    for k in 0..5 {
+                        let g = got[j * lw + i][k] as f64;
+                        assert!(
+                            (g - want[k]).abs() < 1e-6,
+                            "{w}×{h} ({i}, {j}) {k}: {g} vs {}",
+                            want[k]
+                        );
+                    }
+                }
+            }
+        }
+        // Convex weights, from impulse maps: level texel weights and lookup weights per input texel.
+        let texels = w * h;
+        let mut level_sums: Vec<Vec<f64>> = (0..map.levels())
+            .map(|l| vec![0.0; map.level_size(l).map_or(0, |(a, b)| a * b)])
+            .collect();
+        let mut lookup_sums = vec![0.0f64; lookups().len()];
+        for t in 0..texels {
+            let mut slopes = vec![Vec2::ZERO; texels];
+            slopes[t] = Vec2::new(1.0, 0.0);
+            let p = NormalMap::from_slopes(w, h, slopes)
+                .unwrap()
+                .moment_pyramid();
+            for (l, sums) in level_sums.iter_mut().enumerate() {
+                for (s, m) in sums.iter_mut().zip(p.level(l).unwrap()) {
+                    assert!(
+                        (0.0..=1.0).contains(&m[0]) && m[0] == m[2],
+                        "{w}×{h} level {l}: {m:?}"
+                    );
+                    assert!(m[1] == 0.0 && m[3] == 0.0 && m[4] == 0.0);
+                    *s += m[0] as f64;
+                }
+            }
+            for (s, &(c, r)) in lookup_sums.iter_mut().zip(&lookups()) {
+                let m = p.filtered(c, r);
+                assert!(
+                    (0.0..=1.0).contains(&m[0]) && m[0] == m[2],
+                    "{w}×{h} at {c} r {r}: {m:?}"
+                );
+                *s += m[0] as f64;
+            }
+        }
+        for sums in level_sums.iter().chain([&lookup_sums]) {
+            for s in sums {
+                // One f32 rounding per weight: texels × 2⁻²⁴.
+                assert!(
+                    (s - 1.0).abs() < texels as f64 * 1.2e-7,
+                    "{w}×{h}: weights sum to {s}"
+                );
+            }
+        }
+    }
+}
+
+/// The cost of building the pyramid (median of 5 builds at 1024² and 4096²), printed; no assertion.
+/// `cargo test --release --test it -- --ignored glint_normal_map::moment_pyramid_cost --nocapture`
+#[test]
+#[ignore = "timing; run by hand"]
+fn moment_pyramid_cost() {
+    for n in [1024usize, 4096] {
+        let map = random_map(n, n, 0.5, 7);
+        let mut times: Vec<f64> = (0..5)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                let p = map.moment_pyramid();
+                let dt = t.elapsed().as_secs_f64();
+                assert_eq!(p.levels(), map.levels());
+                dt
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        eprintln!(
+            "moment_pyramid {n}²: median {:.1} ms (min {:.1}, max {:.1}), {:.2} ns per texel",
+            times[2] * 1e3,
+            times[0] * 1e3,
+            times[4] * 1e3,
+            times[2] * 1e9 / (n * n) as f64
         );
     }
 }

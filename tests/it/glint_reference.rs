@@ -285,7 +285,7 @@ fn tv_distance_of_the_reference_to_itself_and_to_other_maps() {
     // Gaussian field; the same lobe twice as wide does not.
     let big = Footprint::isotropic_texels(Vec2::new(0.5, 0.5), 4096.0, 64, 64);
     let r = binned_pndf(&a, &big, Kernel::Gaussian, &bins, 400_000, 2);
-    let m = a.moments(a.levels() - 1).unwrap()[0];
+    let m = a.moment_pyramid().level(a.levels() - 1).unwrap()[0];
     let fit = SlopeGaussian::from_moments(m, 0.01);
     let wide = SlopeGaussian::from_moments([m[0], m[1], 4.0 * m[2], 4.0 * m[3], 4.0 * m[4]], 0.01);
     let (t_fit, t_wide) = (tv_distance(&fit, &r, 16), tv_distance(&wide, &r, 16));

@@ -102,7 +102,7 @@ mod tests {
         let slopes: Vec<Vec2> = (0..n * n)
             .map(|k| Vec2::new((k % n) as f32 * 0.01, (k / n) as f32 * -0.02))
             .collect();
-        let chain = MomentPyramid::build(n, n, &slopes).coarse_from(2);
+        let chain = MomentPyramid::build_from(n, n, &slopes, 2);
         let l = chain.level(0).unwrap();
         let cell = |i: usize, j: usize| l.data[j * l.width + i];
         let mean = |w: &[(usize, usize, f64)]| {

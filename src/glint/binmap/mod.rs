@@ -303,7 +303,8 @@ impl BinMap {
         }
         let (facets, center_slope) = bin_tables(&bins, &offsets);
         let table = Table::new(params.lookup, offsets, roots);
-        let moments = map.pyramid().coarse_from(MASKING_FIRST_LEVEL);
+        // The masking lobe's moments: only the levels it reads (from MASKING_FIRST_LEVEL), built here.
+        let moments = MomentPyramid::build_from(width, height, map.slopes(), MASKING_FIRST_LEVEL);
         Ok(BinMap {
             width,
             height,

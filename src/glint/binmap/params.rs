@@ -124,8 +124,8 @@ pub struct PatchOptions {
     /// [`DEFAULT_EXACT_MASKING_TEXELS`]; docs/binmap.md gives the error and cost that chose it.
     pub exact_masking_texels: f32,
     /// Largest measured G1 error of the moment lobe's masking
-    /// ([`BinMap::moment_masking_errors`](super::BinMap::moment_masking_errors), measured per map on
-    /// first use) at which a footprint between [`MIN_MOMENT_MASKING_TEXELS`] and
+    /// ([`BinMap::moment_masking_errors`](super::BinMap::moment_masking_errors), measured per map by
+    /// the build) at which a footprint between [`MIN_MOMENT_MASKING_TEXELS`] and
     /// `exact_masking_texels` takes the moment lobe's masking instead of its own bins'
     /// ([`DEFAULT_MOMENT_MASKING_TOLERANCE`]); 0 or NaN never, `f32::INFINITY` always (from
     /// [`MIN_MOMENT_MASKING_TEXELS`]).

@@ -128,8 +128,8 @@ pub struct PatchOptions {
     /// `f32::INFINITY` or NaN never).
     pub filtered_area: f32,
     /// Largest measured TV between the filtered mixture and the exact element sum at the
-    /// footprint's level ([`PositionNormalParams::DEFAULT_FILTERED_TOLERANCE`]; measured per map on
-    /// first use,
+    /// footprint's level ([`PositionNormalParams::DEFAULT_FILTERED_TOLERANCE`]; measured per map by
+    /// the build,
     /// [`PositionNormalMap::filtered_mixture_errors`](super::PositionNormalMap::filtered_mixture_errors))
     /// at which the filtered mixture
     /// serves a footprint of at least `filtered_area`; above it the elements are summed (under

@@ -5,7 +5,8 @@
 //!
 //! - bins.rs: [`HemisphereBins`], an equal-area binning of the hemisphere.
 //! - normal_map.rs: [`NormalMap`], the tiled grid of per-texel slopes and the interpolated surface.
-//! - moments.rs: the mip chain of slope moments behind [`NormalMap::moments`] and friends.
+//! - moments.rs: [`SlopeMomentPyramid`], the mip chain of slope moments of a map
+//!   ([`NormalMap::moment_pyramid`]), and the crate's chain the bin map keeps.
 //! - procedural.rs: the seeded generators [`scratched`], [`brushed`], [`bumpy`], [`flakes`].
 //! - pixels.rs: decoding normal maps from 8-bit, 16-bit or float pixel slices (always available).
 //! - image_io.rs: decoding PNG / EXR normal-map files into those pixels (feature `image`).
@@ -28,6 +29,7 @@ mod ray_differential;
 
 pub use bins::HemisphereBins;
 pub use footprint::{Footprint, MAX_ANISOTROPY, MAX_EXTENT_PERIODS, MIN_WIDTH_TEXELS};
+pub use moments::SlopeMomentPyramid;
 pub(crate) use moments::{MomentLevel, MomentPyramid};
 pub(crate) use normal_map::texel_count;
 pub use normal_map::{

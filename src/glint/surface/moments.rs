@@ -1,8 +1,7 @@
-//! The mip chain of slope moments of a normal map (mean slope and second moments per texel).
-//!
-//! Private: exposed through [`NormalMap::moments`](super::NormalMap::moments),
-//! [`NormalMap::filtered_moments`](super::NormalMap::filtered_moments) and friends, where the
-//! definitions are documented.
+//! The mip chain of slope moments of a normal map (mean slope and second moments per texel): the
+//! public [`SlopeMomentPyramid`], built by [`NormalMap::moment_pyramid`](super::NormalMap::moment_pyramid),
+//! where the definitions are documented, and the crate's chain behind it, which the bin map also keeps
+//! (coarse levels only) and stores.
 
 use glam::Vec2;
 use rayon::prelude::*;
@@ -19,7 +18,7 @@ pub(crate) struct MomentLevel {
 #[derive(Clone, Debug)]
 pub(crate) struct MomentPyramid {
     levels: Vec<MomentLevel>,
-    /// Index of `levels[0]` in the full chain (0 unless built by [`MomentPyramid::coarse_from`]).
+    /// Index of `levels[0]` in the full chain (0 unless built by [`MomentPyramid::build_from`]).
     first: usize,
 }
 
@@ -58,31 +57,35 @@ impl MomentPyramid {
 
     /// Builds the chain from the map's slopes (parallel over rows, deterministic).
     pub fn build(width: usize, height: usize, slopes: &[Vec2]) -> MomentPyramid {
+        Self::build_from(width, height, slopes, 0)
+    }
+
+    /// Builds levels `first..` of the chain (`first` clamped to the last level), for models that keep
+    /// coarse moments only; their lookups use level `first` for every finer level of detail. Each
+    /// level is reduced from the one below it, so the finer levels are computed too (the values are
+    /// those of [`MomentPyramid::build`], bit for bit), but each is dropped once the next is made.
+    pub fn build_from(width: usize, height: usize, slopes: &[Vec2], first: usize) -> MomentPyramid {
+        let sizes = Self::level_sizes(width, height);
+        let first = first.min(sizes.len() - 1);
         let base: Vec<[f32; 5]> = slopes
             .par_iter()
             .map(|s| [s.x, s.y, s.x * s.x, s.y * s.y, s.x * s.y])
             .collect();
-        let mut levels = vec![MomentLevel {
+        let mut current = MomentLevel {
             width,
             height,
             data: base,
-        }];
-        for &(w, h) in &Self::level_sizes(width, height)[1..] {
-            let prev = levels.last().expect("level 0 exists");
-            let next = downsample(prev, w, h);
-            levels.push(next);
+        };
+        let mut levels = Vec::with_capacity(sizes.len() - first);
+        for (l, &(w, h)) in sizes.iter().enumerate().skip(1) {
+            let next = downsample(&current, w, h);
+            let done = std::mem::replace(&mut current, next);
+            if l > first {
+                levels.push(done);
+            }
         }
-        MomentPyramid { levels, first: 0 }
-    }
-
-    /// A copy holding only levels `first..` of this chain (for models that keep coarse moments
-    /// only); its lookups use level `first` for every finer level of detail.
-    pub fn coarse_from(&self, first: usize) -> MomentPyramid {
-        let first = first.min(self.levels.len() - 1);
-        MomentPyramid {
-            levels: self.levels[first..].to_vec(),
-            first: self.first + first,
-        }
+        levels.push(current);
+        MomentPyramid { levels, first }
     }
 
     /// The chain of stored parts (crate-private, for the bin map's loader): `levels` are levels
@@ -106,7 +109,7 @@ impl MomentPyramid {
         self.levels.get(l)
     }
 
-    /// Trilinear lookup (see `NormalMap::filtered_moments` for the definition).
+    /// Trilinear lookup (see [`SlopeMomentPyramid::filtered`] for the definition).
     pub fn filtered(&self, width: usize, height: usize, center: Vec2, radius: f32) -> [f32; 5] {
         let center = Vec2::select(center.is_finite_mask(), center, Vec2::ZERO);
         let first = self.first as f32;
@@ -150,6 +153,90 @@ impl MomentPyramid {
             (at(bx + 1.0, by + 1.0), fx * fy),
         ];
         std::array::from_fn(|k| c.iter().map(|(m, w)| m[k] as f64 * w).sum())
+    }
+}
+
+/// The slope-moment mip chain of a normal map, level 0 (the map) to the 1 × 1 level: per texel
+/// `[E\[x̃\], E\[ỹ\], E\[x̃²\], E\[ỹ²\], E\[x̃ỹ\]]`.
+///
+/// A plain value, built by [`NormalMap::moment_pyramid`](super::NormalMap::moment_pyramid) (O(texels),
+/// parallel) and owned by the caller; it holds no reference to the map. Level 0 holds each texel's
+/// own slope and its products (x̃, ỹ, x̃², ỹ², x̃ỹ): the texel's slope is taken as constant over the
+/// texel. Level l + 1 has size (max(1, ⌊w/2⌋), max(1, ⌊h/2⌋)) and each of its texels is the
+/// area-weighted average of the level-l texels its rectangle of the uv square overlaps: for even
+/// sizes exactly the 2 × 2 box; an odd size spreads 3 texels over the new texels with fractional
+/// weights (still a convex combination, so E\[x̃²\] ≥ E\[x̃\]² is preserved). Averages are
+/// accumulated in f64 and stored in f32. Level sizes: [`NormalMap::level_size`](super::NormalMap::level_size).
+///
+/// # Reference
+/// \[Dupuy2013\] (LEAN/LEADR-style moment mipmaps); \[Chermain2019\] §4.2.2 (mipmapped moments for the
+/// approximate masking).
+#[derive(Clone)]
+pub struct SlopeMomentPyramid {
+    /// Level-0 size (the map's), the unit of [`SlopeMomentPyramid::filtered`]'s arguments.
+    width: usize,
+    height: usize,
+    /// The full chain (`first` = 0).
+    chain: MomentPyramid,
+}
+
+impl std::fmt::Debug for SlopeMomentPyramid {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SlopeMomentPyramid")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("levels", &self.levels())
+            .finish_non_exhaustive()
+    }
+}
+
+impl SlopeMomentPyramid {
+    /// The whole chain of a `width × height` map's slopes (the caller passes a valid map).
+    pub(crate) fn build(width: usize, height: usize, slopes: &[Vec2]) -> SlopeMomentPyramid {
+        SlopeMomentPyramid {
+            width,
+            height,
+            chain: MomentPyramid::build(width, height, slopes),
+        }
+    }
+
+    /// Number of levels (level 0 = the map, the last level is 1 × 1); the same as
+    /// [`NormalMap::levels`](super::NormalMap::levels).
+    pub fn levels(&self) -> usize {
+        self.chain.levels.len()
+    }
+
+    /// The slope moments of every texel of mip level `level` (row major), `None` beyond the last level:
+    /// `[E\[x̃\], E\[ỹ\], E\[x̃²\], E\[ỹ²\], E\[x̃ỹ\]]`. The levels are defined in the
+    /// [type's docs](SlopeMomentPyramid).
+    ///
+    /// # Reference
+    /// \[Dupuy2013\] (LEAN/LEADR-style moment mipmaps); \[Chermain2019\] §4.2.2 (mipmapped moments for the
+    /// approximate masking).
+    pub fn level(&self, level: usize) -> Option<&[[f32; 5]]> {
+        self.chain.level(level).map(|l| l.data.as_slice())
+    }
+
+    /// Trilinearly filtered slope moments around a texel position.
+    ///
+    /// `center_texel` is in level-0 texel units (any real value: the map tiles); `radius_texels` is the
+    /// half-width of the region to average, in level-0 texels. The level of detail is
+    /// λ = clamp(log₂(2 · radius), 0, levels − 1) (a region 2^l texels wide matches level l, whose texels
+    /// are 2^l level-0 texels wide for power-of-two sizes). Within a level the moments are interpolated
+    /// bilinearly between texel centres with wrapping (same convention as the normals: level texel
+    /// (i, j) has its centre at (i + ½, j + ½) level texels); between the levels ⌊λ⌋ and ⌈λ⌉ linearly.
+    ///
+    /// The result is a convex combination of level-0 texel moments, so it is a valid set of moments
+    /// (variances E\[x̃²\] − E\[x̃\]² ≥ 0 up to rounding). NaN or non-positive radii select level 0, +∞ the
+    /// 1 × 1 level;
+    /// a non-finite centre is replaced by 0. See [`moments_mean_covariance`](super::moments_mean_covariance)
+    /// to turn the result into a mean slope and a covariance.
+    ///
+    /// # Reference
+    /// \[Chermain2019\] §4.2.2; \[Dupuy2013\] §4.
+    pub fn filtered(&self, center_texel: Vec2, radius_texels: f32) -> [f32; 5] {
+        self.chain
+            .filtered(self.width, self.height, center_texel, radius_texels)
     }
 }
 

@@ -8,10 +8,9 @@
 
 use crate::frame::{normal_to_slope, normalize_robust, slope_to_normal};
 use crate::glint::io::format::{self, Kind};
-use crate::glint::surface::MomentPyramid;
+use crate::glint::surface::{MomentPyramid, SlopeMomentPyramid};
 use crate::{Error, Result};
 use glam::{Vec2, Vec3};
-use std::sync::OnceLock;
 
 /// The largest slope magnitude a map may hold: |ñ| ≤ 10⁴, i.e. normals at least 10⁻⁴ above the horizon
 /// (z ≥ 10⁻⁴, 89.994°). Larger slopes lose all precision in f32 sums of slope moments (x̃² ~ 10⁸ would
@@ -62,15 +61,14 @@ pub enum NormalRepair {
 
 /// A tiled normal map: per-texel slopes (f32) of a bilinearly interpolated surface.
 ///
-/// See the [`glint` module docs](crate::glint) for the texel, uv and tangent-frame conventions. Cloning copies the
-/// slopes; the slope-moment pyramid (built on first use by [`NormalMap::moments`] and friends) is
-/// cloned if it was already built.
+/// See the [`glint` module docs](crate::glint) for the texel, uv and tangent-frame conventions. A map
+/// holds its size and slopes only (cloning copies the slopes); its slope-moment mip chain is a value
+/// of its own, built by [`NormalMap::moment_pyramid`].
 #[derive(Clone)]
 pub struct NormalMap {
     width: usize,
     height: usize,
     slopes: Vec<Vec2>,
-    pyramid: OnceLock<MomentPyramid>,
 }
 
 impl std::fmt::Debug for NormalMap {
@@ -78,7 +76,6 @@ impl std::fmt::Debug for NormalMap {
         f.debug_struct("NormalMap")
             .field("width", &self.width)
             .field("height", &self.height)
-            .field("pyramid_built", &self.pyramid.get().is_some())
             .finish_non_exhaustive()
     }
 }
@@ -216,7 +213,6 @@ impl NormalMap {
             width,
             height,
             slopes,
-            pyramid: OnceLock::new(),
         })
     }
 
@@ -412,10 +408,20 @@ impl NormalMap {
         out
     }
 
-    /// The slope-moment pyramid, built on first use.
-    pub(crate) fn pyramid(&self) -> &MomentPyramid {
-        self.pyramid
-            .get_or_init(|| MomentPyramid::build(self.width, self.height, &self.slopes))
+    /// The slope-moment mip chain of the map, built now: O(texels), parallel over rows, owned by the
+    /// caller (the map keeps no copy). Its levels and its trilinear lookup
+    /// ([`SlopeMomentPyramid::filtered`]) are defined in [`SlopeMomentPyramid`]'s docs.
+    ///
+    /// Cost: O(texels) time and 20 bytes per texel per level, 26.7 per map texel in all (4/3 × 20:
+    /// 28 MB at 1024², 447 MB at 4096²); 10-14 ms at 1024² and 0.29-0.31 s at 4096² on 2 cores (median
+    /// of 5 builds, load 2.4-2.9; `glint_normal_map::moment_pyramid_cost` in tests/it, docs/glint.md).
+    /// Build it once and share it between the threads that read it.
+    ///
+    /// # Reference
+    /// \[Dupuy2013\] (LEAN/LEADR-style moment mipmaps); \[Chermain2019\] §4.2.2 (mipmapped moments for the
+    /// approximate masking).
+    pub fn moment_pyramid(&self) -> SlopeMomentPyramid {
+        SlopeMomentPyramid::build(self.width, self.height, &self.slopes)
     }
 
     /// Number of levels of the slope-moment mip chain (level 0 = the map, the last level is 1 × 1).
@@ -431,52 +437,11 @@ impl NormalMap {
             .get(level)
             .copied()
     }
-
-    /// The slope moments of every texel of mip level `level` (row major), `None` beyond the last level:
-    /// `[E\[x̃\], E\[ỹ\], E\[x̃²\], E\[ỹ²\], E\[x̃ỹ\]]`.
-    ///
-    /// Level 0 holds each texel's own slope and its products (x̃, ỹ, x̃², ỹ², x̃ỹ): the texel's slope is
-    /// taken as constant over the texel. Level l + 1 has size (max(1, ⌊w/2⌋), max(1, ⌊h/2⌋)) and each of
-    /// its texels is the area-weighted average of the level-l texels its rectangle of the uv square
-    /// overlaps: for even sizes exactly the 2 × 2 box; an odd size spreads 3 texels over the new texels
-    /// with fractional weights (still a convex combination, so E\[x̃²\] ≥ E\[x̃\]² is preserved).
-    /// Averages are accumulated in f64 and stored in f32.
-    ///
-    /// The first call builds the whole pyramid (O(texels), parallel); later calls are free.
-    ///
-    /// # Reference
-    /// \[Dupuy2013\] (LEAN/LEADR-style moment mipmaps); \[Chermain2019\] §4.2.2 (mipmapped moments for the
-    /// approximate masking).
-    pub fn moments(&self, level: usize) -> Option<&[[f32; 5]]> {
-        self.pyramid().level(level).map(|l| l.data.as_slice())
-    }
-
-    /// Trilinearly filtered slope moments around a texel position.
-    ///
-    /// `center_texel` is in level-0 texel units (any real value: the map tiles); `radius_texels` is the
-    /// half-width of the region to average, in level-0 texels. The level of detail is
-    /// λ = clamp(log₂(2 · radius), 0, levels − 1) (a region 2^l texels wide matches level l, whose texels
-    /// are 2^l level-0 texels wide for power-of-two sizes). Within a level the moments are interpolated
-    /// bilinearly between texel centres with wrapping (same convention as the normals: level texel
-    /// (i, j) has its centre at (i + ½, j + ½) level texels); between the levels ⌊λ⌋ and ⌈λ⌉ linearly.
-    ///
-    /// The result is a convex combination of level-0 texel moments, so it is a valid set of moments
-    /// (variances E\[x̃²\] − E\[x̃\]² ≥ 0 up to rounding). NaN or non-positive radii select level 0, +∞ the
-    /// 1 × 1 level;
-    /// a non-finite centre is replaced by 0. See [`moments_mean_covariance`] to turn the result into a
-    /// mean slope and a covariance.
-    ///
-    /// # Reference
-    /// \[Chermain2019\] §4.2.2; \[Dupuy2013\] §4.
-    pub fn filtered_moments(&self, center_texel: Vec2, radius_texels: f32) -> [f32; 5] {
-        self.pyramid()
-            .filtered(self.width, self.height, center_texel, radius_texels)
-    }
 }
 
 impl NormalMap {
     /// Writes the map in the crate's binary format (docs/format.md): its size and its slopes, exactly
-    /// (f32 bits). The moment pyramid is not stored (it is rebuilt on first use).
+    /// (f32 bits). The moment pyramid is not stored ([`NormalMap::moment_pyramid`] builds it).
     ///
     /// This is not an image: [`NormalMap::to_rgb8`] exports a picture. Wrap files in a
     /// `std::io::BufWriter` or not: the writer already writes in 64 KiB blocks.
