@@ -1,4 +1,5 @@
-//! Cost of the glint base layer: building each procedural map at 2048², the reference P-NDF of a
+//! Cost of the glint base layer: building each procedural map at 2048², a map's slope-moment mip
+//! chain at 1024² and 4096², the reference P-NDF of a
 //! 256-texel footprint on 64² bins, and the per-call cost of the interpolated normal lookup.
 //!
 //! Inputs (maps) are generated before timing. The reference uses short settings (2.5·10⁵ positions)
@@ -31,6 +32,16 @@ fn build(c: &mut Criterion) {
     g.bench_function("flakes", |b| {
         b.iter(|| flakes(SIZE, SIZE, FlakesParams::default(), black_box(1)).unwrap())
     });
+    g.finish();
+    // The slope-moment mip chain of a map, built explicitly (`NormalMap::moment_pyramid`).
+    let mut g = c.benchmark_group("moment_pyramid");
+    for n in [1024, 4096] {
+        let map = bumpy(n, n, 0.25, 4.0, 1).unwrap();
+        g.throughput(Throughput::Elements((n * n) as u64));
+        g.bench_with_input(BenchmarkId::from_parameter(n), &map, |b, map| {
+            b.iter(|| black_box(map).moment_pyramid())
+        });
+    }
     g.finish();
 }
 

@@ -527,30 +527,3 @@ fn moment_pyramid_is_a_convex_combination_on_odd_maps() {
         }
     }
 }
-
-/// The cost of building the pyramid (median of 5 builds at 1024² and 4096²), printed; no assertion.
-/// `cargo test --release --test it -- --ignored glint_normal_map::moment_pyramid_cost --nocapture`
-#[test]
-#[ignore = "timing; run by hand"]
-fn moment_pyramid_cost() {
-    for n in [1024usize, 4096] {
-        let map = random_map(n, n, 0.5, 7);
-        let mut times: Vec<f64> = (0..5)
-            .map(|_| {
-                let t = std::time::Instant::now();
-                let p = map.moment_pyramid();
-                let dt = t.elapsed().as_secs_f64();
-                assert_eq!(p.levels(), map.levels());
-                dt
-            })
-            .collect();
-        times.sort_by(f64::total_cmp);
-        eprintln!(
-            "moment_pyramid {n}²: median {:.1} ms (min {:.1}, max {:.1}), {:.2} ns per texel",
-            times[2] * 1e3,
-            times[0] * 1e3,
-            times[4] * 1e3,
-            times[2] * 1e9 / (n * n) as f64
-        );
-    }
-}

@@ -413,8 +413,8 @@ impl NormalMap {
     /// ([`SlopeMomentPyramid::filtered`]) are defined in [`SlopeMomentPyramid`]'s docs.
     ///
     /// Cost: O(texels) time and 20 bytes per texel per level, 26.7 per map texel in all (4/3 × 20:
-    /// 28 MB at 1024², 447 MB at 4096²); 10-14 ms at 1024² and 0.29-0.31 s at 4096² on 2 cores (median
-    /// of 5 builds, load 2.4-2.9; `glint_normal_map::moment_pyramid_cost` in tests/it, docs/glint.md).
+    /// 28 MB at 1024², 447 MB at 4096²); 17.5 ms at 1024² and 0.30 s at 4096² on 2 cores (criterion,
+    /// `cargo bench -p brdf-benches --bench glint -- moment_pyramid`, docs/glint.md).
     /// Build it once and share it between the threads that read it.
     ///
     /// # Reference
