@@ -328,14 +328,28 @@ fn slot_weights<L: LevelView>(
     ];
     let (lx, ly) = (axes[0].len, axes[1].len);
     w.clear();
-    w.resize(lx * ly, 0.0);
     let (i0, i1) = axes[0].unwrapped_range(eff.c[0], half[0]);
     let (j0, j1) = axes[1].unwrapped_range(eff.c[1], half[1]);
+    if !axes[0].folded && !axes[1].folded {
+        // One unwrapped lobe per slot, rows in slot order: written once, nothing to sum.
+        for j in j0..=j1 {
+            w.extend(eff.row_weights(i0, j).take(lx));
+        }
+        return axes;
+    }
+    w.resize(lx * ly, 0.0);
     for j in j0..=j1 {
         let sy = axes[1].slot_of_unwrapped(j);
         let row = &mut w[sy * lx..(sy + 1) * lx];
-        for (i, wi) in (i0..=i1).zip(eff.row_weights(i0, j)) {
-            row[axes[0].slot_of_unwrapped(i)] += wi;
+        if axes[0].folded {
+            for (i, wi) in (i0..=i1).zip(eff.row_weights(i0, j)) {
+                row[axes[0].slot_of_unwrapped(i)] += wi;
+            }
+        } else {
+            // Unfolded: slot = i − i0, one unwrapped index per slot.
+            for (slot, wi) in row.iter_mut().zip(eff.row_weights(i0, j)) {
+                *slot += wi;
+            }
         }
     }
     axes
@@ -356,10 +370,18 @@ pub(super) fn lod_error_of<L: LevelView>(
     let lx = axes[0].len;
     let nx = lv.grid()[0];
     let (mut total, mut err) = (0.0f64, 0.0f64);
-    for (s, &wi) in w.iter().enumerate() {
-        let k = axes[1].lobe_of_slot(s / lx) * nx + axes[0].lobe_of_slot(s % lx);
-        total += wi;
-        err += wi * lv.error(k, res) as f64;
+    let (x_first, grid_x) = (axes[0].lobe_of_slot(0), axes[0].n);
+    for (sy, row) in w.chunks_exact(lx).enumerate() {
+        let row_lobe = axes[1].lobe_of_slot(sy) * nx;
+        let mut kx = x_first;
+        for &wi in row {
+            total += wi;
+            err += wi * lv.error(row_lobe + kx, res) as f64;
+            kx += 1;
+            if kx == grid_x {
+                kx = 0;
+            }
+        }
     }
     if total > 0.0 { err / total } else { 0.0 }
 }
@@ -488,11 +510,17 @@ fn block_weights(axes: &[AxisSlots; 2], bufs: &mut SlotBuffers) -> ([BlockRect; 
     for (r, &(x_off, y_off)) in rects[..n].iter().zip(&offs[..n]) {
         for y in r.y.0..r.y.1 {
             let sy = (y as i64 + y_off) as usize;
+            let src = &weights[sy * lx..(sy + 1) * lx];
             let row = r.offset + (y / SIDE - r.by0) * r.bw * LANES + (y % SIDE) * SIDE;
-            for x in r.x.0..r.x.1 {
+            // The row's lobes block by block: up to SIDE consecutive lanes per block.
+            let mut x = r.x.0;
+            while x < r.x.1 {
+                let bx = x / SIDE;
+                let end = ((bx + 1) * SIDE).min(r.x.1);
+                let o = row + (bx - r.bx0) * LANES + x % SIDE;
                 let sx = (x as i64 + x_off) as usize;
-                let o = row + (x / SIDE - r.bx0) * LANES + x % SIDE;
-                block_weights[o] = weights[sy * lx + sx];
+                block_weights[o..o + (end - x)].copy_from_slice(&src[sx..sx + (end - x)]);
+                x = end;
             }
         }
     }
