@@ -228,7 +228,9 @@ impl LevelView for FullLevel<'_> {
     #[inline]
     fn mean(&self, k: usize) -> [f64; 2] {
         let m = &self.data.moments[k];
-        if m.iter().all(|v| v.is_finite()) {
+        // The f64 sum of five f32 values is finite exactly when each is (it cannot overflow).
+        let sum: f64 = m.iter().map(|&v| v as f64).sum();
+        if sum.is_finite() {
             [m[0] as f64, m[1] as f64]
         } else {
             let mu = self.lobe(k).mean();
