@@ -323,6 +323,21 @@ impl SlopeGaussian {
         slope_to_normal_f64(self.mean.x as f64, self.mean.y as f64)
     }
 
+    /// [`SlopeGaussian::p22`] at the slope (`sx`, `sy`) in `f64` (0 for non-finite slopes): for sums
+    /// over many lobes at one slope, whose common Jacobian the caller applies once.
+    ///
+    /// # Reference
+    /// \[Chermain2019\] eq. 4.
+    #[cfg(feature = "std")]
+    #[inline]
+    pub(crate) fn p22_f64(&self, sx: f64, sy: f64) -> f64 {
+        let [i11, i21, i22] = self.inv_chol.map(f64::from);
+        let (dx, dy) = (sx - self.mean.x as f64, sy - self.mean.y as f64);
+        let (zx, zy) = (i11 * dx, i21 * dx + i22 * dy);
+        let p = i11 * i22 / (2.0 * PI) * (-0.5 * (zx * zx + zy * zy)).exp();
+        if p >= 0.0 { p } else { 0.0 }
+    }
+
     /// The slope density P22(ñ) = exp(−½ |L⁻¹(ñ − μ)|²) / (2π √|Σ|) (per unit slope area).
     ///
     /// `f32`: one 2×2 triangular product and one `exp`. Non-finite slopes give 0.

@@ -374,17 +374,26 @@ impl<'a> PositionNormalPatch<'a> {
         (acc, touched)
     }
 
-    /// Σ W_i D_i(m) over every kept element, in `f64`.
+    /// Σ W_i D_i(m) over every kept element, in `f64`: D_i(m) = P22_i(ñ) (1 + |ñ|²)² with
+    /// ñ = −m_xy/m_z, whose Jacobian is common to every element, so each element adds
+    /// W_i P22_i(ñ) (one exponential) and the sum is multiplied by the Jacobian once.
     fn untruncated_d(&self, m: Vec3) -> f64 {
         if self.few_serves() {
             return self.few.d(m) as f64;
         }
+        if !(m.z > 0.0 && m.is_finite()) {
+            return 0.0;
+        }
+        let (sx, sy) = (-m.x as f64 / m.z as f64, -m.y as f64 / m.z as f64);
         let s = self.slots();
-        s.weights
+        let sum: f64 = s
+            .weights
             .iter()
             .zip(&s.lobes)
-            .map(|(&w, lobe)| w * lobe.d(m) as f64)
-            .sum()
+            .map(|(&w, lobe)| w * lobe.p22_f64(sx, sy))
+            .sum();
+        let j = 1.0 + sx * sx + sy * sy;
+        sum * j * j
     }
 
     /// Σ W_i V_i(w) over every kept element (the exact visible area of the P-NDF), in `f64`; over
