@@ -127,7 +127,7 @@
 //! - **Memory** (docs/results.md, "Memory per model"): the mixture holds 99 B/texel at the
 //!   defaults (at 512²-2048²: lobes, lobe blocks, quadtree, the moment and filtered-mixture mip
 //!   chains, levels of detail), 15.4 B/texel with `LobeStorage::Compact` (1.4-1.8× the query time);
-//!   the bin map 29.2 B/texel at 2048², position-normal 65 (29.3 of elements and quadtree, 36 of
+//!   the bin map 29.2 B/texel at 2048², position-normal 41 (29.3 of elements and quadtree, 12 of
 //!   its filtered mixture's chain).
 //!
 //! <!-- which-model:begin -->
