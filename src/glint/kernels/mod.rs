@@ -15,6 +15,7 @@ pub(crate) mod cdf;
 pub(crate) mod cut;
 pub(crate) mod filtered_error;
 pub(crate) mod gmm;
+pub(crate) mod gmm_reduce;
 pub(crate) mod gmm_residual;
 pub(crate) mod gmm_store;
 pub(crate) mod lobe_set;

@@ -367,23 +367,37 @@ pub(super) fn lod_error_of<L: LevelView>(
 ) -> f64 {
     let w = &mut bufs.cdf;
     let axes = slot_weights(weight_sigmas, lv, eff, w);
-    let lx = axes[0].len;
     let nx = lv.grid()[0];
     let (mut total, mut err) = (0.0f64, 0.0f64);
+    for_each_slot_lobe(&axes, nx, w, |&mut wi, k| {
+        total += wi;
+        err += wi * lv.error(k, res) as f64;
+    });
+    if total > 0.0 { err / total } else { 0.0 }
+}
+
+/// Calls `f(slot, k)` for every slot of the rectangle `axes` (row major, `slots` holding one value
+/// per slot) with k its node's index on a level of `nx` nodes per row: row by row, the node index
+/// stepped along the row and wrapped at the grid's edge, so no slot divides its index out.
+#[inline(always)]
+fn for_each_slot_lobe<T>(
+    axes: &[AxisSlots; 2],
+    nx: usize,
+    slots: &mut [T],
+    mut f: impl FnMut(&mut T, usize),
+) {
     let (x_first, grid_x) = (axes[0].lobe_of_slot(0), axes[0].n);
-    for (sy, row) in w.chunks_exact(lx).enumerate() {
+    for (sy, row) in slots.chunks_exact_mut(axes[0].len).enumerate() {
         let row_lobe = axes[1].lobe_of_slot(sy) * nx;
         let mut kx = x_first;
-        for &wi in row {
-            total += wi;
-            err += wi * lv.error(row_lobe + kx, res) as f64;
+        for slot in row {
+            f(slot, row_lobe + kx);
             kx += 1;
             if kx == grid_x {
                 kx = 0;
             }
         }
     }
-    if total > 0.0 { err / total } else { 0.0 }
 }
 
 /// The normalised weights of the level's nodes over the footprint (`eff`), their cdf and block
@@ -402,7 +416,6 @@ pub(super) fn gather<'b, L: LevelView>(
     let SlotBuffers { weights, cdf, .. } = &mut *bufs;
     weights.clear();
     let axes = slot_weights(weight_sigmas, lv, eff, cdf);
-    let lx = axes[0].len;
     let nx = lv.grid()[0];
     let w = cdf;
     let total: f64 = w.iter().sum();
@@ -415,41 +428,30 @@ pub(super) fn gather<'b, L: LevelView>(
     let mut m1 = [0.0f64; 2];
     let mut m2 = [0.0f64; 3];
     let mut lod_error = 0.0f64;
-    // Slots row by row, the lobe index stepped along the row (wrapping at the grid's edge) rather
-    // than divided out of the slot index per lobe; level 0 has no merge error (its term is 0).
+    // Level 0 has no merge error (its term is 0).
     let merged = lv.level() > 0;
-    let (x_first, grid_x) = (axes[0].lobe_of_slot(0), axes[0].n);
     weights.reserve(w.len());
-    for (sy, row) in w.chunks_exact_mut(lx).enumerate() {
-        let row_lobe = axes[1].lobe_of_slot(sy) * nx;
-        let mut kx = x_first;
-        for wi in row {
-            let wn = *wi * inv;
-            acc += wn;
-            *wi = acc;
-            let k = row_lobe + kx;
-            kx += 1;
-            if kx == grid_x {
-                kx = 0;
-            }
-            if merged {
-                lod_error += wn * lv.error(k, res) as f64;
-            }
-            if second_moments {
-                let (mu, cov) = lv.mean_cov(k);
-                m1[0] += wn * mu[0];
-                m1[1] += wn * mu[1];
-                m2[0] += wn * (cov[0] + mu[0] * mu[0]);
-                m2[1] += wn * (cov[1] + mu[0] * mu[1]);
-                m2[2] += wn * (cov[2] + mu[1] * mu[1]);
-            } else {
-                let mu = lv.mean(k);
-                m1[0] += wn * mu[0];
-                m1[1] += wn * mu[1];
-            }
-            weights.push(wn as f32);
+    for_each_slot_lobe(&axes, nx, w, |wi, k| {
+        let wn = *wi * inv;
+        acc += wn;
+        *wi = acc;
+        if merged {
+            lod_error += wn * lv.error(k, res) as f64;
         }
-    }
+        if second_moments {
+            let (mu, cov) = lv.mean_cov(k);
+            m1[0] += wn * mu[0];
+            m1[1] += wn * mu[1];
+            m2[0] += wn * (cov[0] + mu[0] * mu[0]);
+            m2[1] += wn * (cov[1] + mu[0] * mu[1]);
+            m2[2] += wn * (cov[2] + mu[1] * mu[1]);
+        } else {
+            let mu = lv.mean(k);
+            m1[0] += wn * mu[0];
+            m1[1] += wn * mu[1];
+        }
+        weights.push(wn as f32);
+    });
     let (rects, n_rects) = block_weights(&axes, &mut bufs);
     // Σ W = 1 up to rounding; the covariance is floored at 0 against cancellation.
     let slope_cov = if second_moments {
