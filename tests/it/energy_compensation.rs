@@ -616,8 +616,9 @@ fn glint_patch_furnace_is_measured() {
         MicrofacetBrdf::new(Beckmann::isotropic(0.25 * 2f32.sqrt()).unwrap(), NoFresnel);
     for t in [0.0, 45.0, 70.0, 85.0] {
         let wo = dir(t, 0.0);
-        let (e, se) = furnace_by_weight(&brdf, wo, 200_000, 23);
-        let (eq, _) = furnace_by_weight(&equivalent, wo, 200_000, 23);
+        let n = crate::support::depth(50_000, 200_000);
+        let (e, se) = furnace_by_weight(&brdf, wo, n, 23);
+        let (eq, _) = furnace_by_weight(&equivalent, wo, n, 23);
         eprintln!(
             "glint patch θo={t}: E = {e:.4} ± {se:.1e} (equivalent Beckmann α=0.354: {eq:.4})"
         );

@@ -160,14 +160,14 @@ fn chi_square_of_the_layered_sampler() {
             format!("layered ggx θo={theta}"),
             &ggx,
             support::dir(theta, 30.0),
-            1_000_000,
+            support::depth(250_000, 1_000_000),
         ));
     }
     cases.push((
         "layered iso ggx θo=89".into(),
         &ggx_iso,
         support::dir(89.0, 30.0),
-        1_000_000,
+        support::depth(250_000, 1_000_000),
     ));
     for theta in [20.0, 70.0] {
         cases.push((

@@ -269,8 +269,10 @@ fn close_to_the_full_mixture_at(cases: &[(f32, u64)]) {
             let full = mix.patch_with(&fp, &PatchOptions::full(), None);
             let small = mix.patch_with(&fp, &cut_options(9), None);
             let big = mix.patch_with(&fp, &cut_options(64), None);
-            let (tv9, _) = support::density_distances(&full, &small, 4096, 7 + c);
-            let (tv64, l2) = support::density_distances(&full, &big, 4096, 7 + c);
+            // 4096 draws per distance, 2048 in the default run (support::depth).
+            let draws = support::depth(2048, 4096);
+            let (tv9, _) = support::density_distances(&full, &small, draws, 7 + c);
+            let (tv64, l2) = support::density_distances(&full, &big, draws, 7 + c);
             println!(
                 "{name} {area} centre {c}: tv 9 nodes {tv9:.3}, 64 nodes {tv64:.3} (l2 {l2:.3})"
             );

@@ -138,7 +138,7 @@ fn level_d_equals_the_brute_force_sum() {
 fn chi_square_and_furnace_at_a_merged_level() {
     let mix = BeckmannMixture::build(&noise(N, 4), MixtureParams::default()).unwrap();
     // The cost cap forces level 1 on a 16-texel footprint (16 / 4 nodes ≤ 8 < 16): few nodes, so the
-    // 10⁶-draw chi-square of the O(nodes) visible sampler stays cheap in the default debug build.
+    // chi-square of the O(nodes) visible sampler stays cheap.
     let patch = mix.patch_with(
         &footprint(16.0, Vec2::new(0.3, 0.3)),
         &PatchOptions {

@@ -30,7 +30,7 @@ fn chi_square_of_both_samplers() {
     let mut rng = support::rng(21);
     for theta in [0.0, 30.0, 60.0, 75.0] {
         let wo = support::dir(theta, 20.0);
-        for _ in 0..50_000 {
+        for _ in 0..support::depth(10_000, 50_000) {
             let u = Vec2::new(rng.random(), rng.random());
             let m = smooth_patch.sample_visible(wo, u);
             let p = smooth_patch.pdf_visible(wo, m);

@@ -124,11 +124,11 @@ fn check(name: &str, value: f64, err: f64, expected: f64, rel: f64) -> Option<St
         .then(|| format!("{name}: quadrature {value} ± {err}, expected {expected} (tol {tol:e})"))
 }
 
-/// The identities at normal incidence, 60° and 89°; [`hemisphere_identities_every_view`] adds 30°
-/// and 80° (`THETAS`).
+/// The identities at normal incidence, 60° and 89° (normal incidence and 89° in the default run,
+/// `support::depth`); [`hemisphere_identities_every_view`] adds 30° and 80° (`THETAS`).
 #[test]
 fn hemisphere_identities() {
-    hemisphere_identities_at(&[0.0, 60.0, 89.0]);
+    hemisphere_identities_at(support::depth(&[0.0, 89.0], &[0.0, 60.0, 89.0]));
 }
 
 /// `cargo test --release --test it -- --ignored ndf_centred_integrals::hemisphere_identities_every_view`

@@ -42,7 +42,7 @@ pub struct Chi2 {
     /// Cells along φ.
     pub res_phi: usize,
     /// Lower end of the gridded z range; `None` chooses it from a pilot run (the 0.05 % quantile of z
-    /// over 10⁵ draws with another seed, floored at 0), so that peaked lobes get cells of their own size.
+    /// over 10⁵ draws with another seed, 2·10⁴ in the default run, floored at 0), so that peaked lobes get cells of their own size.
     pub z_min: Option<f64>,
     /// Number of tests in the family (Šidák correction).
     pub family: usize,
@@ -61,8 +61,9 @@ impl Default for Chi2 {
     fn default() -> Self {
         Chi2 {
             name: "chi2".into(),
-            // 10⁶ draws: enough power to see a 1 % density error in a 10 %-mass region, ~1 s per test.
-            samples: 1_000_000,
+            // 10⁶ draws at full power: enough to see a 1 % density error in a 10 %-mass region, ~1 s
+            // per test. The default run draws 2·10⁵ (~60 per cell): a 2-3 % error in such a region.
+            samples: super::depth(200_000, 1_000_000),
             // 40 × 80 cells: ~310 draws per cell on average; fine enough for the lobes we test.
             res_z: 40,
             res_phi: 80,
@@ -158,7 +159,7 @@ impl Chi2 {
 
     fn pilot_z_min(&self, sample: &mut impl FnMut(f32, Vec2) -> Option<Vec3>) -> f64 {
         let mut rng = super::rng(self.seed ^ 0x9e37_79b9_7f4a_7c15);
-        let mut zs: Vec<f64> = (0..100_000)
+        let mut zs: Vec<f64> = (0..super::depth(20_000, 100_000))
             .filter_map(|_| {
                 let uc: f32 = rng.random();
                 sample(uc, Vec2::new(rng.random(), rng.random()))
