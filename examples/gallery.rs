@@ -5,7 +5,7 @@
 //! `index.html` that shows each with one line of explanation. By default the examples run as a small
 //! preview (fewer maps, scales, samples and pixels where a part would be slow; each blurb says what the
 //! preview leaves out) so that the whole gallery, release build included, stays within about three
-//! minutes of a fresh clone on 2 cores; `--full` runs them at full size.
+//! minutes of a fresh clone on an idle 2-core machine; `--full` runs them at full size.
 
 use brdf_examples::common;
 

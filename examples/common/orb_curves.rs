@@ -499,10 +499,10 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, setting: &str) -> R
         title.draw(&Text::new(
             format!(
                 "orb: denoised rel. RMSE vs (a) exact P-BRDF against time (s){}; naive dotted = vs (b)",
-                if setting == "full" {
-                    String::new()
-                } else {
-                    format!(", {setting}")
+                match setting {
+                    "full" => String::new(),
+                    "quick" => ", --quick".to_string(),
+                    other => format!(", {other}"),
                 }
             ),
             (6, 6),

@@ -45,8 +45,8 @@ impl Options {
             progress: false,
         }
     }
-    /// The gallery's preview: [`Options::quick`] at 240 × 150 and 6 spp (about a quarter of its
-    /// time; the sky and the ground are noisier, the glints are the same).
+    /// The gallery's preview: [`Options::quick`] at 240 × 150 and 6 spp (about a fifth of its time;
+    /// the sky and the ground are noisier, the glints the same).
     pub fn preview() -> Options {
         Options {
             width: 240,
