@@ -1,8 +1,9 @@
 //! Energy compensation charts: the white furnace before / after against α and θo, and rough gold
 //! spheres uncompensated against compensated; see `common::energy`.
 //!
-//! `cargo run --release --example energy -- [--out DIR]` (every value by deterministic quadrature;
-//! `--quick` is accepted and changes nothing).
+//! `cargo run --release --example energy -- [--out DIR] [--quick]` (every value by deterministic
+//! quadrature; `--quick`, the gallery's preview, computes every other α, every other θo and a quarter
+//! of the spheres' μ values).
 
 use brdf_examples::common;
 

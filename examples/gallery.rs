@@ -2,9 +2,10 @@
 //!
 //! `cargo run --release --example gallery [-- --out DIR] [--full]`
 //! writes the charts and images of every example into DIR (default `target/brdf-out/`) and an
-//! `index.html` that shows each with one line of explanation. By default the examples run in their
-//! quick settings so that the whole gallery stays within a few minutes on 2 cores; `--full` runs them
-//! at full size.
+//! `index.html` that shows each with one line of explanation. By default the examples run as a small
+//! preview (fewer maps, scales, samples and pixels where a part would be slow; each blurb says what the
+//! preview leaves out) so that the whole gallery, release build included, stays within about three
+//! minutes of a fresh clone on an idle 2-core machine; `--full` runs them at full size.
 
 use brdf_examples::common;
 
@@ -34,7 +35,8 @@ fn main() -> Res<()> {
             "Energy compensation",
             "The white furnace of the microfacet BRDF before and after Kulla-Conty compensation \
              against α and θo, and rough gold spheres uncompensated against compensated (the \
-             energy example).",
+             energy example; preview: 13 values of α, θo every 4°, the spheres from 33 values of \
+             μ, where --full computes 25, every 2° and 129).",
             common::energy::run,
         ),
         (
@@ -58,24 +60,43 @@ fn main() -> Res<()> {
         ),
         (
             "Orb: error against time",
-            "Naive sampling at 1…1024 spp against each glint model at 1, 4 and 16 evaluations per \
-             pixel, on the four procedural maps and a fractal height field at two map scales, with \
-             equal-error speedups (the orb example's --curves --quick, also under --full: the full \
-             sweep, 1 to 139,898 texels per pixel, takes ~16 min of a quiet 2-core machine, run it \
-             as `orb -- --curves`; its results are in docs/results.md).",
-            |out, _quick| common::orb_curves::run(out, true),
+            "Naive sampling against each glint model at 1, 4 and 16 evaluations per pixel, with \
+             equal-error speedups. Preview (the default): the scratched and flakes maps at one map \
+             scale (~34 texels per pixel), naive 1…256 spp, reference 2 × 576 spp. Under --full: \
+             the orb example's --curves --quick, the four procedural maps and a fractal height \
+             field at two map scales, naive 1…1024 spp. The full sweep, 1 to 139,898 texels per \
+             pixel, takes ~16 min of a quiet 2-core machine: run it as `orb -- --curves`; its \
+             results are in docs/results.md.",
+            |out, quick| {
+                if quick {
+                    common::orb_curves::run_preview(out)
+                } else {
+                    common::orb_curves::run(out, true)
+                }
+            },
         ),
         (
             "Accuracy against speed",
             "Every glint method on the four procedural maps: distance to the ground truth against \
-             cost, footprint size and view angle, and the white furnace (the compare example).",
-            common::compare::run,
+             cost, footprint size and view angle, and the white furnace (the compare example). \
+             Preview (the default): 256² maps, 2.5·10⁵ ground-truth positions per footprint, \
+             footprints of 0.25 to 256 texels on 63² bins only, a coarser per-bin quadrature (TV \
+             good to ~0.01) and 256 furnace samples; `compare -- --quick` is the larger quick run, \
+             --full runs the full comparison.",
+            |out, quick| {
+                if quick {
+                    common::compare::run_with(out, &common::compare::Settings::preview())
+                } else {
+                    common::compare::run(out, false)
+                }
+            },
         ),
         (
             "Grazing angles",
             "Where masking and sampling break down as the view approaches the horizon: visible-area \
              error, white furnace and the spread of the sample weight of every NDF and glint method \
-             (the grazing example).",
+             (the grazing example; preview: 2¹⁰ furnace and 2¹² V_ref samples per point, a quarter \
+             of the example's, noise floors twice as high).",
             common::grazing::run,
         ),
         (
@@ -91,7 +112,8 @@ fn main() -> Res<()> {
              procedural scratched map and a PNG normal map the example writes first), a glint \
              coat over red paint and car paint (procedural aluminium flakes over dark blue paint, no \
              normal map, under a smooth clear coat), every material a `brdf::Material`, through the \
-             public API only (the render example, quick setting).",
+             public API only (the render example; preview: 240 × 150 at 6 spp, where `render -- \
+             --quick` renders 320 × 200 at 12 spp).",
             common::render::showcase::run,
         ),
     ];

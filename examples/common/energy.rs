@@ -12,62 +12,79 @@ use brdf::Vec3;
 use brdf::bxdf::{Bxdf, EnergyCompensated, MicrofacetBrdf};
 use brdf::fresnel::{ConductorFresnel, NoFresnel};
 use brdf::ndf::{Beckmann, Ggx};
+use rayon::prelude::*;
 use std::path::Path;
-
-/// The white furnace (channel 0) of `b` at `wo` and its quadrature error estimate, the largest so
-/// far kept in `worst`.
-fn furnace(b: &dyn Bxdf, wo: Vec3, alpha: f32, worst: &mut f64) -> f64 {
-    let (e, err) = quadrature::furnace(b, wo, alpha as f64);
-    *worst = worst.max(err);
-    e[0]
-}
 
 fn dir(theta_deg: f64) -> Vec3 {
     let t = theta_deg.to_radians();
     Vec3::new(t.sin() as f32, 0.0, t.cos() as f32)
 }
 
-/// The white furnace of GGX and Beckmann before and after compensation, at `alpha`, view `wo`.
-fn white_pair(family: &str, alpha: f32, wo: Vec3, worst: &mut f64) -> Res<(f64, f64)> {
+/// A BRDF that the furnace points share between threads.
+type SharedBxdf = Box<dyn Bxdf + Sync>;
+
+/// GGX or Beckmann at `alpha` with F = 1: single scattering and compensated.
+fn white_pair(family: &str, alpha: f32) -> Res<[SharedBxdf; 2]> {
     Ok(match family {
         "GGX" => {
             let ss = MicrofacetBrdf::new(Ggx::isotropic(alpha)?, NoFresnel);
-            let ms = EnergyCompensated::new(ss)?;
-            (
-                furnace(&ss, wo, alpha, worst),
-                furnace(&ms, wo, alpha, worst),
-            )
+            [Box::new(ss), Box::new(EnergyCompensated::new(ss)?)]
         }
         _ => {
             let ss = MicrofacetBrdf::new(Beckmann::isotropic(alpha)?, NoFresnel);
-            let ms = EnergyCompensated::new(ss)?;
-            (
-                furnace(&ss, wo, alpha, worst),
-                furnace(&ms, wo, alpha, worst),
-            )
+            [Box::new(ss), Box::new(EnergyCompensated::new(ss)?)]
         }
     })
 }
 
-/// Furnace against α (log axis) at θo = 0°, 60°, 85°, before and after, both families.
-fn furnace_against_alpha(out: &Path) -> Res<Artifact> {
-    let alphas: Vec<f32> = (0..=24)
-        .map(|k| 0.01 * 100f32.powf(k as f32 / 24.0))
+/// The white furnace (channel 0) of each pair (single scattering, compensated) at its view θo
+/// (degrees) and roughness α, and the largest quadrature error estimate of all. The points run in
+/// parallel; each is the deterministic quadrature, so the values do not depend on the threads.
+fn furnaces(points: &[([SharedBxdf; 2], f64, f32)]) -> (Vec<(f64, f64)>, f64) {
+    let values: Vec<((f64, f64), f64)> = points
+        .par_iter()
+        .map(|(pair, theta, alpha)| {
+            let [(b, eb), (c, ec)] = pair
+                .each_ref()
+                .map(|bxdf| quadrature::furnace(bxdf.as_ref(), dir(*theta), *alpha as f64));
+            ((b[0], c[0]), eb.max(ec))
+        })
         .collect();
-    let mut series = Vec::new();
-    let mut worst = 0.0f64;
-    for family in ["GGX", "Beckmann"] {
-        for theta in [0.0, 60.0, 85.0] {
-            let mut before = Vec::new();
-            let mut after = Vec::new();
-            for &a in &alphas {
-                let (b, c) = white_pair(family, a, dir(theta), &mut worst)?;
-                before.push((a as f64, b));
-                after.push((a as f64, c));
-            }
-            series.push(Series::new(format!("{family} {theta}° single"), before));
-            series.push(Series::new(format!("{family} {theta}° compensated"), after));
+    let worst = values.iter().map(|v| v.1).fold(0.0, f64::max);
+    (values.into_iter().map(|v| v.0).collect(), worst)
+}
+
+/// Furnace against α (log axis, `n` + 1 values from 0.01 to 1) at θo = 0°, 60°, 85°, before and
+/// after, both families.
+fn furnace_against_alpha(out: &Path, n: usize) -> Res<Artifact> {
+    let alphas: Vec<f32> = (0..=n)
+        .map(|k| 0.01 * 100f32.powf(k as f32 / n as f32))
+        .collect();
+    let curves: Vec<(&str, f64)> = ["GGX", "Beckmann"]
+        .into_iter()
+        .flat_map(|family| [0.0, 60.0, 85.0].map(|theta| (family, theta)))
+        .collect();
+    let mut points = Vec::new();
+    for &(family, theta) in &curves {
+        for &a in &alphas {
+            points.push((white_pair(family, a)?, theta, a));
         }
+    }
+    let (values, worst) = furnaces(&points);
+    let mut series = Vec::new();
+    for (&(family, theta), e) in curves.iter().zip(values.chunks(alphas.len())) {
+        let before = alphas
+            .iter()
+            .zip(e)
+            .map(|(&a, v)| (a as f64, v.0))
+            .collect();
+        let after = alphas
+            .iter()
+            .zip(e)
+            .map(|(&a, v)| (a as f64, v.1))
+            .collect();
+        series.push(Series::new(format!("{family} {theta}° single"), before));
+        series.push(Series::new(format!("{family} {theta}° compensated"), after));
     }
     // The charted values, for reading off (series label, α, E).
     let mut csv = String::from("series,alpha,furnace\n");
@@ -100,22 +117,24 @@ fn furnace_against_alpha(out: &Path) -> Res<Artifact> {
     ))
 }
 
-/// Furnace against θo at α = 0.25, 0.5, 1 (GGX), before and after.
-fn furnace_against_theta(out: &Path) -> Res<Artifact> {
-    let thetas: Vec<f64> = (0..=45)
-        .map(|k| 2.0 * k as f64)
-        .filter(|t| *t < 90.0)
+/// Furnace against θo (every `step` degrees below 90°) at α = 0.25, 0.5, 1 (GGX), before and after.
+fn furnace_against_theta(out: &Path, step: f64) -> Res<Artifact> {
+    let thetas: Vec<f64> = (0..)
+        .map(|k| step * k as f64)
+        .take_while(|t| *t < 90.0)
         .collect();
-    let mut series = Vec::new();
-    let mut worst = 0.0f64;
-    for alpha in [0.25f32, 0.5, 1.0] {
-        let mut before = Vec::new();
-        let mut after = Vec::new();
+    let alphas = [0.25f32, 0.5, 1.0];
+    let mut points = Vec::new();
+    for alpha in alphas {
         for &t in &thetas {
-            let (b, c) = white_pair("GGX", alpha, dir(t), &mut worst)?;
-            before.push((t, b));
-            after.push((t, c));
+            points.push((white_pair("GGX", alpha)?, t, alpha));
         }
+    }
+    let (values, worst) = furnaces(&points);
+    let mut series = Vec::new();
+    for (alpha, e) in alphas.iter().zip(values.chunks(thetas.len())) {
+        let before = thetas.iter().zip(e).map(|(&t, v)| (t, v.0)).collect();
+        let after = thetas.iter().zip(e).map(|(&t, v)| (t, v.1)).collect();
         series.push(Series::new(format!("GGX α={alpha} single"), before));
         series.push(Series::new(format!("GGX α={alpha} compensated"), after));
     }
@@ -150,13 +169,20 @@ fn srgb(v: f32) -> u8 {
 }
 
 /// The directional albedo (RGB) of a BRDF of roughness `alpha` on `steps` + 1 values of
-/// μ = cos θo in [0, 1], by quadrature; the largest error estimate so far kept in `worst`.
-fn albedo_curve(b: &dyn Bxdf, alpha: f32, steps: usize, worst: &mut f64) -> Vec<Vec3> {
-    (0..=steps)
+/// μ = cos θo in [0, 1], by quadrature (the values in parallel, each deterministic); the largest
+/// error estimate so far kept in `worst`.
+fn albedo_curve(b: &(dyn Bxdf + Sync), alpha: f32, steps: usize, worst: &mut f64) -> Vec<Vec3> {
+    let values: Vec<([f64; 3], f64)> = (0..=steps)
+        .into_par_iter()
         .map(|k| {
             let mu = (k as f32 / steps as f32).max(1e-3);
             let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
-            let (e, err) = quadrature::furnace(b, wo, alpha as f64);
+            quadrature::furnace(b, wo, alpha as f64)
+        })
+        .collect();
+    values
+        .into_iter()
+        .map(|(e, err)| {
             *worst = worst.max(err);
             Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32)
         })
@@ -166,13 +192,12 @@ fn albedo_curve(b: &dyn Bxdf, alpha: f32, steps: usize, worst: &mut f64) -> Vec<
 /// Rough gold spheres under a uniform white sky (radiance 1): a pixel's radiance is the directional
 /// albedo at its μ = n·v, so each sphere shows E(μ) from its centre (μ = 1) to its rim (μ → 0).
 /// Top row: single scattering; bottom row: compensated; α = 0.2, 0.4, 0.7, 1 from left to right.
-fn gold_spheres(out: &Path) -> Res<Artifact> {
+fn gold_spheres(out: &Path, steps: usize) -> Res<Artifact> {
     let alphas = [0.2f32, 0.4, 0.7, 1.0];
     let r = 80usize;
     let cell = 2 * r + 16;
     let (w, h) = (cell * alphas.len(), cell * 2);
     let mut rgb = vec![24u8; w * h * 3];
-    let steps = 128;
     let mut means = Vec::new();
     let mut worst = 0.0f64;
     for (col, &alpha) in alphas.iter().enumerate() {
@@ -221,20 +246,24 @@ fn gold_spheres(out: &Path) -> Res<Artifact> {
             "Rough gold (ConductorFresnel::GOLD, GGX) spheres under a uniform white sky, dark \
              background: single scattering (top) against Kulla-Conty compensated (bottom), α = 0.2, \
              0.4, 0.7, 1 left to right. A pixel is the directional albedo at its cos θo \
-             (hemisphere quadrature on 129 values of μ, largest error estimate {worst:.1e}). \
+             (hemisphere quadrature on {} values of μ, linear between them, largest error \
+             estimate {worst:.1e}). \
              Compensation brightens rough gold and saturates it (red gains more than blue). Centre \
              albedo: {}.",
+            steps + 1,
             centre.join("; ")
         ),
     ))
 }
 
-/// Writes the energy-compensation charts into `out` (deterministic quadrature: `quick` changes
-/// nothing).
-pub fn run(out: &Path, _quick: bool) -> Res<Vec<Artifact>> {
+/// Writes the energy-compensation charts into `out`. Every value is the deterministic quadrature;
+/// `quick` (the gallery's preview) computes fewer of them: 13 values of α instead of 25, θo every 4°
+/// instead of 2°, and the spheres' albedo on 33 values of μ instead of 129.
+pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
+    let (n_alpha, theta_step, mu_steps) = if quick { (12, 4.0, 32) } else { (24, 2.0, 128) };
     Ok(vec![
-        furnace_against_alpha(out)?,
-        furnace_against_theta(out)?,
-        gold_spheres(out)?,
+        furnace_against_alpha(out, n_alpha)?,
+        furnace_against_theta(out, theta_step)?,
+        gold_spheres(out, mu_steps)?,
     ])
 }

@@ -27,6 +27,7 @@ use brdf::glint::{
 };
 use brdf::ndf::{Beckmann, Ggx, Ndf};
 use brdf::{Bxdf, MicrofacetBrdf, Vec2, Vec3};
+use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -85,12 +86,13 @@ impl Settings {
         }
     }
 
-    /// The gallery's quick settings: half the samples of [`Settings::new`] each way (noise floors
-    /// √2 higher), so that the whole gallery stays within its time budget.
+    /// The gallery's preview: a quarter of the samples of [`Settings::new`] each way (2¹⁰ furnace,
+    /// 2¹² V_ref samples per point: noise floors twice as high), so that the whole gallery stays
+    /// within its time budget.
     pub fn quick() -> Settings {
         Settings {
-            furnace_samples: 1 << 11,
-            v_samples: 1 << 13,
+            furnace_samples: 1 << 10,
+            v_samples: 1 << 12,
             ..Settings::new()
         }
     }
@@ -143,7 +145,7 @@ fn v_monte_carlo(ndf: &dyn Ndf, wo: Vec3, n: usize) -> (f64, f64) {
 }
 
 /// Furnace, its standard error, the weight's relative spread and the lost fraction.
-fn furnace(brdf: &dyn Bxdf, wo: Vec3, cosine: &dyn Fn(Vec3) -> f32, n: usize) -> [f64; 4] {
+fn furnace(brdf: &dyn Bxdf, wo: Vec3, cosine: &Cosine, n: usize) -> [f64; 4] {
     let (mut sum, mut sum2, mut lost) = (0.0f64, 0.0f64, 0usize);
     for k in 0..n {
         let uc = ((k as f64 + 0.5) / n as f64) as f32;
@@ -183,8 +185,16 @@ fn row(method: &str, theta: f64, v: f64, v_ref: (f64, f64), f: [f64; 4]) -> Row 
     }
 }
 
+/// The cosine a furnace weights its samples by (shared between threads).
+type Cosine = dyn Fn(Vec3) -> f32 + Sync;
+
 /// An analytic NDF, its microfacet BRDF, and its f64 closed-form V(α, θ).
-type AnalyticModel<'a> = (&'static str, &'a dyn Ndf, &'a dyn Bxdf, fn(f64, f64) -> f64);
+type AnalyticModel<'a> = (
+    &'static str,
+    &'a (dyn Ndf + Sync),
+    &'a (dyn Bxdf + Sync),
+    fn(f64, f64) -> f64,
+);
 
 fn analytic_rows(settings: &Settings) -> Res<Vec<Row>> {
     let mut rows = Vec::new();
@@ -202,40 +212,50 @@ fn analytic_rows(settings: &Settings) -> Res<Vec<Row>> {
         ];
         for (name, ndf, brdf, v_ref) in models {
             let label = format!("{name} α={alpha}");
-            for theta in THETAS {
-                let wo = view(theta);
-                let f = furnace(brdf, wo, &cos, settings.furnace_samples);
-                let v = (v_ref(alpha as f64, theta.to_radians()), 0.0);
-                rows.push(row(&label, theta, ndf.visible_area(wo) as f64, v, f));
-            }
+            // The view angles in parallel (deterministic R2 points: the same rows either way).
+            let of_model: Vec<Row> = THETAS
+                .par_iter()
+                .map(|&theta| {
+                    let wo = view(theta);
+                    let f = furnace(brdf, wo, &cos, settings.furnace_samples);
+                    let v = (v_ref(alpha as f64, theta.to_radians()), 0.0);
+                    row(&label, theta, ndf.visible_area(wo) as f64, v, f)
+                })
+                .collect();
+            rows.extend(of_model);
         }
     }
     Ok(rows)
 }
 
 /// The rows of one glint patch inside `MicrofacetBrdf`, furnace in the renderer's measure.
-fn patch_rows(label: &str, patch: &dyn Ndf, settings: &Settings, rows: &mut Vec<Row>) {
+fn patch_rows(label: &str, patch: &(dyn Ndf + Sync), settings: &Settings, rows: &mut Vec<Row>) {
     let cos = |w: Vec3| w.z.max(0.0);
     let brdf = MicrofacetBrdf::new(patch, NoFresnel);
     brdf_rows(label, patch, &brdf, &cos, settings, rows);
 }
 
 /// The rows of `brdf` built on `patch`: the patch's V against its Monte Carlo reference, and the
-/// BRDF's furnace weighted by `cosine`.
+/// BRDF's furnace weighted by `cosine`; the view angles in parallel (deterministic R2 points: the
+/// same rows either way).
 fn brdf_rows(
     label: &str,
-    patch: &dyn Ndf,
-    brdf: &dyn Bxdf,
-    cosine: &dyn Fn(Vec3) -> f32,
+    patch: &(dyn Ndf + Sync),
+    brdf: &(dyn Bxdf + Sync),
+    cosine: &Cosine,
     settings: &Settings,
     rows: &mut Vec<Row>,
 ) {
-    for theta in THETAS {
-        let wo = view(theta);
-        let v_ref = v_monte_carlo(patch, wo, settings.v_samples);
-        let f = furnace(brdf, wo, cosine, settings.furnace_samples);
-        rows.push(row(label, theta, patch.visible_area(wo) as f64, v_ref, f));
-    }
+    let of_brdf: Vec<Row> = THETAS
+        .par_iter()
+        .map(|&theta| {
+            let wo = view(theta);
+            let v_ref = v_monte_carlo(patch, wo, settings.v_samples);
+            let f = furnace(brdf, wo, cosine, settings.furnace_samples);
+            row(label, theta, patch.visible_area(wo) as f64, v_ref, f)
+        })
+        .collect();
+    rows.extend(of_brdf);
 }
 
 fn glint_rows(name: &str, map: &NormalMap, settings: &Settings) -> Res<Vec<Row>> {

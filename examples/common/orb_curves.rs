@@ -29,6 +29,8 @@ use std::time::Instant;
 /// The sweep's settings.
 #[derive(Clone, Debug)]
 pub struct CurveOptions {
+    /// The maps swept (names of [`MAPS`], one row of panels each).
+    pub maps: Vec<&'static str>,
     /// Image size (pixels per side).
     pub size: u32,
     /// Procedural map size (texels per side).
@@ -48,6 +50,7 @@ impl CurveOptions {
     /// The full sweep (`--curves`).
     pub fn full() -> CurveOptions {
         CurveOptions {
+            maps: MAPS.to_vec(),
             size: 128,
             map_size: 512,
             // 1, 9, 34, 2 186 and 139 898 texels per pixel (median).
@@ -58,15 +61,30 @@ impl CurveOptions {
         }
     }
 
-    /// The gallery's sweep (`--curves --quick`): a few minutes at most.
+    /// The gallery's `--full` sweep (`--curves --quick`): a few minutes at most.
     pub fn quick() -> CurveOptions {
         CurveOptions {
+            maps: MAPS.to_vec(),
             size: 64,
             map_size: 256,
             scales: vec![2.0, 32.0],
             reference_k: 32,
             naive_max_spp: 1024,
             budget_s: 10.0,
+        }
+    }
+
+    /// The gallery's default preview: [`CurveOptions::quick`] on two maps (scratched and flakes:
+    /// long thin glints and isolated sparkles) at one scale (~30 texels per pixel), naive sampling
+    /// up to 256 spp and a 2 × 24² spp reference; ten seconds or so on 2 cores.
+    pub fn preview() -> CurveOptions {
+        CurveOptions {
+            maps: vec!["scratched", "flakes"],
+            scales: vec![2.0],
+            reference_k: 24,
+            naive_max_spp: 256,
+            budget_s: 5.0,
+            ..CurveOptions::quick()
         }
     }
 }
@@ -88,7 +106,7 @@ struct Point {
 }
 
 /// The crate's four procedural maps and the example's fractal height field (orb/fractal.rs).
-const MAPS: [&str; 5] = ["scratched", "brushed", "bumpy", "flakes", "fractal"];
+pub const MAPS: [&str; 5] = ["scratched", "brushed", "bumpy", "flakes", "fractal"];
 /// The mixture without level of detail is rendered only up to this footprint (texels per pixel):
 /// beyond it every pixel reads tens of thousands of lobes.
 const NO_LOD_MAX_TEXELS: f64 = 5000.0;
@@ -238,19 +256,30 @@ pub fn naive_time_at(curve: &[(f64, f64)], error: f64) -> (f64, &'static str) {
     ((t0 + f * (t1 - t0)).exp(), "=")
 }
 
-/// Runs the sweep and writes orb_curves.csv, orb_speedup.csv and orb_curves.png into `out`.
+/// Runs the sweep ([`CurveOptions::quick`] or [`CurveOptions::full`]) and writes orb_curves.csv,
+/// orb_speedup.csv and orb_curves.png into `out`.
 pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
-    std::fs::create_dir_all(out)?;
-    let opts = if quick {
-        CurveOptions::quick()
+    if quick {
+        run_with(out, &CurveOptions::quick(), "quick")
     } else {
-        CurveOptions::full()
-    };
+        run_with(out, &CurveOptions::full(), "full")
+    }
+}
+
+/// The gallery's default: [`CurveOptions::preview`].
+pub fn run_preview(out: &Path) -> Res<Vec<Artifact>> {
+    run_with(out, &CurveOptions::preview(), "preview")
+}
+
+/// Runs the sweep of `opts` (`setting` names it in the output and the chart's title) and writes
+/// orb_curves.csv, orb_speedup.csv and orb_curves.png into `out`.
+pub fn run_with(out: &Path, opts: &CurveOptions, setting: &str) -> Res<Vec<Artifact>> {
+    std::fs::create_dir_all(out)?;
     let wall = Instant::now();
     let hidden = ProgressBar::hidden();
     let mut points: Vec<Point> = Vec::new();
     let mut notes = String::new();
-    for map_name in MAPS {
+    for &map_name in &opts.maps {
         let orb = OrbOptions {
             map: MapSource::parse(map_name),
             map_size: opts.map_size,
@@ -415,10 +444,10 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
     std::fs::write(&speedup_path, sp)?;
 
     let chart_path = out.join("orb_curves.png");
-    chart(&chart_path, &points, &opts, quick)?;
+    chart(&chart_path, &points, opts, setting)?;
     println!(
-        "orb curves ({}): image {}², map {}², scales {:?}, reference 2 × {} spp, wall time {wall_s:.0} s",
-        if quick { "quick" } else { "full" },
+        "orb curves ({setting}): maps {:?}, image {}², map {}², scales {:?}, reference 2 × {} spp, wall time {wall_s:.0} s",
+        opts.maps,
         opts.size,
         opts.map_size,
         opts.scales,
@@ -450,7 +479,7 @@ pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
 }
 
 /// A grid of log-log panels, maps × scales.
-fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res<()> {
+fn chart(path: &Path, points: &[Point], opts: &CurveOptions, setting: &str) -> Res<()> {
     register_font();
     // The glint models, in first-seen order.
     let mut labels: Vec<String> = Vec::new();
@@ -459,9 +488,10 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res
             labels.push(p.method.clone());
         }
     }
-    let (cols, rows) = (opts.scales.len() as u32, MAPS.len() as u32);
+    let (cols, rows) = (opts.scales.len() as u32, opts.maps.len() as u32);
     let (pw, ph) = (360u32, 260u32);
-    let (w, h) = (cols * pw, rows * ph + 30);
+    // At least two panels wide, so that the title fits (the preview has one column).
+    let (w, h) = ((cols * pw).max(2 * pw), rows * ph + 30);
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
@@ -469,7 +499,11 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res
         title.draw(&Text::new(
             format!(
                 "orb: denoised rel. RMSE vs (a) exact P-BRDF against time (s){}; naive dotted = vs (b)",
-                if quick { ", --quick" } else { "" }
+                match setting {
+                    "full" => String::new(),
+                    "quick" => ", --quick".to_string(),
+                    other => format!(", {other}"),
+                }
             ),
             (6, 6),
             ("sans-serif", 15).into_font(),
@@ -484,7 +518,10 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, quick: bool) -> Res
             RGBColor(140, 210, 140),
         ];
         for (pi, area) in panels.iter().enumerate() {
-            let (map, scale) = (MAPS[pi / cols as usize], opts.scales[pi % cols as usize]);
+            let (map, scale) = (
+                opts.maps[pi / cols as usize],
+                opts.scales[pi % cols as usize],
+            );
             let here: Vec<&Point> = points
                 .iter()
                 .filter(|p| p.map == map && p.scale == scale)

@@ -64,12 +64,16 @@ pub fn report(results: &Results, settings: &Settings, out: &Path) -> Res<(Vec<Ar
 
 /// The example's entry point: measure, write, return the artifacts.
 pub fn run(out: &Path, quick: bool) -> Res<Vec<Artifact>> {
-    let settings = Settings::new(quick);
+    run_with(out, &Settings::new(quick))
+}
+
+/// [`run`] on the given settings (the gallery's [`Settings::preview`]).
+pub fn run_with(out: &Path, settings: &Settings) -> Res<Vec<Artifact>> {
     let t = Instant::now();
-    let results = measure(&settings, &mut |s| {
+    let results = measure(settings, &mut |s| {
         eprintln!("[{:6.1} s] {s}", t.elapsed().as_secs_f64())
     })?;
-    let (artifacts, md) = report(&results, &settings, out)?;
+    let (artifacts, md) = report(&results, settings, out)?;
     println!("{md}");
     Ok(artifacts)
 }

@@ -86,7 +86,8 @@ fn build_csv(results: &Results) -> Res<String> {
     Ok(csv)
 }
 
-/// The markdown tables, one after the other with a blank line between them.
+/// The markdown tables, one after the other with a blank line between them (the 127² table only if
+/// a footprint has those bins).
 pub(super) fn markdown(
     results: &Results,
     settings: &Settings,
@@ -94,14 +95,16 @@ pub(super) fn markdown(
     view_methods: &[String],
     summary: &[MethodSummary],
 ) -> Res<String> {
-    Ok([
+    let mut tables = vec![
         summary_table(results, summary)?,
         tv_table(results, settings, methods, false),
-        tv_table(results, settings, methods, true),
-        d_time_table(results, settings, methods)?,
-        view_table(results, settings, view_methods)?,
-    ]
-    .join("\n"))
+    ];
+    if settings.areas.iter().any(|&a| a <= settings.fine_up_to) {
+        tables.push(tv_table(results, settings, methods, true));
+    }
+    tables.push(d_time_table(results, settings, methods)?);
+    tables.push(view_table(results, settings, view_methods)?);
+    Ok(tables.join("\n"))
 }
 
 /// Per method: mean TV to both truths (≥ 1 texel; the convolved truth first: the material every
