@@ -58,7 +58,7 @@ fn white_furnace() {
                     for theta in [0.0, 45.0, 70.0, 85.0] {
                         let wo = support::dir(theta, 60.0);
                         let brdf = MicrofacetBrdf::new(&patch, NoFresnel).with_masking(masking);
-                        let (e, err) = albedo(&brdf, wo, 2000);
+                        let (e, err) = albedo(&brdf, wo, support::depth(1000, 2000));
                         // ≤ 1 + 4 standard errors (stratified draws make the bound conservative).
                         assert!(
                             e <= 1.0 + 4.0 * err,
@@ -223,7 +223,8 @@ fn furnace_up_to_grazing_stays_below_one() {
                 for theta in [70.0, 85.0, 89.0, 89.9] {
                     for phi in [30.0, 210.0] {
                         let wo = support::dir(theta, phi);
-                        let (e, se, _, _) = furnace_stats(&patch, wo, 1 << 12);
+                        let (e, se, _, _) =
+                            furnace_stats(&patch, wo, support::depth(1 << 11, 1 << 12));
                         assert!(
                             e <= 1.0 + 4.0 * se,
                             "{name} n={n} θo={theta} φ={phi}: {e} ± {se}"

@@ -6,7 +6,7 @@
 //!
 //! Run one module with `cargo test --test it MODULE::` (e.g. `cargo test --test it mixture_sampling::`).
 //!
-//! Two depths (`support::full`): the default run keeps every check with lighter settings (2·10⁵
+//! Two depths (`support::full`): the default run keeps every check with lighter settings (10⁵
 //! chi-square draws instead of 10⁶, coarser furnace quadratures, every second direction of the
 //! density sweeps), so that a fresh clone's `cargo test` takes minutes; `BRDF_TEST_FULL=1 cargo
 //! test --test it` runs the same checks at the settings they were written with (CI runs

@@ -219,7 +219,7 @@ fn converges_to_the_limit() {
 }
 
 /// Chi-square of both samplers at a small (a few facets), medium (a dozen lobes of a fine level)
-/// and large footprint (coarse lobes blended with the limit lobe), 10⁶ draws each (2·10⁵ in the
+/// and large footprint (coarse lobes blended with the limit lobe), 10⁶ draws each (10⁵ in the
 /// default run, `support::depth`). A draw where
 /// the density is 0 (beyond a lobe's slope box, 10⁻⁶ of its mass, which D truncates: the density
 /// contract of `brdf::ndf::Ndf`) is counted as `None`, as `MicrofacetBrdf::sample` returns it, so

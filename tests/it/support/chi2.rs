@@ -62,8 +62,8 @@ impl Default for Chi2 {
         Chi2 {
             name: "chi2".into(),
             // 10⁶ draws at full power: enough to see a 1 % density error in a 10 %-mass region, ~1 s
-            // per test. The default run draws 2·10⁵ (~60 per cell): a 2-3 % error in such a region.
-            samples: super::depth(200_000, 1_000_000),
+            // per test. The default run draws 10⁵ (~30 per cell): a ~3 % error in such a region.
+            samples: super::depth(100_000, 1_000_000),
             // 40 × 80 cells: ~310 draws per cell on average; fine enough for the lobes we test.
             res_z: 40,
             res_phi: 80,

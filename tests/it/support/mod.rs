@@ -169,7 +169,7 @@ pub fn chi2_few_lobe_samplers(ndf: &dyn brdf::ndf::Ndf, label: &str, thetas: &[f
     chi2_ndf_samplers(ndf, label, thetas, true, |name| chi2::Chi2::new(name, 3));
 }
 
-/// Chi-square (10⁶ draws, 100 × 200 cells; 2.5·10⁵ draws and 50 × 100 cells in the default run,
+/// Chi-square (10⁶ draws, 100 × 200 cells; 1.25·10⁵ draws and 50 × 100 cells in the default run,
 /// [`depth`]) of a mixture patch's visible sampler at each θo (φo = 20°), and of its normal sampler
 /// if `normals`.
 pub fn chi2_patch_samplers(
@@ -181,7 +181,7 @@ pub fn chi2_patch_samplers(
     chi2_ndf_samplers(patch, label, thetas, normals, |name| chi2::Chi2 {
         res_z: depth(50, 100),
         res_phi: depth(100, 200),
-        samples: depth(250_000, 1_000_000),
+        samples: depth(125_000, 1_000_000),
         ..chi2::Chi2::new(name, 3)
     });
 }
