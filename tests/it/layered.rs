@@ -160,21 +160,21 @@ fn chi_square_of_the_layered_sampler() {
             format!("layered ggx θo={theta}"),
             &ggx,
             support::dir(theta, 30.0),
-            support::depth(250_000, 1_000_000),
+            support::depth(100_000, 1_000_000),
         ));
     }
     cases.push((
         "layered iso ggx θo=89".into(),
         &ggx_iso,
         support::dir(89.0, 30.0),
-        support::depth(250_000, 1_000_000),
+        support::depth(100_000, 1_000_000),
     ));
     for theta in [20.0, 70.0] {
         cases.push((
             format!("layered glint θo={theta}"),
             &glint,
             support::dir(theta, 30.0),
-            200_000,
+            support::depth(100_000, 200_000),
         ));
     }
     let family = cases.len();

@@ -106,10 +106,10 @@ fn samplers_match_their_densities_at(normal_cases: &[(f32, usize)], thetas: &[f6
     let patch = pn.patch(&fp);
     for &theta in thetas {
         let wo = support::dir(theta, 40.0);
-        // 2·10⁵ draws on 50 × 100 cells (~40 per cell; 10⁵ in the default run): the visible
+        // 2·10⁵ draws on 50 × 100 cells (~40 per cell; 5·10⁴ in the default run): the visible
         // sampler and density cost O(elements) per call each.
         Chi2 {
-            samples: support::depth(100_000, 200_000),
+            samples: support::depth(50_000, 200_000),
             ..chi(&format!("pn_visible_{theta}"), 50)
         }
         .run(
@@ -131,9 +131,9 @@ fn samplers_match_their_densities_at(normal_cases: &[(f32, usize)], thetas: &[f6
     let brdf = PositionNormalBrdf::new(&patch, NoFresnel);
     let wo = support::dir(45.0, 10.0);
     // 3·10⁵ draws on 50 × 100 cells: each draw evaluates D_P at its half vector (~40 elements of
-    // the smooth map overlap there; 1.5·10⁵ in the default run).
+    // the smooth map overlap there; 7.5·10⁴ in the default run).
     Chi2 {
-        samples: support::depth(150_000, 300_000),
+        samples: support::depth(75_000, 300_000),
         ..chi("pn_brdf_45", 50)
     }
     .run(
