@@ -253,8 +253,9 @@ fn converges_to_the_limit() {
 
 /// The sampler checks at a small (1 texel), a medium (256) and a blended footprint (60,000: GGX
 /// and lobes): which of them `cases` selects as (area index, sampler: None normals, Some(θo)
-/// visible). 10⁶ draws each (10⁵ in the default run, `support::depth`); draws where the density is 0 (beyond a lobe's slope box) count as
-/// `None`, as in procedural_glints.rs; normals beyond θ = 60° form the overflow cell (below).
+/// visible). 10⁶ draws each (10⁵ in the default run, `support::depth`); draws where the density
+/// is 0 (beyond a lobe's slope box) count as `None`, as in procedural_glints.rs; normals beyond
+/// θ = 60° form the overflow cell (below).
 fn chi2_samplers(cases: &[(usize, Option<f64>)]) {
     let s = surface(5);
     let footprints = [
