@@ -478,6 +478,9 @@ pub fn run_with(out: &Path, opts: &CurveOptions, setting: &str) -> Res<Vec<Artif
     ])
 }
 
+/// Width in pixels of the legend column of a one-column chart.
+const LEGEND_WIDTH: u32 = 260;
+
 /// A grid of log-log panels, maps × scales.
 fn chart(path: &Path, points: &[Point], opts: &CurveOptions, setting: &str) -> Res<()> {
     register_font();
@@ -508,7 +511,15 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, setting: &str) -> R
             (6, 6),
             ("sans-serif", 15).into_font(),
         ))?;
-        let panels = body.split_evenly((rows as usize, cols as usize));
+        // A one-column chart (the preview) is two panels wide: its legend goes into a column of its
+        // own beside the panels, where it covers no point.
+        let (plots, side) = if cols == 1 {
+            let (p, s) = body.split_horizontally(w - LEGEND_WIDTH);
+            (p, Some(s))
+        } else {
+            (body, None)
+        };
+        let panels = plots.split_evenly((rows as usize, cols as usize));
         let colours = [
             BLUE,
             RGBColor(120, 170, 255),
@@ -605,12 +616,32 @@ fn chart(path: &Path, points: &[Point], opts: &CurveOptions, setting: &str) -> R
                     )
                 }))?;
             }
-            if pi == 0 {
+            if pi == 0 && side.is_none() {
                 c.configure_series_labels()
                     .label_font(("sans-serif", 10))
                     .background_style(WHITE.mix(0.8))
                     .border_style(BLACK)
                     .draw()?;
+            }
+        }
+        if let Some(side) = &side {
+            let entries = std::iter::once(("naive".to_string(), BLACK)).chain(
+                labels
+                    .iter()
+                    .enumerate()
+                    .map(|(i, m)| (m.clone(), colours[i % colours.len()])),
+            );
+            for (i, (label, col)) in entries.enumerate() {
+                let y = 40 + 16 * i as i32;
+                side.draw(&PathElement::new(
+                    vec![(6, y), (22, y)],
+                    col.stroke_width(3),
+                ))?;
+                side.draw(&Text::new(
+                    label,
+                    (28, y - 6),
+                    ("sans-serif", 11).into_font(),
+                ))?;
             }
         }
         root.present()?;
