@@ -6,7 +6,7 @@
 //! [--size PIXELS] [--map-size TEXELS] [--tiles UxV] [--naive-spp N] [--sigma S]
 //! [--out DIR] [--quiet]`, or `-- --quick [--out DIR]` for the gallery's
 //! small strip (scratched 512² map, 160² pixels, 256 spp); `-- --curves [--quick] [--out DIR]` for
-//! the error-against-time curves and equal-error speedups (examples/common/orb_curves.rs); `-- --bias
+//! the error-against-time curves and equal-error speedups (examples/common/orb_curves/); `-- --bias
 //! [--out DIR]` for the decomposition of the glint models' bias floor (examples/common/orb/bias.rs).
 //!
 //! Writes one PNG per method, a labelled strip and a CSV of times and errors into DIR (default

@@ -174,23 +174,15 @@ mod tests {
         }
     }
 
-    fn comp(w: f64, mx: f64, my: f64, s: f64) -> Comp {
-        Comp {
-            w,
-            mean: [mx, my],
-            cov: [s * s, 0.0, s * s],
-        }
-    }
-
     /// Reduction keeps the total weight, mean and covariance of the mixture (moment matching is
     /// exact at every merge), and merges the two close components before the far one.
     #[test]
     fn reduction_keeps_the_first_two_moments() {
         let mut c = vec![
-            comp(0.25, 0.0, 0.0, 0.01),
-            comp(0.25, 0.001, 0.0, 0.01),
-            comp(0.25, 0.3, 0.1, 0.02),
-            comp(0.25, -0.2, 0.05, 0.01),
+            Comp::isotropic(0.25, 0.0, 0.0, 0.01),
+            Comp::isotropic(0.25, 0.001, 0.0, 0.01),
+            Comp::isotropic(0.25, 0.3, 0.1, 0.02),
+            Comp::isotropic(0.25, -0.2, 0.05, 0.01),
         ];
         let moments = |c: &[Comp]| {
             let w: f64 = c.iter().map(|c| c.w).sum();

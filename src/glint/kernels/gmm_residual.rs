@@ -33,6 +33,18 @@ pub(crate) struct Comp {
     pub cov: [f64; 3],
 }
 
+#[cfg(test)]
+impl Comp {
+    /// The isotropic component of weight `w`, mean (mx, my) and standard deviation `s` (tests).
+    pub(crate) fn isotropic(w: f64, mx: f64, my: f64, s: f64) -> Comp {
+        Comp {
+            w,
+            mean: [mx, my],
+            cov: [s * s, 0.0, s * s],
+        }
+    }
+}
+
 /// ∫ N(x; μ_a, Σ_a) N(x; μ_b, Σ_b) dx = N(μ_a − μ_b; 0, Σ_a + Σ_b) (weights not applied).
 pub(crate) fn overlap(a: &Comp, b: &Comp) -> f64 {
     let s = [
@@ -116,14 +128,6 @@ pub(crate) fn node_residual(q: &[Comp], children: &[&[Comp]], child_res: &[Resid
 mod tests {
     use super::*;
 
-    fn comp(w: f64, mx: f64, my: f64, s: f64) -> Comp {
-        Comp {
-            w,
-            mean: [mx, my],
-            cov: [s * s, 0.0, s * s],
-        }
-    }
-
     /// The overlap against a midpoint quadrature of the product of two densities.
     #[test]
     fn overlap_matches_quadrature() {
@@ -132,7 +136,7 @@ mod tests {
             mean: [0.01, -0.02],
             cov: [0.0009, 0.0002, 0.0004],
         };
-        let b = comp(1.0, 0.03, 0.0, 0.015);
+        let b = Comp::isotropic(1.0, 0.03, 0.0, 0.015);
         let pdf = |c: &Comp, x: f64, y: f64| {
             let det = c.cov[0] * c.cov[2] - c.cov[1] * c.cov[1];
             let (dx, dy) = (x - c.mean[0], y - c.mean[1]);
@@ -156,10 +160,13 @@ mod tests {
     /// a node that merges two far lobes into one has a large residual.
     #[test]
     fn residual_is_zero_exactly_when_nothing_is_lost() {
-        let l = [comp(1.0, 0.0, 0.0, 0.01)];
-        let r = [comp(1.0, 0.1, 0.0, 0.01)];
+        let l = [Comp::isotropic(1.0, 0.0, 0.0, 0.01)];
+        let r = [Comp::isotropic(1.0, 0.1, 0.0, 0.01)];
         let children: [&[Comp]; 2] = [&l, &r];
-        let exact = [comp(0.5, 0.0, 0.0, 0.01), comp(0.5, 0.1, 0.0, 0.01)];
+        let exact = [
+            Comp::isotropic(0.5, 0.0, 0.0, 0.01),
+            Comp::isotropic(0.5, 0.1, 0.0, 0.01),
+        ];
         let z = [Residual::default(); 2];
         let e = node_residual(&exact, &children, &z);
         assert!(e.rho < 1e-6, "{e:?}");
@@ -181,7 +188,7 @@ mod tests {
     /// least as much in the bound.
     #[test]
     fn residual_carries_the_childrens() {
-        let l = [comp(1.0, 0.0, 0.0, 0.01)];
+        let l = [Comp::isotropic(1.0, 0.0, 0.0, 0.01)];
         let children: [&[Comp]; 2] = [&l, &l];
         let child = Residual {
             rho: 0.3,
