@@ -418,6 +418,18 @@ impl SlopeGaussian {
         Some(ViewTerms { a_s, vx, vy, s_w })
     }
 
+    /// (A_s(w), s_w(w)) in `f64` for a usable direction (w_z > 0, finite; the caller checks): the
+    /// two numbers V(w) = s_w G(A_s/s_w) is made of, for sets of lobes that evaluate G over lanes.
+    #[cfg(feature = "std")]
+    #[inline]
+    pub(crate) fn area_and_spread(&self, w: Vec3) -> (f64, f64) {
+        let (wx, wy, wz) = (w.x as f64, w.y as f64, w.z as f64);
+        let a_s = wz - (self.mean.x as f64 * wx + self.mean.y as f64 * wy);
+        let [l11, l21, l22] = self.chol.map(f64::from);
+        let (vx, vy) = (l11 * wx + l21 * wy, l22 * wy);
+        (a_s, (vx * vx + vy * vy).sqrt())
+    }
+
     /// The normal of the slope μ + L z.
     #[inline]
     fn normal_from_z(&self, zx: f64, zy: f64) -> Vec3 {
@@ -427,13 +439,48 @@ impl SlopeGaussian {
         slope_to_normal_f64(sx, sy)
     }
 
-    /// ln D(m) in `f64`: −½ |L⁻¹(ñ − μ)|² + ln(L⁻¹₁₁ L⁻¹₂₂ / (2π)) + 2 ln(1 + |ñ|²), with the slope
-    /// ñ = (−m_x/m_z, −m_y/m_z) formed in `f64` from the `f32` normal; `None` for m_z ≤ 0 or a
-    /// non-finite m.
+    /// D(m) in `f64`: P22(ñ) (1 + |ñ|²)² with the slope ñ = (−m_x/m_z, −m_y/m_z) formed in `f64`
+    /// from the `f32` normal; `None` for m_z ≤ 0 or a non-finite m.
     ///
-    /// [`Ndf::d`] and [`Ndf::pdf_visible`] both go through it, so that they agree on where D is
+    /// [`Ndf::d`] and the visible densities all go through it, so that they agree on where D is
     /// zero: an `f32` slope loses up to 6·10⁻⁸ |ñ| (5·10⁻⁴ at |ñ| = 10⁴, where a lobe may have
     /// σ = 10⁻⁴), and D and the pdf taken from two roundings of it could differ by any factor.
+    ///
+    /// No step overflows or loses a value `f32` can hold: |ñ| ≤ 1/m_z ≤ 2¹⁴⁹ bounds (1 + |ñ|²)² by
+    /// 10¹⁸⁰, the normalisation is at most `f32::MAX`², so the product stays below 10²⁵⁷; and where
+    /// the exponential underflows (exponent < −745) the product is below 10⁻⁷⁴⁵ · 10²⁵⁷, far under
+    /// the smallest `f32`.
+    #[inline]
+    fn d_f64(&self, m: Vec3) -> Option<f64> {
+        if !(m.z > 0.0 && m.is_finite()) {
+            return None;
+        }
+        let (mx, my, mz) = (m.x as f64, m.y as f64, m.z as f64);
+        let (sx, sy) = (-mx / mz, -my / mz);
+        let j = 1.0 + sx * sx + sy * sy;
+        let d = self.p22_f64(sx, sy) * j * j;
+        (!d.is_nan()).then_some(d)
+    }
+
+    /// ln D_wo(m) = ln(⟨wo, m⟩ D(m) / V(wo)) in `f64`, or `None` outside the visible support
+    /// (m below the horizon, ⟨wo, m⟩ ≤ 0 as `wo.dot(m)` rounds it, invalid wo).
+    ///
+    /// Finite on the whole support, also where D and V both underflow `f32` (grazing views of a
+    /// lobe tilted away: the visible normals then lie tens of σ out), where [`Ndf::pdf_visible`]
+    /// is 0 because D is: for references and tests that follow the visible sampler into that tail.
+    pub fn ln_pdf_visible(&self, wo: Vec3, m: Vec3) -> Option<f64> {
+        let t = self.view_terms(wo)?;
+        let ln_d = self.ln_d(m)?;
+        let c = facing(wo, m);
+        if c.is_nan() || c <= 0.0 {
+            return None;
+        }
+        let ln_pdf = c.ln() + ln_d - ln_visible_area(&t)?;
+        (!ln_pdf.is_nan()).then_some(ln_pdf)
+    }
+
+    /// ln D(m) in `f64`: −½ |L⁻¹(ñ − μ)|² + ln(L⁻¹₁₁ L⁻¹₂₂ / (2π)) + 2 ln(1 + |ñ|²) (finite where
+    /// D underflows `f64`); `None` for m_z ≤ 0 or a non-finite m.
     fn ln_d(&self, m: Vec3) -> Option<f64> {
         if !(m.z > 0.0 && m.is_finite()) {
             return None;
@@ -448,45 +495,48 @@ impl SlopeGaussian {
         (!ln_d.is_nan()).then_some(ln_d)
     }
 
-    /// ln D_wo(m) = ln(⟨wo, m⟩ D(m) / V(wo)) in `f64`, or `None` outside the visible support
-    /// (m below the horizon, ⟨wo, m⟩ ≤ 0 as `wo.dot(m)` rounds it, invalid wo).
-    ///
-    /// Finite on the whole support, also where D and V both underflow `f32` (grazing views of a
-    /// lobe tilted away: the visible normals then lie tens of σ out), where [`Ndf::pdf_visible`]
-    /// is 0 because D is: for references and tests that follow the visible sampler into that tail.
-    pub fn ln_pdf_visible(&self, wo: Vec3, m: Vec3) -> Option<f64> {
-        self.ln_d_and_pdf_visible(wo, m).map(|(_, l)| l)
-    }
-
-    /// (ln D(m), ln D_wo(m)) in `f64` (see [`SlopeGaussian::ln_pdf_visible`]).
-    fn ln_d_and_pdf_visible(&self, wo: Vec3, m: Vec3) -> Option<(f64, f64)> {
+    /// D(m)/V(wo) in `f64` where D rounds to a positive `f32` and m faces wo, else `None`: the
+    /// quotient directly where V(wo) is a normal `f64` (D ≥ `f32`'s smallest value there, so the
+    /// quotient loses nothing), from logarithms where V underflows (grazing views of a lobe tilted
+    /// away).
+    fn d_over_v(&self, wo: Vec3, m: Vec3) -> Option<f64> {
         let t = self.view_terms(wo)?;
-        let ln_d = self.ln_d(m)?;
+        let d = self.d_f64(m)?;
         let c = facing(wo, m);
-        if c.is_nan() || c <= 0.0 {
+        if (d as f32) <= 0.0 || c.is_nan() || c <= 0.0 {
             return None;
         }
-        let ln_v = if t.s_w > 0.0 {
-            t.s_w.ln() + gauss::ln_ramp(t.a_s / t.s_w)
-        } else if t.a_s > 0.0 {
-            t.a_s.ln()
+        let v = visible_area_f64(&t);
+        let q = if v >= 1.0e-290 {
+            d / v
         } else {
-            return None;
+            (self.ln_d(m)? - ln_visible_area(&t)?).exp()
         };
-        let ln_pdf = c.ln() + ln_d - ln_v;
-        (!ln_pdf.is_nan()).then_some((ln_d, ln_pdf))
+        (!q.is_nan()).then_some(q)
     }
 }
 
-/// D in `f32` from ln D: e^(ln D) rounded, values beyond `f32::MAX` clamped to it.
+/// ln V(w) from the view terms, finite where V underflows `f64`; `None` where V is 0.
 #[inline]
-fn d_of_ln(ln_d: f64) -> f32 {
-    (ln_d.exp() as f32).min(f32::MAX)
+fn ln_visible_area(t: &ViewTerms) -> Option<f64> {
+    if t.s_w > 0.0 {
+        Some(t.s_w.ln() + gauss::ln_ramp(t.a_s / t.s_w))
+    } else if t.a_s > 0.0 {
+        Some(t.a_s.ln())
+    } else {
+        None
+    }
+}
+
+/// D in `f32` from its `f64` value, values beyond `f32::MAX` clamped to it.
+#[inline]
+fn d_to_f32(d: f64) -> f32 {
+    (d as f32).min(f32::MAX)
 }
 
 impl Ndf for SlopeGaussian {
     /// D(m) = P22(ñ(m)) (1 + |ñ|²)² = P22(ñ) / cos⁴θ_m, formed in `f64` (slope included) and
-    /// rounded once to `f32` (see `ln_d`).
+    /// rounded once to `f32` (see `d_f64`).
     ///
     /// 0 for m.z ≤ 0 or non-finite m and where D underflows `f32`; values beyond `f32::MAX` are
     /// clamped to it.
@@ -495,7 +545,7 @@ impl Ndf for SlopeGaussian {
     /// \[Chermain2019\] eq. 2.
     #[inline]
     fn d(&self, m: Vec3) -> f32 {
-        self.ln_d(m).map_or(0.0, d_of_ln)
+        self.d_f64(m).map_or(0.0, d_to_f32)
     }
 
     /// Smith Λ(w) = V/A − 1 = G(−z)/z with z = A_s / s_w = (μ_w − q̄)/s, μ_w = cot θ.
@@ -586,8 +636,8 @@ impl Ndf for SlopeGaussian {
         ensure_facing(wo, m)
     }
 
-    /// D_wo(m) = ⟨wo, m⟩⁺ D(m) / V(wo), formed in `f64` logarithms so that it stays finite where V
-    /// underflows `f32` (grazing views of lobes tilted away).
+    /// D_wo(m) = ⟨wo, m⟩⁺ D(m) / V(wo), formed in `f64` (from logarithms where V underflows `f64`:
+    /// grazing views of lobes tilted away), so that it stays finite where V underflows `f32`.
     ///
     /// 0 outside the visible set (m below the horizon or ⟨wo, m⟩ ≤ 0), for invalid wo, and wherever
     /// [`Ndf::d`] is 0 (the density contract of every NDF: no density where D rounds to 0 in `f32`,
@@ -598,28 +648,23 @@ impl Ndf for SlopeGaussian {
     /// caller testing pdf > 0 for "in the support" stays right) and values above `f32::MAX` as
     /// `f32::MAX`.
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
-        match self.ln_d_and_pdf_visible(wo, m) {
-            Some((ln_d, l)) if d_of_ln(ln_d) > 0.0 => {
-                (l.exp() as f32).clamp(f32::MIN_POSITIVE, f32::MAX)
-            }
-            _ => 0.0,
+        match self.d_over_v(wo, m) {
+            Some(q) => ((facing(wo, m) * q) as f32).clamp(f32::MIN_POSITIVE, f32::MAX),
+            None => 0.0,
         }
     }
 
     /// D(m) / V(wo): [`Ndf::pdf_visible`] without its factor ⟨wo, m⟩ (which the reflection
-    /// Jacobian cancels), formed in `f64` logarithms like it and clamped like it, 0 where it is 0
-    /// (`d_m` is not needed: D comes from the same logarithm).
+    /// Jacobian cancels), formed in `f64` like it and clamped like it, 0 where it is 0 (`d_m` is
+    /// not needed: D is formed again in `f64`).
     ///
     /// # Reference
     /// \[Heitz2014\] eq. 16.
     fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
         let _ = d_m;
-        match self.ln_d_and_pdf_visible(wo, m) {
-            Some((ln_d, l)) if d_of_ln(ln_d) > 0.0 => {
-                let ln_c = facing(wo, m).ln();
-                ((l - ln_c).exp() as f32).clamp(f32::MIN_POSITIVE, f32::MAX)
-            }
-            _ => 0.0,
+        match self.d_over_v(wo, m) {
+            Some(q) => (q as f32).clamp(f32::MIN_POSITIVE, f32::MAX),
+            None => 0.0,
         }
     }
 
@@ -708,244 +753,4 @@ fn clamp_u(u: f32) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn lobe(mx: f32, my: f32, sx: f32, sy: f32, rho: f32) -> SlopeGaussian {
-        let c = rho * sx * sy;
-        SlopeGaussian::new(
-            Vec2::new(mx, my),
-            Mat2::from_cols_array(&[sx * sx, c, c, sy * sy]),
-        )
-        .unwrap()
-    }
-
-    #[test]
-    fn size_is_32_bytes() {
-        assert_eq!(std::mem::size_of::<SlopeGaussian>(), 32);
-    }
-
-    #[test]
-    fn accessors_round_trip() {
-        let g = lobe(0.3, -0.2, 0.2, 0.05, 0.7);
-        let cov = g.covariance();
-        // f32 storage of L: entries agree to a few ulp of the largest (~1e-7 relative).
-        assert!((cov.x_axis.x - 0.04).abs() < 1e-8);
-        assert!((cov.y_axis.y - 0.0025).abs() < 1e-9);
-        assert!((cov.x_axis.y - 0.7 * 0.2 * 0.05).abs() < 1e-8);
-        assert_eq!(cov.x_axis.y, cov.y_axis.x);
-        let l = g.cholesky();
-        let back = l * l.transpose();
-        assert!((back - cov).abs_diff_eq(Mat2::ZERO, 1e-8));
-        assert_eq!(g.mean(), Vec2::new(0.3, -0.2));
-        let n = g.mean_normal();
-        let expected = Vec3::new(-0.3, 0.2, 1.0).normalize();
-        assert!((n - expected).length() < 1e-7);
-    }
-
-    #[test]
-    fn p22_is_the_bivariate_normal() {
-        // Independent f64 formula with Σ⁻¹ from the adjugate.
-        let (mx, my, sx, sy, rho) = (0.3f64, -0.2, 0.2, 0.05, -0.6);
-        let g = lobe(mx as f32, my as f32, sx as f32, sy as f32, rho as f32);
-        for &(x, y) in &[(0.3, -0.2), (0.5, -0.1), (0.1, -0.3), (0.0, 0.0)] {
-            let (dx, dy) = (x - mx, y - my);
-            let q = (dx * dx / (sx * sx) - 2.0 * rho * dx * dy / (sx * sy) + dy * dy / (sy * sy))
-                / (1.0 - rho * rho);
-            let p = (-0.5 * q).exp() / (2.0 * PI * sx * sy * (1.0 - rho * rho).sqrt());
-            let got = g.p22(Vec2::new(x as f32, y as f32)) as f64;
-            // f32 exp of an argument up to ~30: relative error ≤ ~30 × 2⁻²³ ≈ 4e-6, plus storage.
-            assert!(
-                (got - p).abs() <= 1e-5 * p + 1e-30,
-                "({x}, {y}): {got} vs {p}"
-            );
-        }
-        assert_eq!(g.p22(Vec2::new(f32::NAN, 0.0)), 0.0);
-        assert_eq!(g.p22(Vec2::new(f32::INFINITY, 0.0)), 0.0);
-    }
-
-    #[test]
-    fn masking_identities_hold() {
-        let g = lobe(0.4, 0.1, 0.3, 0.2, 0.5);
-        for &(x, y, z) in &[
-            (0.0f32, 0.0f32, 1.0f32),
-            (0.5, 0.1, 0.8),
-            (-0.9, 0.2, 0.3),
-            (0.9, 0.3, 0.1),
-        ] {
-            let w = Vec3::new(x, y, z).normalize();
-            let parts = g.visible_area_parts(w);
-            let a = g.projected_area(w);
-            let v = g.visible_area(w);
-            assert_eq!(parts.visible_area, v);
-            assert_eq!(parts.signed_area.max(0.0), a);
-            assert!(v >= a && v > 0.0);
-            let l = g.lambda(w);
-            if a > 0.0 {
-                // V = A (1 + Λ) to f32 rounding of the three values.
-                assert!((a * (1.0 + l) - v).abs() <= 4e-7 * v, "{a} {l} {v}");
-            } else {
-                assert_eq!(l, f32::MAX);
-            }
-        }
-        assert_eq!(g.lambda(Vec3::Z), 0.0);
-        assert_eq!(g.visible_area(Vec3::Z), 1.0);
-    }
-
-    #[test]
-    fn invalid_directions_give_zero() {
-        let g = lobe(0.4, 0.1, 0.3, 0.2, 0.5);
-        for w in [
-            Vec3::new(0.0, 0.0, -1.0),
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::ZERO,
-            Vec3::new(f32::NAN, 0.0, 1.0),
-            Vec3::new(0.0, f32::INFINITY, 1.0),
-        ] {
-            assert_eq!(g.d(w), 0.0);
-            assert_eq!(g.lambda(w), 0.0);
-            assert_eq!(g.projected_area(w), 0.0);
-            assert_eq!(g.visible_area(w), 0.0);
-            assert_eq!(g.signed_projected_area(w), 0.0);
-            assert_eq!(g.pdf_visible(w, Vec3::Z), 0.0);
-            assert_eq!(g.pdf_visible(Vec3::Z, w), 0.0);
-            assert_eq!(g.g1(w, Vec3::Z), 0.0);
-            let m = g.sample_visible(w, Vec2::new(0.3, 0.6));
-            assert!(m.z > 0.0 && (m.length() - 1.0).abs() < 1e-6);
-        }
-    }
-
-    #[test]
-    fn from_moments_floors_and_clamps() {
-        // A constant slope (0.2, −0.1): variances 0, so σ = σ_min on both axes, c = 0.
-        let (x, y) = (0.2f32, -0.1f32);
-        let g = SlopeGaussian::from_moments([x, y, x * x, y * y, x * y], 0.01);
-        let cov = g.covariance();
-        assert_eq!(g.mean(), Vec2::new(x, y));
-        // f32 rounding of E[x̃]² vs E[x̃²] leaves |var| ≲ 1e-8 < σ_min² = 1e-4: the floor wins.
-        assert!((cov.x_axis.x - 1e-4).abs() < 1e-10 && (cov.y_axis.y - 1e-4).abs() < 1e-10);
-        assert!(cov.x_axis.y.abs() < 1e-10);
-
-        // Perfect correlation along the diagonal: var = 0.05 on both axes, c = 0.05 (ρ = 1).
-        let g = SlopeGaussian::from_moments([0.0, 0.0, 0.05, 0.05, 0.05], 0.01);
-        let cov = g.covariance();
-        let (sxx, sxy, syy) = (
-            cov.x_axis.x as f64,
-            cov.x_axis.y as f64,
-            cov.y_axis.y as f64,
-        );
-        // c clamped to √((σx² − σ²)(σy² − σ²)) = 0.05 − 1e-4: minor eigenvalue exactly σ_min².
-        assert!((sxy - (0.05 - 1e-4)).abs() < 1e-8, "{sxy}");
-        let mean_eig = 0.5 * (sxx + syy);
-        let minor = mean_eig - (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt();
-        assert!((minor - 1e-4).abs() < 1e-8, "{minor}");
-
-        // Anti-correlated with distinct variances: clamp to −√((0.09 − σ²)(0.01 − σ²)).
-        let g = SlopeGaussian::from_moments([0.0, 0.0, 0.09, 0.01, -0.5], 0.01);
-        let c = g.covariance().x_axis.y as f64;
-        assert!(
-            (c + ((0.09f64 - 1e-4) * (0.01 - 1e-4)).sqrt()).abs() < 1e-8,
-            "{c}"
-        );
-
-        // A valid moment set is reproduced: σx = 0.3, σy = 0.1, ρ = 0.4, mean (0.5, 0.2).
-        let (mx, my, sx, sy, r) = (0.5f64, 0.2f64, 0.3f64, 0.1f64, 0.4f64);
-        let m = [
-            mx as f32,
-            my as f32,
-            (sx * sx + mx * mx) as f32,
-            (sy * sy + my * my) as f32,
-            (r * sx * sy + mx * my) as f32,
-        ];
-        let cov = SlopeGaussian::from_moments(m, 0.01).covariance();
-        // Moments rounded to f32 (relative 6e-8 of E[x̃²] ≈ 0.34): variances good to ~5e-8.
-        assert!((cov.x_axis.x as f64 - sx * sx).abs() < 1e-7);
-        assert!((cov.y_axis.y as f64 - sy * sy).abs() < 1e-7);
-        assert!((cov.x_axis.y as f64 - r * sx * sy).abs() < 1e-7);
-    }
-
-    #[test]
-    fn from_moments_fallbacks() {
-        let centred = |g: SlopeGaussian, s: f32| {
-            let cov = g.covariance();
-            g.mean() == Vec2::ZERO
-                && (cov.x_axis.x - s * s).abs() < 1e-6 * s * s
-                && (cov.y_axis.y - s * s).abs() < 1e-6 * s * s
-                && cov.x_axis.y == 0.0
-        };
-        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
-            for i in 0..5 {
-                let mut m = [0.1, 0.2, 0.3, 0.3, 0.0];
-                m[i] = bad;
-                assert!(centred(SlopeGaussian::from_moments(m, 0.02), 0.02));
-            }
-        }
-        // Bad sigma_min → DEFAULT_SIGMA_MIN; tiny sigma_min → SIGMA_MIN_FLOOR.
-        let flat = [0.0, 0.0, 0.0, 0.0, 0.0];
-        assert!(centred(
-            SlopeGaussian::from_moments(flat, f32::NAN),
-            DEFAULT_SIGMA_MIN
-        ));
-        assert!(centred(
-            SlopeGaussian::from_moments(flat, -1.0),
-            DEFAULT_SIGMA_MIN
-        ));
-        assert!(centred(
-            SlopeGaussian::from_moments(flat, 1e-20),
-            SIGMA_MIN_FLOOR
-        ));
-        // Huge second moments beyond f32-representable lobes: fallback, not a panic.
-        let g = SlopeGaussian::from_moments([0.0, 0.0, f32::MAX, f32::MAX, 0.0], 0.01);
-        assert!(g.d(Vec3::Z).is_finite());
-    }
-
-    #[test]
-    fn bad_constructor_input_names_the_parameter() {
-        let id = Mat2::IDENTITY;
-        let e = SlopeGaussian::new(Vec2::new(f32::NAN, 0.0), id).unwrap_err();
-        assert!(
-            matches!(e, Error::InvalidParameter { name: "mean", .. }),
-            "{e}"
-        );
-        let cases = [
-            Mat2::from_cols_array(&[f32::NAN, 0.0, 0.0, 1.0]),
-            Mat2::from_cols_array(&[1.0, 0.5, 0.0, 1.0]),
-            Mat2::from_cols_array(&[1.0, 2.0, 2.0, 1.0]),
-            Mat2::from_cols_array(&[-1.0, 0.0, 0.0, 1.0]),
-            Mat2::from_cols_array(&[0.0, 0.0, 0.0, 1.0]),
-            Mat2::from_cols_array(&[1e-45, 0.0, 0.0, 1e-45]),
-        ];
-        for cov in cases {
-            let e = SlopeGaussian::new(Vec2::ZERO, cov).unwrap_err();
-            assert!(matches!(e, Error::InvalidMatrix { name: "cov", .. }), "{e}");
-            assert!(e.to_string().contains("cov"));
-        }
-        for (ax, ay, name) in [(0.0, 0.1, "alpha_x"), (0.1, f32::NAN, "alpha_y")] {
-            let e = SlopeGaussian::beckmann(ax, ay).unwrap_err();
-            assert!(e.to_string().contains(name), "{e}");
-        }
-    }
-
-    #[test]
-    fn pdf_visible_is_zero_exactly_where_d_is_when_v_underflows() {
-        // σ = 0.05, mean slope (1, 0), view from the side the lobe is tilted away from, 80°:
-        // a = (cot 80° − 1)/0.05 ≈ −16.5, V ≈ 0.05 φ(16.5)/16.5² ≈ 1e-63: below f32.
-        let g = lobe(1.0, 0.0, 0.05, 0.05, 0.0);
-        let wo = Vec3::new(80f32.to_radians().sin(), 0.0, 80f32.to_radians().cos());
-        assert_eq!(g.visible_area(wo), 0.0);
-        assert_eq!(g.lambda(wo), f32::MAX);
-        // The normals facing wo lie ~16 σ out, where D itself rounds to 0 in f32: the pdf is
-        // positive exactly where D is (the pdf contract: d = 0 ⇒ pdf_visible = 0), finite always.
-        for i in 0..50 {
-            let u = Vec2::new((i as f32 + 0.5) / 50.0, ((i * 7) % 50) as f32 / 50.0 + 0.01);
-            let m = g.sample_visible(wo, u);
-            assert!(m.z > 0.0 && wo.dot(m) > 0.0);
-            let p = g.pdf_visible(wo, m);
-            assert!(
-                p.is_finite() && (p > 0.0) == (g.d(m) > 0.0),
-                "{m} {p} {}",
-                g.d(m)
-            );
-        }
-    }
-}
+mod tests;

@@ -3,12 +3,13 @@
 //! the filtered mixture of a large footprint (gmm.rs, for the mixture and position-normal), with
 //! the terms of \[Chermain2019\] eq. 9-17 over its lobes:
 //!
-//! - D(m) = Σ w_i D_i(m) over the lobes whose slope box holds m's slope: the box of the ellipse
+//! - D(m) = Σ w_i D_i(m) over the lobes whose slope box holds m's slope (their P22 summed at one
+//!   slope in `f64`, times the shared Jacobian (1 + |ñ|²)²): the box of the ellipse
 //!   holding 1 − [`BOX_TAIL`] of the lobe (k = √(−2 ln tail) standard deviations per axis), so that a
 //!   query costs a box test per lobe and a density only where it contributes (as the mixture's
 //!   slope boxes at its default tail);
 //! - A(w) = max(cos θ − w_xy·μ, 0), μ = Σ w_i μ_i (the signed areas summed, as the mixture's);
-//! - V(w) = Σ w_i V_i(w) (exact, O(lobes));
+//! - V(w) = Σ w_i V_i(w) (exact up to the lanes' 10⁻⁶, O(lobes), the ramp term over 16 lanes);
 //! - `sample_normal`: a lobe ∝ w_i, then its slope Gaussian; density Σ w_i D_i(m) cos θ_m;
 //! - `sample_visible`: a lobe ∝ w_i V_i(wo), then its visible normal; density
 //!   Σ w_i ⟨wo, m⟩⁺ D_i(m) / V(wo).
@@ -17,10 +18,17 @@
 //! ([`Few::One`]) or a set lent by the caller's scratch ([`Few::Set`]), so that neither a patch's
 //! size nor a shading loop's allocations grow with the set.
 
+use super::lanes::{LANES, ramp_neg_lanes};
 use super::prepared_view::PreparedView;
 use crate::glint::scratch::Lent;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Vec2, Vec3};
+
+/// `v` if finite, else 0.
+#[inline]
+fn finite_or_zero(v: f32) -> f32 {
+    if v.is_finite() { v } else { 0.0 }
+}
 
 /// A weighted set of slope Gaussians (module docs).
 #[derive(Clone, Debug, Default)]
@@ -30,12 +38,17 @@ pub(crate) struct LobeSet {
     g: Vec<SlopeGaussian>,
     /// Slope boxes [min x, min y, max x, max y] (module docs).
     boxes: Vec<[f32; 4]>,
-    /// Per lobe, √(Σxx + Σyy) ≥ the largest standard deviation of its slope along any direction.
-    spread: Vec<f32>,
     /// V(wo) at the view the set was prepared for ([`LobeSet::prepare_view`]); reset by every
     /// change of the set.
     view: PreparedView,
+    /// At the prepared view, each lobe's w_i V_i(wo) (the visible sampler's pick weights, whose
+    /// sum is V(wo)); empty when no view is prepared.
+    view_lobes: Vec<f32>,
 }
+
+/// The largest t = |A_s|/s_w at which a lobe wholly behind w takes the lanes' G(−t) (≈ 4·10⁻³⁴ there,
+/// within the lanes' stated error); beyond it the lobe's own `f64` V.
+const LANE_RAMP_MAX: f64 = 12.0;
 
 /// Mass of a lobe left outside its slope box: 10⁻⁶, the mixture's default slope tail.
 pub(crate) const BOX_TAIL: f64 = 1.0e-6;
@@ -74,8 +87,13 @@ impl LobeSet {
         self.w.clear();
         self.g.clear();
         self.boxes.clear();
-        self.spread.clear();
+        self.unprepare();
+    }
+
+    /// Forgets the prepared view (every change of the set calls it).
+    fn unprepare(&mut self) {
         self.view = PreparedView::NONE;
+        self.view_lobes.clear();
     }
 
     /// Adds a lobe of weight `w` (ignored unless `w` is positive and finite).
@@ -93,15 +111,14 @@ impl LobeSet {
             self.g.push(g);
             self.boxes
                 .push([m.x - half.x, m.y - half.y, m.x + half.x, m.y + half.y]);
-            self.spread.push(half.length() / box_sigmas());
             self.n += 1;
-            self.view = PreparedView::NONE;
+            self.unprepare();
         }
     }
 
     /// Scales the weights to sum to 1 (an empty set stays empty).
     pub fn normalise(&mut self) {
-        self.view = PreparedView::NONE;
+        self.unprepare();
         let sum: f32 = self.weights().iter().sum();
         if sum > 0.0 {
             for w in &mut self.w[..self.n] {
@@ -114,10 +131,21 @@ impl LobeSet {
     /// and read by the queries at that wo (`view_visible_area`, the visible densities); queries at
     /// any other view compute their own, and every value is the unprepared set's, bit for bit.
     pub fn prepare_view(&mut self, wo: Vec3) {
-        self.view = PreparedView::NONE;
+        self.unprepare();
         if self.n > 1 && wo.z > 0.0 && wo.is_finite() {
-            self.view = PreparedView::new(wo, self.visible_area(wo) as f64);
+            let mut lobes = core::mem::take(&mut self.view_lobes);
+            lobes.resize(self.n, 0.0);
+            self.lobe_areas(wo, &mut lobes);
+            // The sum as `visible_area` forms it (the same terms in the same order).
+            let v: f32 = lobes.iter().sum();
+            self.view = PreparedView::new(wo, finite_or_zero(v) as f64);
+            self.view_lobes = lobes;
         }
+    }
+
+    /// The pick weights w_i V_i(wo) at the prepared view, if `wo` is it.
+    fn prepared_lobes(&self, wo: Vec3) -> Option<&[f32]> {
+        (self.view_lobes.len() == self.n && self.view.is(wo)).then_some(&self.view_lobes[..])
     }
 
     /// Number of lobes.
@@ -139,25 +167,16 @@ impl LobeSet {
         self.iter().map(|(w, g)| w * g.mean()).sum()
     }
 
-    /// Picks lobe i with probability ∝ `p(i)` (each evaluated once), rescaling `u` into [0, 1) for
-    /// the lobe's own draw.
-    fn pick(&self, p: impl Fn(usize) -> f32, u: f32) -> Option<(usize, f32)> {
-        // The probabilities of the first `STACK` lobes on the stack (a filtered mixture has ≤ 32),
-        // the rest evaluated again in the scan.
-        const STACK: usize = 32;
-        let mut first = [0.0f32; STACK];
-        for (i, f) in first.iter_mut().enumerate().take(self.n) {
-            *f = p(i);
-        }
-        let total: f32 = first.iter().sum::<f32>() + (STACK..self.n).map(&p).sum::<f32>();
+    /// Picks lobe i with probability ∝ `p[i]`, rescaling `u` into [0, 1) for the lobe's own draw.
+    fn pick(p: &[f32], u: f32) -> Option<(usize, f32)> {
+        let total: f32 = p.iter().sum();
         if !(total > 0.0 && total.is_finite()) {
             return None;
         }
         let target = u.clamp(0.0, 1.0) * total;
         let mut acc = 0.0;
         let mut last = None;
-        for i in 0..self.n {
-            let pi = first.get(i).copied().unwrap_or_else(|| p(i));
+        for (i, &pi) in p.iter().enumerate() {
             if pi <= 0.0 {
                 continue;
             }
@@ -173,17 +192,55 @@ impl LobeSet {
 }
 
 impl LobeSet {
-    /// V_i(w) of lobe i, the number `SlopeGaussian::visible_area` returns: where the lobe lies
-    /// wholly in front of w (A_s > 8 s_w, checked with the bound s_w ≤ spread · |w_xy|), V_i = A_s
-    /// exactly, computed as that function computes it without its per-lobe square root.
-    #[inline]
-    fn lobe_visible_area(&self, i: usize, w: Vec3, w_xy: f32) -> f32 {
-        let m = self.g[i].mean();
-        let a_s = w.z as f64 - (m.x as f64 * w.x as f64 + m.y as f64 * w.y as f64);
-        if a_s > 8.0 * (self.spread[i] * w_xy) as f64 * (1.0 + 1e-6) {
-            crate::math::finite_or_zero(a_s)
+    /// w_i V_i(w) of every lobe into `out` (its length, at most the set's), for a usable w (w_z > 0,
+    /// finite): V_i = A_s⁺ + s_w G(−|A_s|/s_w) (the two branches of `SlopeGaussian::visible_area`
+    /// in one form, since G(z) = z + G(−z)), A_s and s_w per lobe in `f64`, G over
+    /// [`LANES`] lanes ([`ramp_neg_lanes`], relative error < 10⁻⁶). A lobe wholly behind w by more
+    /// than [`LANE_RAMP_MAX`] of its s_w, where the lanes' G leaves `f32`'s normal range, takes
+    /// the lobe's own `f64` V.
+    fn lobe_areas(&self, w: Vec3, out: &mut [f32]) {
+        for (c, chunk) in out.chunks_mut(LANES).enumerate() {
+            let base = c * LANES;
+            let mut a = [0.0f64; LANES];
+            let mut sw = [0.0f64; LANES];
+            let mut t = [0.0f64; LANES];
+            for (k, g) in self.g[base..base + chunk.len()].iter().enumerate() {
+                let (ak, sk) = g.area_and_spread(w);
+                (a[k], sw[k], t[k]) = (ak, sk, ak.abs() / sk);
+            }
+            // A lobe wholly in front of w by more than 8 s_w has V = A_s to `f64` resolution
+            // (G(−t)/t < 10⁻¹⁷ there): a chunk of such lobes skips the ramp.
+            let mut ramp = [0.0f32; LANES];
+            if (0..chunk.len()).any(|k| !(a[k] > 0.0 && t[k] > 8.0)) {
+                ramp_neg_lanes(&t, &mut ramp);
+            }
+            for (k, out) in chunk.iter_mut().enumerate() {
+                let i = base + k;
+                let v = if a[k] < 0.0 && t[k] > LANE_RAMP_MAX {
+                    self.g[i].visible_area(w)
+                } else {
+                    finite_or_zero((a[k].max(0.0) + sw[k] * ramp[k] as f64) as f32)
+                };
+                *out = self.w[i] * v;
+            }
+        }
+    }
+
+    /// The pick weights w_i V_i(wo) into a buffer of the set's length (the prepared ones at the
+    /// prepared view), then `f` of them.
+    fn with_pick_weights<R>(&self, wo: Vec3, f: impl FnOnce(&[f32]) -> R) -> R {
+        if let Some(p) = self.prepared_lobes(wo) {
+            return f(p);
+        }
+        const STACK: usize = 64;
+        if self.n <= STACK {
+            let mut buf = [0.0f32; STACK];
+            self.lobe_areas(wo, &mut buf[..self.n]);
+            f(&buf[..self.n])
         } else {
-            self.g[i].visible_area(w)
+            let mut buf = vec![0.0f32; self.n];
+            self.lobe_areas(wo, &mut buf);
+            f(&buf)
         }
     }
 
@@ -203,14 +260,19 @@ impl Ndf for LobeSet {
         let Some(s) = crate::frame::normal_to_slope(m) else {
             return 0.0;
         };
-        let mut sum = 0.0;
+        // The slope and the Jacobian (1 + |ñ|²)² once in `f64`, as `SlopeGaussian::d` forms them
+        // per lobe; the lobes' P22 summed in `f64` and rounded once.
+        let (sx, sy) = (-(m.x as f64) / m.z as f64, -(m.y as f64) / m.z as f64);
+        let mut sum = 0.0f64;
         for i in 0..self.n {
             let b = &self.boxes[i];
             if s.x >= b[0] && s.x <= b[2] && s.y >= b[1] && s.y <= b[3] {
-                sum += self.w[i] * self.g[i].d(m);
+                sum += self.w[i] as f64 * self.g[i].p22_f64(sx, sy);
             }
         }
-        sum
+        let j = 1.0 + sx * sx + sy * sy;
+        // Beyond `f32::MAX` clamped to it, as each lobe's D is.
+        (sum * j * j).min(f32::MAX as f64) as f32
     }
 
     fn lambda(&self, w: Vec3) -> f32 {
@@ -241,11 +303,8 @@ impl Ndf for LobeSet {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
         }
-        let w_xy = Vec2::new(w.x, w.y).length();
-        let v: f32 = (0..self.n)
-            .map(|i| self.w[i] * self.lobe_visible_area(i, w, w_xy))
-            .sum();
-        if v.is_finite() { v } else { 0.0 }
+        let v: f32 = self.with_pick_weights(w, |p| p.iter().sum());
+        finite_or_zero(v)
     }
 
     /// V(wo): the prepared value at the prepared view ([`LobeSet::prepare_view`]), else one pass.
@@ -257,7 +316,7 @@ impl Ndf for LobeSet {
         if let Some(g) = self.single() {
             return g.sample_normal(u);
         }
-        match self.pick(|i| self.w[i], u.x) {
+        match Self::pick(self.weights(), u.x) {
             Some((i, ux)) => self.g[i].sample_normal(Vec2::new(ux, u.y)),
             None => Vec3::Z,
         }
@@ -270,8 +329,7 @@ impl Ndf for LobeSet {
         if !(wo.z > 0.0 && wo.is_finite()) {
             return self.sample_normal(u);
         }
-        let w_xy = Vec2::new(wo.x, wo.y).length();
-        match self.pick(|i| self.w[i] * self.lobe_visible_area(i, wo, w_xy), u.x) {
+        match self.with_pick_weights(wo, |p| Self::pick(p, u.x)) {
             Some((i, ux)) => self.g[i].sample_visible(wo, Vec2::new(ux, u.y)),
             None => self.sample_normal(u),
         }
@@ -396,5 +454,103 @@ impl Ndf for Few<'_> {
 
     fn pdf_visible_over_cos_given_d(&self, wo: Vec3, m: Vec3, d_m: f32) -> f32 {
         with_few!(self, 0.0, |n| n.pdf_visible_over_cos_given_d(wo, m, d_m))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Mat2;
+
+    /// A set of narrow and wide, tilted lobes (some wholly behind grazing views).
+    fn set() -> LobeSet {
+        let mut s = LobeSet::default();
+        let lobes = [
+            (0.2, [0.0, 0.0], [0.1, 0.1]),
+            (0.1, [0.8, -0.3], [0.02, 0.05]),
+            (0.3, [-2.0, 1.0], [0.01, 0.01]),
+            (0.15, [0.1, 0.4], [1.2, 0.6]),
+            (0.25, [3.0, 0.0], [0.05, 0.3]),
+        ];
+        for k in 0..4 {
+            for (w, m, sd) in lobes {
+                let mean = Vec2::new(m[0] + 0.1 * k as f32, m[1]);
+                let cov = Mat2::from_diagonal(Vec2::new(sd[0] * sd[0], sd[1] * sd[1]));
+                s.push(w, SlopeGaussian::new(mean, cov).unwrap());
+            }
+        }
+        s.normalise();
+        s
+    }
+
+    fn dir(theta: f32, phi: f32) -> Vec3 {
+        let (t, p) = (theta.to_radians(), phi.to_radians());
+        Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+    }
+
+    /// V over lanes against the lobes' own `f64` V (erfc), and D at one slope against the lobes'
+    /// own D, summed: within the lanes' 10⁻⁶ (and `f32` rounding; D also within the slope boxes'
+    /// tails), at views up to 89.9°.
+    #[test]
+    fn lane_terms_match_the_lobes_own() {
+        let s = set();
+        assert_eq!(s.len(), 20);
+        for (t, p) in [
+            (0.0, 0.0),
+            (30.0, 10.0),
+            (60.0, 100.0),
+            (80.0, 190.0),
+            (89.9, 300.0),
+        ] {
+            let w = dir(t, p);
+            let want: f64 = s
+                .iter()
+                .map(|(wi, g)| wi as f64 * g.visible_area(w) as f64)
+                .sum();
+            let got = s.visible_area(w) as f64;
+            assert!(
+                (got - want).abs() <= 2e-6 * want,
+                "V at {t}°: {got} against {want}"
+            );
+            for k in 0..200 {
+                let m = dir(60.0 * (k as f32 / 200.0), 37.0 * k as f32);
+                let want: f64 = s.iter().map(|(wi, g)| wi as f64 * g.d(m) as f64).sum();
+                // A lobe whose slope box misses m is left out: its P22 there is at most
+                // 10⁻⁶ (`BOX_TAIL`) of its peak.
+                let sl = crate::frame::normal_to_slope(m).unwrap();
+                let j = (1.0 + sl.length_squared() as f64).powi(2);
+                let tails: f64 = s
+                    .iter()
+                    .map(|(wi, g)| wi as f64 * g.p22(g.mean()) as f64 * BOX_TAIL * j)
+                    .sum();
+                let got = s.d(m) as f64;
+                assert!(
+                    (got - want).abs() <= 1e-6 * want + tails,
+                    "D: {got} against {want}"
+                );
+            }
+        }
+    }
+
+    /// The prepared view's pick weights are the terms of V(wo): the prepared set samples and
+    /// answers as the unprepared one, bit for bit, at the prepared view and at another.
+    #[test]
+    fn prepared_set_samples_as_the_unprepared_one() {
+        let plain = set();
+        let mut prepared = set();
+        let wo = dir(70.0, 40.0);
+        prepared.prepare_view(wo);
+        for w in [wo, dir(20.0, 250.0)] {
+            assert_eq!(prepared.view_visible_area(w), plain.view_visible_area(w));
+            for k in 0..64 {
+                let u = Vec2::new((k as f32 + 0.5) / 64.0, (k * 29 % 64) as f32 / 64.0);
+                let m = plain.sample_visible(w, u);
+                assert_eq!(prepared.sample_visible(w, u), m);
+                assert_eq!(prepared.pdf_visible(w, m), plain.pdf_visible(w, m));
+            }
+        }
+        // A change of the set forgets the view.
+        prepared.push(0.1, SlopeGaussian::beckmann(0.3, 0.3).unwrap());
+        assert!(prepared.prepared_lobes(wo).is_none());
     }
 }

@@ -5,6 +5,8 @@
 //!   level (what the models' `filtered_tolerance` is compared with).
 //! - gmm.rs: the filtered mixture, a mip chain of few-lobe Gaussian mixtures over a lobe grid;
 //!   gmm_residual.rs its nodes' residuals, gmm_store.rs the chain in a model's file.
+//! - lanes.rs: lane arithmetic that vectorises (`exp2`, the ramp term of V), for the mixture's
+//!   lobe blocks and the lobe sets.
 //! - lobe_set.rs: a small weighted set of slope Gaussians, the few-lobe patches' P-NDF.
 //! - mip.rs: trilinear addressing of mip chains over a lobe grid.
 //! - prepared_view.rs: a value a patch computes once for the view it is prepared for (V(wo)).
@@ -18,6 +20,7 @@ pub(crate) mod gmm;
 pub(crate) mod gmm_reduce;
 pub(crate) mod gmm_residual;
 pub(crate) mod gmm_store;
+pub(crate) mod lanes;
 pub(crate) mod lobe_set;
 pub(crate) mod mip;
 pub(crate) mod prepared_view;

@@ -37,6 +37,12 @@ impl PreparedView {
         }
     }
 
+    /// Whether `w` is the prepared direction (the same bits).
+    #[inline]
+    pub(crate) fn is(&self, w: Vec3) -> bool {
+        self.key == Some(key_of(w))
+    }
+
     /// The prepared value if `w` is the prepared direction, else `compute()` (not kept).
     #[inline]
     pub(crate) fn get_or(&self, w: Vec3, compute: impl FnOnce() -> f64) -> f64 {

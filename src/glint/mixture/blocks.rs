@@ -14,8 +14,8 @@
 //! of lanes.rs. The loops over blocks that call these kernels are in passes.rs, compiled per
 //! storage and per instruction set (simd.rs).
 
-pub(super) use super::lanes::LANES;
-use super::lanes::{exp2_lanes, ramp_neg_lanes, select};
+pub(super) use crate::glint::kernels::lanes::LANES;
+use crate::glint::kernels::lanes::{exp2_lanes, ramp_neg_lanes, select};
 use crate::glint::kernels::slope_tree::{SlopeTree, contains};
 use crate::ndf::SlopeGaussian;
 use glam::{Vec2, Vec3};

@@ -10,10 +10,10 @@
 //! Generic over the storage ([`LobeStore`], [`LevelView`]): compiled once per storage.
 
 use super::blocks::SIDE;
-use super::lanes::LANES;
 use super::params::{PatchOptions, SeedKernel};
 use super::storage::{LevelView, LobeStore};
 use crate::glint::Footprint;
+use crate::glint::kernels::lanes::LANES;
 use crate::glint::scratch::Lent;
 use glam::Vec2;
 

@@ -32,7 +32,7 @@
 //! modules may also build mixtures through the public API):
 //! 1. `params.rs`: build parameters, per-query options, `DEFAULT_*` constants, [`MixtureMemory`];
 //! 2. `build.rs` (QMC moments), `build_filter.rs` (the separable filter's moments);
-//! 3. `lanes.rs` (lane arithmetic: `exp2`, the ramp term), `blocks.rs` (the 4 × 4 lobe blocks, their
+//! 3. src/glint/kernels/lanes.rs (lane arithmetic: `exp2`, the ramp term), `blocks.rs` (the 4 × 4 lobe blocks, their
 //!    lane kernels and the walk to them), `simd.rs` (the baseline and AVX2 copies of the block loops);
 //! 4. `hierarchy.rs` (slope boxes, moment mip chain), `levels.rs` (merged levels of detail and
 //!    their error bounds); the filtered mixture's kernels (a few weighted lobes evaluated by brute
@@ -61,7 +61,6 @@ mod dispatch_tests;
 mod full;
 mod gather;
 mod hierarchy;
-mod lanes;
 mod levels;
 mod measured;
 mod model;

@@ -6,9 +6,9 @@
 
 use super::blocks::{self, LobeBlock, SIDE};
 use super::gather::Gathered;
-use super::lanes::LANES;
 use super::simd::{BlockPass, Isa};
 use super::storage::LevelView;
+use crate::glint::kernels::lanes::LANES;
 use glam::{Vec2, Vec3};
 
 /// Calls `f(block, lane weights, bx, by)` for every lobe block of the patch, rectangle by rectangle,

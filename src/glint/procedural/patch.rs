@@ -320,8 +320,16 @@ fn ggx_patch<'a>(
             (tau2[0].sqrt() * z[0] as f64) as f32,
             (tau2[1].sqrt() * z[1] as f64) as f32,
         );
-        let cov = Mat2::from_diagonal(Vec2::new(beta2[0] as f32, beta2[1] as f32));
-        if let Ok(g) = SlopeGaussian::new(mean, cov) {
+        // The diagonal covariance's Cholesky factor directly (a lobe wider than `MAX_SLOPE`, which
+        // `SlopeGaussian::new` refuses, is left out as it would be).
+        let max_var = (crate::glint::MAX_SLOPE as f64).powi(2);
+        let lobe = (beta2[0] <= max_var && beta2[1] <= max_var)
+            .then(|| {
+                let [lx, ly] = beta2.map(|b| b.sqrt() as f32);
+                SlopeGaussian::from_mean_cholesky(mean, lx, 0.0, ly)
+            })
+            .flatten();
+        if let Some(g) = lobe {
             // Slope boxes of 1 − 10⁻¹², as the Beckmann surface's facet lobes.
             let half = box_half_widths(&g) * std::f32::consts::SQRT_2;
             set.push_with_half_widths(cand.w[i] * scale, g, half);

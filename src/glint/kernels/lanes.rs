@@ -1,11 +1,12 @@
-//! Lane arithmetic of the lobe blocks' kernels (blocks.rs): the exponential [`exp2_lanes`], a
+//! Lane arithmetic of the mixture's lobe blocks (src/glint/mixture/blocks.rs) and of the few-lobe
+//! sets (lobe_set.rs): the exponential [`exp2_lanes`], a
 //! polynomial of stated error that vectorises (std's `exp` is a library call per lane), and V_P's
 //! ramp term G(−t), [`ramp_neg_lanes`]: one fitted exponent and one such exponential, no `erfc`
 //! call. Branch-free (selects by bit masks), so the lane loops that call them vectorise; each error
 //! bound is measured by the tests below.
 
 /// Lanes per block (a block is a tile of 4 × 4 lobes, blocks.rs).
-pub(super) const LANES: usize = 16;
+pub(crate) const LANES: usize = 16;
 
 /// 2^x for x ≤ 0 in `f32`, branch-free (vectorisable); 0 below −126 (the normal range).
 ///
@@ -15,7 +16,7 @@ pub(super) const LANES: usize = 16;
 /// [−126, 0]: < 1·10⁻⁶ stated (Horner roundings, a few ulp), measured in `tests::exp2_error`.
 /// x > 0 is clamped to 0 (the kernels only need x ≤ 0); NaN gives 0.
 #[inline(always)]
-pub(super) fn exp2_lanes(x: f32) -> f32 {
+pub(crate) fn exp2_lanes(x: f32) -> f32 {
     const ROUND: f32 = 12_582_912.0; // 1.5 · 2²³: x + ROUND rounds x to an integer in the low bits
     // All-ones if x ≥ −126, else 0 (NaN too): a bit mask, not a branch.
     let keep = ((x >= -126.0) as u32).wrapping_neg();
@@ -48,7 +49,7 @@ fn exp2_poly(f: f32) -> f32 {
 
 /// `v` where `keep`, else +0.0, by a bit mask (branch-free; vectorises as an `and`).
 #[inline(always)]
-pub(super) fn select(keep: bool, v: f32) -> f32 {
+pub(crate) fn select(keep: bool, v: f32) -> f32 {
     f32::from_bits(v.to_bits() & (keep as u32).wrapping_neg())
 }
 
@@ -69,7 +70,7 @@ pub(super) fn select(keep: bool, v: f32) -> f32 {
 /// docs/slope_gaussian.md (G and V); \[AbramowitzStegun1964\] 26.2.14 (the continued fraction used
 /// for the fit's reference values); the τ substitution as in \[Press1992\] §6.2 (`erfcc`).
 #[inline(always)]
-pub(super) fn ramp_neg_lanes(t: &[f64; LANES], out: &mut [f32; LANES]) {
+pub(crate) fn ramp_neg_lanes(t: &[f64; LANES], out: &mut [f32; LANES]) {
     const INV_SQRT_2PI: f32 = 0.398_942_3;
     #[allow(clippy::excessive_precision)]
     const P: [f32; 10] = [
