@@ -360,6 +360,15 @@ fn sample_visible_slope_std(cot_theta: f32, tan_theta: f32, theta: f32, u: Vec2)
     Vec2::new(x, erfinv(2.0 * u.y.clamp(0.0, 1.0) - 1.0))
 }
 
+/// The x slope of [`sample_visible_slope_std`] alone: the standard visible slope along the view's
+/// azimuth, density ∝ (cot θ − x)⁺ e^(−x²), for `u` ∈ [0, 1] (the lobe of any Gaussian slope
+/// distribution seen from a side its mean facet faces, in its own standardised frame:
+/// `SlopeGaussian::sample_visible`).
+#[inline]
+pub(super) fn visible_slope_x_std(cot_theta: f32, tan_theta: f32, theta: f32, u: f32) -> f32 {
+    visible_slope_x::<true>(cot_theta, tan_theta, theta, u, HALLEY_SAFETY).0
+}
+
 /// The visible sampler's first iterate: q(θ, u) = (erf(cot θ) − b)/(1 + erf(cot θ)) ∈ [0, 1], the
 /// normalised distance of the root b from the top of its bracket, interpolated bilinearly in the
 /// 33 × 33 table of [`beckmann_guess::Q`] (regular in θ ∈ [0, π/2] and u ∈ [0, 1]; 4.4 KB; generated
