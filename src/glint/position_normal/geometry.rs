@@ -9,8 +9,6 @@
 use super::{PositionNormalMap, SIGMA_H_PER_SPACING};
 use crate::glint::Footprint;
 
-const TWO_PI: f64 = std::f64::consts::TAU;
-
 /// Per-footprint constants, positions in element units (element i has its centre at i + ½).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Geometry {
@@ -155,18 +153,6 @@ impl Geometry {
         ];
         (mean, cov)
     }
-}
-
-/// The 2D Gaussian density N(s; mean, cov) in `f64` (0 for a degenerate covariance).
-#[inline]
-pub(super) fn gaussian(s: [f64; 2], mean: [f64; 2], cov: [f64; 3]) -> f64 {
-    let det = cov[0] * cov[2] - cov[1] * cov[1];
-    if det.is_nan() || det <= 0.0 {
-        return 0.0;
-    }
-    let (dx, dy) = (s[0] - mean[0], s[1] - mean[1]);
-    let q = (cov[2] * dx * dx - 2.0 * cov[1] * dx * dy + cov[0] * dy * dy) / det;
-    (-0.5 * q).exp() / (TWO_PI * det.sqrt())
 }
 
 /// Segments of one axis: wrapped index ranges [lo, hi] (inclusive) with the offset that unwraps them.

@@ -10,7 +10,7 @@
 
 use super::build::slope_box;
 use super::filtered::footprint_in_elements;
-use super::geometry::{Geometry, gaussian, segments};
+use super::geometry::{Geometry, segments};
 use super::{PatchOptions, PositionNormalMap, SIGMA_H_PER_SPACING};
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
@@ -34,6 +34,10 @@ pub(crate) struct Slots {
     /// Cumulative weights (last = Σ weights).
     cdf: Vec<f64>,
     lobes: Vec<SlopeGaussian>,
+    /// Per element of the footprint's rectangle (row-major, unwrapped coordinates), its slot
+    /// (index into `weights` and `lobes`), or `u32::MAX` where the element is not kept: so that D,
+    /// which walks the elements by slope box, sums the same lobes as the densities.
+    index: Vec<u32>,
 }
 
 /// The position-normal P-NDF of one footprint of a [`PositionNormalMap`]: an [`Ndf`].
@@ -77,8 +81,6 @@ pub struct PositionNormalPatch<'a> {
     map: &'a PositionNormalMap,
     geo: Geometry,
     rect: [[i64; 2]; 2],
-    /// 1 / Σ w_i over the kept elements.
-    inv_total: f64,
     /// Number of kept elements.
     count: usize,
     mean_slope: Vec2,
@@ -158,7 +160,6 @@ impl<'a> PositionNormalPatch<'a> {
             map,
             geo: Geometry::new(map, footprint, f32::INFINITY),
             rect: [[0, -1], [0, -1]],
-            inv_total: 0.0,
             count: 0,
             mean_slope: Vec2::new(moments[0], moments[1]),
             moments,
@@ -217,12 +218,18 @@ impl<'a> PositionNormalPatch<'a> {
             weights,
             cdf,
             lobes,
+            index,
         } = &mut *slots;
         weights.clear();
         lobes.clear();
         cdf.clear();
+        index.clear();
+        let rect_width = (rect[0][1] - rect[0][0] + 1).max(0) as usize;
+        let rect_height = (rect[1][1] - rect[1][0] + 1).max(0) as usize;
+        index.resize(rect_width * rect_height, u32::MAX);
         let sigma_r = map.params.sigma_r;
-        Self::for_each_kept(map, &geo, rect, |w, mean, cov| {
+        Self::for_each_kept(map, &geo, rect, |at, w, mean, cov| {
+            index[at] = weights.len() as u32;
             total += w;
             count += 1;
             acc[0] += w * mean[0];
@@ -247,7 +254,6 @@ impl<'a> PositionNormalPatch<'a> {
             map,
             geo,
             rect,
-            inv_total,
             count,
             mean_slope: Vec2::new(moments[0], moments[1]),
             moments,
@@ -264,18 +270,21 @@ impl<'a> PositionNormalPatch<'a> {
         map: &PositionNormalMap,
         geo: &Geometry,
         rect: [[i64; 2]; 2],
-        mut f: impl FnMut(f64, [f64; 2], [f64; 3]),
+        mut f: impl FnMut(usize, f64, [f64; 2], [f64; 3]),
     ) {
         let [nx, ny] = map.grid;
+        let mut at = 0;
         for j in rect[1][0]..=rect[1][1] {
             let jw = j.rem_euclid(ny as i64) as usize;
             for i in rect[0][0]..=rect[0][1] {
+                let here = at;
+                at += 1;
                 let Some((w, d)) = geo.weight(i, j) else {
                     continue;
                 };
                 let iw = i.rem_euclid(nx as i64) as usize;
                 let (mean, cov) = geo.lobe(&map.elements[jw * nx + iw], d);
-                f(w, mean, cov);
+                f(here, w, mean, cov);
             }
         }
     }
@@ -338,20 +347,26 @@ impl<'a> PositionNormalPatch<'a> {
         if !s.is_finite() {
             return (0.0, 0);
         }
-        let (p, touched) = self.sum_p(s);
-        let c = 1.0 + s.length_squared() as f64;
-        let d = (p * self.inv_total * c * c) as f32;
+        // The slope in `f64` from the `f32` normal (as the densities form it), the `f32` slope
+        // only for the slope-box tests of the walk.
+        let sd = [-(m.x as f64) / m.z as f64, -(m.y as f64) / m.z as f64];
+        let (p, touched) = self.sum_p(s, sd);
+        let c = 1.0 + sd[0] * sd[0] + sd[1] * sd[1];
+        let d = (p * c * c) as f32;
         (if d.is_finite() { d } else { f32::MAX }, touched)
     }
 
-    /// Σ w_i N(ñ; μ_i, C_i) over the kept elements whose slope box contains ñ, by a depth-first walk
-    /// of the quadtree restricted to each (x segment × y segment) of the rectangle.
-    fn sum_p(&self, s: Vec2) -> (f64, usize) {
+    /// Σ W_i P22_i(ñ) over the kept elements whose slope box contains ñ (`s` the slope in `f32` for
+    /// the box tests, `sd` in `f64` for the lobes), by a depth-first walk of the quadtree restricted
+    /// to each (x segment × y segment) of the rectangle; W_i and P22_i are the slot's normalised
+    /// weight and `f32` lobe, the terms the densities sum.
+    fn sum_p(&self, s: Vec2, sd: [f64; 2]) -> (f64, usize) {
         let map = self.map;
         let tree = &map.tree;
         let [nx, ny] = map.grid;
         let sigma_h = SIGMA_H_PER_SPACING * map.spacing;
-        let sd = [s.x as f64, s.y as f64];
+        let (rect, slots) = (self.rect, self.slots());
+        let width = (rect[0][1] - rect[0][0] + 1).max(0) as usize;
         let mut acc = 0.0f64;
         let mut touched = 0usize;
         for (x_lo, x_hi, x_off) in segments(self.rect[0], nx) {
@@ -362,12 +377,16 @@ impl<'a> PositionNormalPatch<'a> {
                     if !contains(&slope_box(e, sigma_h, &map.params), s) {
                         return;
                     }
-                    let Some((w, d)) = self.geo.weight(x as i64 + x_off, y as i64 + y_off) else {
+                    let (i, j) = (x as i64 + x_off - rect[0][0], y as i64 + y_off - rect[1][0]);
+                    let Some(&k) = slots.index.get(j as usize * width + i as usize) else {
                         return;
                     };
+                    if k == u32::MAX {
+                        return;
+                    }
                     touched += 1;
-                    let (mean, cov) = self.geo.lobe(e, d);
-                    acc += w * gaussian(sd, mean, cov);
+                    let k = k as usize;
+                    acc += slots.weights[k] * slots.lobes[k].p22_f64(sd[0], sd[1]);
                 });
             }
         }
