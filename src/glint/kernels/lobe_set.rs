@@ -134,10 +134,12 @@ impl LobeSet {
         self.unprepare();
         if self.n > 1 && wo.z > 0.0 && wo.is_finite() {
             let mut lobes = core::mem::take(&mut self.view_lobes);
-            lobes.resize(self.n, 0.0);
-            self.lobe_areas(wo, &mut lobes);
-            // The sum as `visible_area` forms it (the same terms in the same order).
-            let v: f32 = lobes.iter().sum();
+            let mut v = 0.0f32;
+            // The terms and their sum as `visible_area` forms them (`lobe_area_sum`).
+            self.for_each_lobe_area(wo, |_, x| {
+                lobes.push(x);
+                v += x;
+            });
             self.view = PreparedView::new(wo, finite_or_zero(v) as f64);
             self.view_lobes = lobes;
         }
@@ -192,54 +194,63 @@ impl LobeSet {
 }
 
 impl LobeSet {
-    /// w_i V_i(w) of every lobe into `out` (its length, at most the set's), for a usable w (w_z > 0,
-    /// finite): V_i = A_s⁺ + s_w G(−|A_s|/s_w) (the two branches of `SlopeGaussian::visible_area`
-    /// in one form, since G(z) = z + G(−z)), A_s and s_w per lobe in `f64`, G over
-    /// [`LANES`] lanes ([`ramp_neg_lanes`], relative error < 10⁻⁶). A lobe wholly behind w by more
-    /// than [`LANE_RAMP_MAX`] of its s_w, where the lanes' G leaves `f32`'s normal range, takes
-    /// the lobe's own `f64` V.
-    fn lobe_areas(&self, w: Vec3, out: &mut [f32]) {
-        for (c, chunk) in out.chunks_mut(LANES).enumerate() {
-            let base = c * LANES;
+    /// `f(i, w_i V_i(w))` for every lobe i in order, for a usable w (w_z > 0, finite):
+    /// V_i = A_s⁺ + s_w G(−|A_s|/s_w) (the two branches of `SlopeGaussian::visible_area` in one
+    /// form, since G(z) = z + G(−z)), A_s and s_w per lobe in `f64`, G over [`LANES`] lanes
+    /// ([`ramp_neg_lanes`], relative error < 10⁻⁶). A lobe wholly behind w by more than
+    /// [`LANE_RAMP_MAX`] of its s_w, where the lanes' G leaves `f32`'s normal range, takes the
+    /// lobe's own `f64` V.
+    fn for_each_lobe_area(&self, w: Vec3, mut f: impl FnMut(usize, f32)) {
+        for base in (0..self.n).step_by(LANES) {
+            let len = LANES.min(self.n - base);
             let mut a = [0.0f64; LANES];
             let mut sw = [0.0f64; LANES];
             let mut t = [0.0f64; LANES];
-            for (k, g) in self.g[base..base + chunk.len()].iter().enumerate() {
+            for (k, g) in self.g[base..base + len].iter().enumerate() {
                 let (ak, sk) = g.area_and_spread(w);
                 (a[k], sw[k], t[k]) = (ak, sk, ak.abs() / sk);
             }
             // A lobe wholly in front of w by more than 8 s_w has V = A_s to `f64` resolution
             // (G(−t)/t < 10⁻¹⁷ there): a chunk of such lobes skips the ramp.
             let mut ramp = [0.0f32; LANES];
-            if (0..chunk.len()).any(|k| !(a[k] > 0.0 && t[k] > 8.0)) {
+            if (0..len).any(|k| !(a[k] > 0.0 && t[k] > 8.0)) {
                 ramp_neg_lanes(&t, &mut ramp);
             }
-            for (k, out) in chunk.iter_mut().enumerate() {
+            for k in 0..len {
                 let i = base + k;
                 let v = if a[k] < 0.0 && t[k] > LANE_RAMP_MAX {
                     self.g[i].visible_area(w)
                 } else {
                     finite_or_zero((a[k].max(0.0) + sw[k] * ramp[k] as f64) as f32)
                 };
-                *out = self.w[i] * v;
+                f(i, self.w[i] * v);
             }
         }
     }
 
-    /// The pick weights w_i V_i(wo) into a buffer of the set's length (the prepared ones at the
-    /// prepared view), then `f` of them.
+    /// V(w) = Σ w_i V_i(w), summed in lobe order from +0 (the prepared view's sum is formed the
+    /// same way, so the two agree bit for bit).
+    fn lobe_area_sum(&self, w: Vec3) -> f32 {
+        let mut v = 0.0f32;
+        self.for_each_lobe_area(w, |_, x| v += x);
+        v
+    }
+
+    /// The pick weights w_i V_i(wo) (the prepared ones at the prepared view), then `f` of them.
     fn with_pick_weights<R>(&self, wo: Vec3, f: impl FnOnce(&[f32]) -> R) -> R {
         if let Some(p) = self.prepared_lobes(wo) {
             return f(p);
         }
+        // An unprepared view: on the stack for sets up to `STACK` lobes (every few-lobe form but a
+        // large cut), else one allocation.
         const STACK: usize = 64;
         if self.n <= STACK {
             let mut buf = [0.0f32; STACK];
-            self.lobe_areas(wo, &mut buf[..self.n]);
+            self.for_each_lobe_area(wo, |i, x| buf[i] = x);
             f(&buf[..self.n])
         } else {
             let mut buf = vec![0.0f32; self.n];
-            self.lobe_areas(wo, &mut buf);
+            self.for_each_lobe_area(wo, |i, x| buf[i] = x);
             f(&buf)
         }
     }
@@ -303,8 +314,7 @@ impl Ndf for LobeSet {
         if !(w.z > 0.0 && w.is_finite()) {
             return 0.0;
         }
-        let v: f32 = self.with_pick_weights(w, |p| p.iter().sum());
-        finite_or_zero(v)
+        finite_or_zero(self.lobe_area_sum(w))
     }
 
     /// V(wo): the prepared value at the prepared view ([`LobeSet::prepare_view`]), else one pass.
