@@ -334,7 +334,6 @@ impl SlopeGaussian {
     ///
     /// # Reference
     /// \[Chermain2019\] eq. 4.
-    #[cfg(feature = "std")]
     #[inline]
     pub(crate) fn p22_f64(&self, sx: f64, sy: f64) -> f64 {
         let [i11, i21, i22] = self.inv_chol.map(f64::from);
