@@ -24,7 +24,7 @@
 //! as rendered in \[Atanasov2020\] Fig. 1), the harnesses also show that variant, labelled
 //! "paper default", beside the matched one.
 
-use brdf::glint::binmap::PatchOptions as BinMapOptions;
+use brdf::glint::binmap::{BinMapParams, PatchOptions as BinMapOptions};
 use brdf::glint::{
     BinMap, Footprint, GlintModel, GlintNdf, GlintOptions, GlintPatch, GlintScratch,
 };
@@ -47,6 +47,17 @@ pub fn binmap_options(sigma: f32) -> BinMapOptions {
         smoothing_alpha: beckmann_alpha(sigma),
         ..BinMapOptions::default()
     }
+}
+
+/// The bin map of `map` at its default B and s with its masking lobe floored at σ = `sigma`
+/// (`BinMapParams::sigma_min`): the harnesses' matched bin map, before its per-query smoothing
+/// ([`binmap_options`]).
+pub fn binmap_at(map: &brdf::glint::NormalMap, sigma: f32) -> brdf::Result<Arc<GlintModel>> {
+    let params = BinMapParams {
+        sigma_min: sigma,
+        ..BinMapParams::default()
+    };
+    Ok(Arc::new(BinMap::build(map, params)?.into()))
 }
 
 /// The slope σ a bin map's patches carry with `options`, read back from a patch (0 for the one-bin

@@ -16,16 +16,14 @@ use super::metrics::{coverage, errors, reference_noise};
 use super::render::{Image, glint_pixel, normal_mapped_pixel};
 use super::scene::{Scene, ShadingPoint};
 use super::{MapSource, OrbOptions, load_map};
-use crate::common::material::{Configured, SIGMA_EPS};
+use crate::common::material::{Configured, SIGMA_EPS, binmap_at};
 use crate::common::{Artifact, Res, register_font, save_rgb};
 use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf};
 use brdf::fresnel::Fresnel;
-use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions, SeedKernel};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, GlintModel, GlintNdf, Kernel, NormalMap, PositionNormalMap,
-    footprint_brdf,
+    BeckmannMixture, GlintModel, GlintNdf, Kernel, NormalMap, PositionNormalMap, footprint_brdf,
 };
 use glam::{Vec2, Vec3};
 use plotters::prelude::*;
@@ -241,16 +239,7 @@ fn variants(map: &NormalMap) -> Res<Vec<Variant>> {
         ..PatchOptions::default()
     };
     let t = Instant::now();
-    let binmap: Arc<GlintModel> = Arc::new(
-        BinMap::build(
-            map,
-            BinMapParams {
-                sigma_min: SIGMA_EPS,
-                ..BinMapParams::default()
-            },
-        )?
-        .into(),
-    );
+    let binmap = binmap_at(map, SIGMA_EPS)?;
     let binmap_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let pn: Arc<GlintModel> = Arc::new(

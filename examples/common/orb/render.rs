@@ -6,15 +6,14 @@
 use super::OrbOptions;
 use super::scene::{Scene, ShadingPoint};
 use crate::common::Res;
-use crate::common::material::{Configured, beckmann_alpha};
+use crate::common::material::{Configured, beckmann_alpha, binmap_at};
 use brdf::bxdf::{Bxdf, Masking, MicrofacetBrdf, NormalMapTilt, ShadingNormal};
 use brdf::frame::slope_to_normal;
 use brdf::fresnel::{ConductorFresnel, Fresnel};
-use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{MaskingMode, MixtureParams, PatchOptions};
 use brdf::glint::position_normal::PositionNormalParams;
 use brdf::glint::{
-    BeckmannMixture, BinMap, Footprint, GlintModel, GlintNdf, Kernel, NormalMap, PositionNormalMap,
+    BeckmannMixture, Footprint, GlintModel, GlintNdf, Kernel, NormalMap, PositionNormalMap,
     footprint_brdf, for_each_footprint_slope,
 };
 use brdf::ndf::Beckmann;
@@ -397,11 +396,7 @@ pub fn build_methods(opts: &OrbOptions, map: &NormalMap) -> Res<Vec<OrbMethod>> 
     let default_lod = PatchOptions::default().lod_lobes;
     let t = Instant::now();
     // The masking lobe's floor at σ_ε too.
-    let binmap_params = BinMapParams {
-        sigma_min: sigma,
-        ..BinMapParams::default()
-    };
-    let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, binmap_params)?.into());
+    let binmap = binmap_at(map, sigma)?;
     let binmap_build = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let pn = |sigma_r| {

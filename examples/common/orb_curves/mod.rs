@@ -8,16 +8,15 @@
 //! ‖m − r‖² minus the reference's own noise variance ‖a − b‖²/4 (E‖r − E r‖²), clamped at 0,
 //! over ‖r‖² — an unbiased estimate of the squared error against the reference's expectation.
 
-use super::material::{Configured, SIGMA_EPS};
+use super::material::{Configured, SIGMA_EPS, binmap_at};
 use super::orb::{
     Errors, Image, MapSource, OrbMethod, OrbOptions, Scene, coverage, errors, gap_errors,
     glint_pixel, load_map, reference_noise, render_glint_evals, render_naive, render_references,
 };
 use super::{Artifact, Res};
-use brdf::glint::binmap::BinMapParams;
 use brdf::glint::mixture::{MixtureParams, PatchOptions};
 use brdf::glint::position_normal::PositionNormalParams;
-use brdf::glint::{BeckmannMixture, BinMap, GlintModel, PositionNormalMap};
+use brdf::glint::{BeckmannMixture, PositionNormalMap};
 use glam::Vec2;
 use indicatif::ProgressBar;
 use std::fmt::Write as _;
@@ -144,11 +143,7 @@ pub fn build_models(map: &brdf::glint::NormalMap) -> Res<Vec<OrbMethod>> {
     let mixture_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
     // The masking lobe's floor at σ_ε too.
-    let binmap_params = BinMapParams {
-        sigma_min: SIGMA_EPS,
-        ..BinMapParams::default()
-    };
-    let binmap: Arc<GlintModel> = Arc::new(BinMap::build(map, binmap_params)?.into());
+    let binmap = binmap_at(map, SIGMA_EPS)?;
     let binmap_s = t.elapsed().as_secs_f64();
     let pn = |sigma_r| -> Res<(Configured, f64)> {
         let t = Instant::now();

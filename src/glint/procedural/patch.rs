@@ -312,6 +312,7 @@ fn ggx_patch<'a>(
     let mut set = Lent::<LobeSet>::new(scratch.map(|s| s.home()));
     set.clear();
     let scale = 1.0 / sum as f32;
+    let max_var = (crate::glint::MAX_SLOPE as f64).powi(2);
     for i in 0..cand.len {
         let v = ggx::variance_scale(cand.u[i]);
         let (beta2, tau2) = ggx::scaled_lobe_widths(alpha, v, wd.sigma_f, r);
@@ -322,7 +323,6 @@ fn ggx_patch<'a>(
         );
         // The diagonal covariance's Cholesky factor directly (a lobe wider than `MAX_SLOPE`, which
         // `SlopeGaussian::new` refuses, is left out as it would be).
-        let max_var = (crate::glint::MAX_SLOPE as f64).powi(2);
         let lobe = (beta2[0] <= max_var && beta2[1] <= max_var)
             .then(|| {
                 let [lx, ly] = beta2.map(|b| b.sqrt() as f32);
