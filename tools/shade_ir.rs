@@ -13,8 +13,9 @@
 //! (the render example's procedural surfaces: that α as the limit, one facet per texel of a 1024²
 //! grid, seed 7), `mixture`, `bin-map`, `position-normal` (default builds of the 1024² `scratched`
 //! map of seed 7, the render example's timed map); silver, default options. The points are drawn
-//! from seed 5 (uniform uv, cos θo ≥ 0.2). docs/results.md, "Few-lobe patches: instructions per
-//! shading point".
+//! from seed 5 (uniform uv, cos θo ≥ 0.2). A glint material's name followed by `+compensated`
+//! (`mixture+compensated`) is that material with its energy compensation on. docs/results.md,
+//! "Few-lobe patches: instructions per shading point" and "Energy compensation of glint patches".
 
 use brdf::Vec2;
 use brdf::fresnel::ConductorFresnel;
@@ -33,7 +34,20 @@ const ALPHA: f32 = 0.091;
 
 fn material(name: &str) -> Result<Material, Box<dyn std::error::Error>> {
     let silver = ConductorFresnel::SILVER;
-    let glint = |m: GlintModel| -> Material { GlintMaterial::new(Arc::new(m), silver).into() };
+    // "MODEL+compensated": the glint material with its energy compensation on.
+    let (name, compensated) = match name.strip_suffix("+compensated") {
+        Some(n) => (n, true),
+        None => (name, false),
+    };
+    let glint = |m: GlintModel| -> Material {
+        let g = GlintMaterial::new(Arc::new(m), silver);
+        if compensated {
+            g.with_energy_compensation()
+        } else {
+            g
+        }
+        .into()
+    };
     let procedural = |limit| -> Result<Material, Box<dyn std::error::Error>> {
         let params = ProceduralParams {
             alpha: Vec2::splat(ALPHA),

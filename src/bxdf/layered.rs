@@ -28,7 +28,8 @@
 //! R̄) would need R at every wi, i.e. a full visible-normal integral per evaluation, which a glint
 //! patch cannot afford; this is the trade made by the albedo-scaling layered models of renderers.
 
-use super::{Bxdf, BxdfSample, LobeFlags, MicrofacetBrdf, lambert::unit_rgb};
+use super::compensated::multiple_scattering_fresnel;
+use super::{AlbedoEstimate, Bxdf, BxdfSample, LobeFlags, MicrofacetBrdf, lambert::unit_rgb};
 use crate::error::Result;
 use crate::frame::is_upper;
 use crate::fresnel::Fresnel;
@@ -78,9 +79,29 @@ const MIN_LOBE_PROBABILITY: f32 = 0.05;
 pub struct LayeredBrdf<D, F> {
     specular: MicrofacetBrdf<D, F>,
     base: Vec3,
-    /// R̂(wo) at the view the layer was prepared for ([`LayeredBrdf::prepare_view`]): the bits of
-    /// wo and the value.
-    view: Option<([u32; 3], Vec3)>,
+    /// The energy compensation of the specular layer, if any
+    /// ([`LayeredBrdf::with_energy_compensation`]).
+    compensation: Option<Compensation<D>>,
+    /// R̂(wo) and the specular layer's albedo estimate E(wo) (1 without compensation) at the view
+    /// the layer was prepared for ([`LayeredBrdf::prepare_view`]): the bits of wo and the values.
+    view: Option<([u32; 3], Vec3, f32)>,
+}
+
+impl<D> Clone for Compensation<D> {
+    fn clone(&self) -> Self {
+        Compensation {
+            f_avg: self.f_avg,
+            albedo: self.albedo,
+        }
+    }
+}
+
+/// The specular layer's energy compensation: the Fresnel average F_avg and the NDF's albedo
+/// estimate ([`AlbedoEstimate::albedo_estimate`] of the layer's NDF type).
+#[derive(Debug)]
+struct Compensation<D> {
+    f_avg: Vec3,
+    albedo: fn(&D, Vec3) -> f32,
 }
 
 impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
@@ -90,6 +111,7 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
         Ok(LayeredBrdf {
             specular,
             base: unit_rgb("base", base)?,
+            compensation: None,
             view: None,
         })
     }
@@ -100,8 +122,38 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
         LayeredBrdf {
             specular,
             base,
+            compensation: None,
             view: None,
         }
+    }
+
+    /// The same layer with the specular layer's single-scattering loss given back
+    /// ([`crate::bxdf::ViewCompensated`]'s lobe F_ms (1 − E(wo))/π beside the base term, E the
+    /// NDF's own estimate), for a Fresnel term of hemispherical average `f_avg`
+    /// ([`crate::bxdf::average_fresnel`]; channels clamped to [0, 1]). The albedo is then
+    /// E_s + F_ms (1 − E) + ρ (1 − R̂): 1 for F = 1 up to the estimate's error, at most
+    /// 1 − (1 − E)(F − F_ms) ≤ 1 otherwise (docs/bxdf.md).
+    pub fn with_energy_compensation(mut self, f_avg: Vec3) -> Self
+    where
+        D: AlbedoEstimate,
+    {
+        let f_avg = Vec3::select(
+            f_avg.is_finite_mask(),
+            f_avg.clamp(Vec3::ZERO, Vec3::ONE),
+            Vec3::ONE,
+        );
+        self.compensation = Some(Compensation {
+            f_avg,
+            albedo: <D as AlbedoEstimate>::albedo_estimate,
+        });
+        self.view = None;
+        self
+    }
+
+    /// Whether the specular layer's single-scattering loss is given back
+    /// ([`LayeredBrdf::with_energy_compensation`]).
+    pub fn is_compensated(&self) -> bool {
+        self.compensation.is_some()
     }
 
     /// The specular layer.
@@ -123,8 +175,35 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
     pub fn prepare_view(&mut self, wo: Vec3) {
         self.view = None;
         if is_upper(wo) {
-            self.view = Some((key_of(wo), self.estimate_reflectance(wo)));
+            self.view = Some((
+                key_of(wo),
+                self.estimate_reflectance(wo),
+                self.estimate_albedo(wo),
+            ));
         }
+    }
+
+    /// E(wo) of the compensated specular layer's NDF (1 without compensation: nothing to give
+    /// back).
+    fn estimate_albedo(&self, wo: Vec3) -> f32 {
+        self.compensation
+            .as_ref()
+            .map_or(1.0, |c| (c.albedo)(self.specular.ndf(), wo).clamp(0.0, 1.0))
+    }
+
+    /// R̂(wo) and E(wo) (upper `wo`): the prepared values at the prepared view.
+    fn view_terms(&self, wo: Vec3) -> (Vec3, f32) {
+        match self.view {
+            Some((k, r, e)) if k == key_of(wo) => (r, e),
+            _ => (self.estimate_reflectance(wo), self.estimate_albedo(wo)),
+        }
+    }
+
+    /// The value of the compensation lobe, F_ms (1 − E)/π (0 without compensation).
+    fn multiple_scattering_value(&self, e: f32) -> Vec3 {
+        self.compensation.as_ref().map_or(Vec3::ZERO, |c| {
+            multiple_scattering_fresnel(c.f_avg, e) * ((1.0 - e) * FRAC_1_PI)
+        })
     }
 
     /// R̂(wo): the specular layer's first-bounce reflectance ∫ F(wo·m) D_wo(m) dm, estimated on
@@ -136,7 +215,7 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
             return Vec3::ONE;
         }
         match self.view {
-            Some((k, r)) if k == key_of(wo) => r,
+            Some((k, r, _)) if k == key_of(wo) => r,
             _ => self.estimate_reflectance(wo),
         }
     }
@@ -170,10 +249,11 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
         (Vec3::ONE - r) * self.base * FRAC_1_PI
     }
 
-    /// The probability of sampling the specular lobe.
-    fn specular_probability(&self, r: Vec3) -> f32 {
+    /// The probability of sampling the specular lobe, with `diffuse` the cosine-shaped terms' value
+    /// (the base's and the compensation lobe's).
+    fn specular_probability(&self, r: Vec3, diffuse: Vec3) -> f32 {
         let spec = r.element_sum() / 3.0;
-        let diffuse = self.base_value(r).element_sum() / 3.0 * core::f32::consts::PI;
+        let diffuse = diffuse.element_sum() / 3.0 * core::f32::consts::PI;
         if diffuse <= 0.0 {
             return 1.0;
         }
@@ -211,10 +291,11 @@ impl<D: Ndf, F: Fresnel> Bxdf for LayeredBrdf<D, F> {
         if !(is_upper(wo) && is_upper(wi)) {
             return (Vec3::ZERO, 0.0);
         }
-        let r = self.first_bounce_reflectance(wo);
-        let p = self.specular_probability(r);
+        let (r, e) = self.view_terms(wo);
+        let diffuse = self.base_value(r) + self.multiple_scattering_value(e);
+        let p = self.specular_probability(r, diffuse);
         let (fs, ps) = self.specular.eval_pdf(wo, wi);
-        let f = fs + self.base_value(r);
+        let f = fs + diffuse;
         let pdf = p * ps + (1.0 - p) * pdf_cosine_hemisphere(wi);
         (f, pdf)
     }
@@ -223,13 +304,14 @@ impl<D: Ndf, F: Fresnel> Bxdf for LayeredBrdf<D, F> {
         if !(is_upper(wo) && u.is_finite() && uc.is_finite()) {
             return None;
         }
-        let r = self.first_bounce_reflectance(wo);
-        let p = self.specular_probability(r);
+        let (r, e) = self.view_terms(wo);
+        let diffuse = self.base_value(r) + self.multiple_scattering_value(e);
+        let p = self.specular_probability(r, diffuse);
         if uc < p {
             // `MicrofacetBrdf::sample` returns its own `eval_pdf` at the drawn wi: the layered f and
             // pdf follow from it exactly as `eval_pdf` forms them, without evaluating the coat again.
             let s = self.specular.sample(wo, uc / p, u)?;
-            let f = s.f + self.base_value(r);
+            let f = s.f + diffuse;
             let pdf = p * s.pdf + (1.0 - p) * pdf_cosine_hemisphere(s.wi);
             return BxdfSample::checked(s.wi, f, pdf, s.flags);
         }

@@ -7,7 +7,8 @@
 //! [`PhongNormalization`], optional Schlick Fresnel) and [`OriginalPhong`] (cos^γ θr / cos θi); the
 //! [`BlinnPhongLobe`]; and [`MicrofacetBrdf`], generic over any [`crate::ndf::Ndf`] (centred NDFs,
 //! non-centred lobes, glint patches) and any [`crate::fresnel::Fresnel`], with opt-in multiple-scattering
-//! energy compensation in [`EnergyCompensated`] (tables: [`AlbedoTable`]); [`LayeredBrdf`], a microfacet
+//! energy compensation in [`EnergyCompensated`] (tables: [`AlbedoTable`]) and, for NDFs that estimate
+//! their own albedo (glint patches), [`ViewCompensated`]; [`LayeredBrdf`], a microfacet
 //! layer over a Lambertian base; [`ClearCoat`], a smooth dielectric coat over any base BxDF (car
 //! paint: flakes under a varnish); [`SpecularReflection`], the smooth limit (a delta lobe, see the
 //! convention on [`Bxdf`]); and the shading-normal adapters [`NormalMapTilt`] (conventional normal
@@ -31,6 +32,7 @@ mod microfacet;
 mod normal_mapping;
 mod phong;
 mod specular;
+mod view_compensated;
 
 pub use albedo::{
     ALBEDO_ALPHA_MAX, ALBEDO_ALPHA_MIN, ALBEDO_GRID, ALBEDO_MU_EPSILON, AlbedoTable, average_of_row,
@@ -51,7 +53,6 @@ pub use compensated::{
     EnergyCompensated, TabulatedAlbedo, average_fresnel, multiple_scattering_fresnel,
 };
 pub use lambert::Lambert;
-#[cfg(feature = "std")]
 pub(crate) use lambert::unit_rgb;
 pub use layered::{LayeredBrdf, TRANSMISSION_SAMPLES};
 pub use microfacet::{Masking, MicrofacetBrdf, Sampling};
@@ -60,6 +61,7 @@ pub use phong::{
     ARVO_MAX_GAMMA, OriginalPhong, OriginalPhongNormalization, Phong, PhongNormalization,
 };
 pub use specular::SpecularReflection;
+pub use view_compensated::{AlbedoEstimate, ViewCompensated};
 
 /// Which kinds of lobe a sample came from (a small bit set).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

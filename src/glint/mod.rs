@@ -124,6 +124,7 @@
 //! P-BRDF of eq. 7 with the true P-NDF, and normal-mapped shading averaged over the footprint).
 
 pub mod binmap;
+mod compensation;
 mod io;
 mod kernels;
 pub mod mixture;

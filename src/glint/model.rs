@@ -17,6 +17,7 @@ use super::io::header;
 use super::{
     BeckmannMixture, BinMap, Footprint, GlintNdf, GlintScratch, PositionNormalMap, ProceduralGlints,
 };
+use crate::bxdf::AlbedoEstimate;
 use crate::error::{Error, Result};
 use crate::ndf::forward_ndf;
 use glam::{Vec2, Vec3};
@@ -88,6 +89,15 @@ macro_rules! glint_models {
                 }
             }
         )+
+
+        /// The estimate of the model that made the patch (src/glint/compensation.rs).
+        impl AlbedoEstimate for GlintPatch<'_> {
+            fn albedo_estimate(&self, wo: Vec3) -> f32 {
+                match self {
+                    $( GlintPatch::$variant(p) => p.albedo_estimate(wo), )+
+                }
+            }
+        }
 
         impl GlintPatch<'_> {
             /// Prepares the patch for the view direction `wo` (shading frame): what every query at

@@ -4,7 +4,8 @@
 use super::{AnalyticNdf, AnyFresnel};
 use crate::bxdf::{
     BlinnPhongLobe, ClearCoat, EnergyCompensated, Lambert, LayeredBrdf, MicrofacetBrdf,
-    NormalMapMicrofacet, NormalMapTilt, OriginalPhong, Phong, SpecularReflection, forward_bxdf,
+    NormalMapMicrofacet, NormalMapTilt, OriginalPhong, Phong, SpecularReflection, ViewCompensated,
+    forward_bxdf,
 };
 use crate::glint::GlintPatch;
 
@@ -33,6 +34,7 @@ pub(super) enum Coat<'a> {
 pub(super) enum Inner<'a> {
     Plain(Plain<'a>),
     Glint(MicrofacetBrdf<GlintPatch<'a>, AnyFresnel>),
+    GlintCompensated(ViewCompensated<GlintPatch<'a>, AnyFresnel>),
     GlintCoat(LayeredBrdf<GlintPatch<'a>, AnyFresnel>),
     Tilt(NormalMapTilt<Plain<'a>>),
     NormalMicrofacet(NormalMapMicrofacet<Plain<'a>>),
@@ -75,6 +77,7 @@ macro_rules! forward_inner {
         match $self_ {
             Inner::Plain($b) => $e,
             Inner::Glint($b) => $e,
+            Inner::GlintCompensated($b) => $e,
             Inner::GlintCoat($b) => $e,
             Inner::Tilt($b) => $e,
             Inner::NormalMicrofacet($b) => $e,

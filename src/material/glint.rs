@@ -28,6 +28,9 @@ pub struct GlintMaterial {
     fresnel: AnyFresnel,
     uv_scale: Vec2,
     base: Option<Vec3>,
+    /// F_avg of the Fresnel term when the energy compensation is on
+    /// ([`GlintMaterial::with_energy_compensation`]).
+    compensation: Option<Vec3>,
 }
 
 impl GlintMaterial {
@@ -41,7 +44,21 @@ impl GlintMaterial {
             fresnel: fresnel.into(),
             uv_scale: Vec2::ONE,
             base: None,
+            compensation: None,
         }
+    }
+
+    /// The same material with the energy its patches' single scattering loses given back
+    /// ([`crate::bxdf::ViewCompensated`]: a Lambertian lobe F_ms (1 − E(wo))/π, E each patch's own
+    /// albedo estimate toward the shading point's wo; beside the base term when the glints are a
+    /// layer over a base, [`crate::bxdf::LayeredBrdf::with_energy_compensation`]). Opt-in like
+    /// [`crate::bxdf::EnergyCompensated`]: a compensated glint surface's white furnace is flat in θo
+    /// (within the estimate's error, docs/results.md "Energy compensation of glint patches")
+    /// instead of darkening toward grazing views; not reciprocal. Costs one pass over the patch's
+    /// lobes per shading point. F_avg is computed here, once.
+    pub fn with_energy_compensation(mut self) -> GlintMaterial {
+        self.compensation = Some(crate::bxdf::average_fresnel(&self.fresnel));
+        self
     }
 
     /// The same material with per-query `options` (level of detail, masking, smoothing: see each
@@ -88,6 +105,12 @@ impl GlintMaterial {
     /// How many times the map repeats along u and v.
     pub fn uv_scale(&self) -> Vec2 {
         self.uv_scale
+    }
+
+    /// The Fresnel average F_avg the energy compensation uses, if it is on
+    /// ([`GlintMaterial::with_energy_compensation`]).
+    pub fn energy_compensation(&self) -> Option<Vec3> {
+        self.compensation
     }
 
     /// The Lambertian base's albedo, if the glints are a layer over one.

@@ -72,7 +72,7 @@ pub use normal_mapped::{NormalMappedMaterial, NormalMapping};
 use crate::bxdf::inside_view;
 use crate::bxdf::{
     BlinnPhongLobe, ClearCoat, EnergyCompensated, Lambert, LayeredBrdf, MicrofacetBrdf,
-    NormalMapMicrofacet, NormalMapTilt, OriginalPhong, Phong, SpecularReflection,
+    NormalMapMicrofacet, NormalMapTilt, OriginalPhong, Phong, SpecularReflection, ViewCompensated,
 };
 use crate::error::Result;
 use crate::glint::{Footprint, GlintNdf, GlintScratch};
@@ -235,11 +235,19 @@ impl Material {
                 let mut patch = g.model().patch_with(&fp, g.options(), Some(scratch));
                 patch.prepare_view(wo);
                 let layer = MicrofacetBrdf::new(patch, g.fresnel());
-                match g.base() {
-                    None => Inner::Glint(layer),
+                match (g.base(), g.energy_compensation()) {
+                    (None, None) => Inner::Glint(layer),
+                    // F_avg was computed by `average_fresnel` (in [0, 1]); masking is the default
+                    // height-correlated form.
+                    (None, Some(f_avg)) => {
+                        Inner::GlintCompensated(ViewCompensated::from_valid(layer, f_avg, wo))
+                    }
                     // Validated by `GlintMaterial::over_base`.
-                    Some(base) => {
+                    (Some(base), compensation) => {
                         let mut coat = LayeredBrdf::with_valid_base(layer, base);
+                        if let Some(f_avg) = compensation {
+                            coat = coat.with_energy_compensation(f_avg);
+                        }
                         coat.prepare_view(wo);
                         Inner::GlintCoat(coat)
                     }

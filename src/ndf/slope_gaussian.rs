@@ -435,6 +435,41 @@ impl SlopeGaussian {
         (a_s, (vx * vx + vy * vy).sqrt())
     }
 
+    /// The visible normals of a product grid toward `wo`: for each quantile `u1[i]` of the
+    /// whitened slope along the view (the visible sampler's first variate) and each whitened
+    /// slope `z2[j]` across it, `f(i, j, m)`. What `sample_visible` draws at (u1, Φ(z2)), with
+    /// one inversion per `u1`; nothing for an invalid `wo`.
+    #[cfg(feature = "std")]
+    pub(crate) fn visible_grid(
+        &self,
+        wo: Vec3,
+        u1: &[f32],
+        z2: &[f64],
+        mut f: impl FnMut(usize, usize, Vec3),
+    ) {
+        let Some(t) = self.view_terms(wo) else {
+            return;
+        };
+        // At normal incidence (s_w = 0) every normal is seen alike: z ~ N(0, I), any axis.
+        let normal = t.s_w.is_nan() || t.s_w <= 0.0;
+        let (ex, ey) = if normal {
+            (1.0, 0.0)
+        } else {
+            (t.vx / t.s_w, t.vy / t.s_w)
+        };
+        for (i, &u) in u1.iter().enumerate() {
+            let z1 = if normal {
+                gauss::inv_std_cdf(clamp_u(u))
+            } else {
+                visible_z1(t.a_s / t.s_w, u)
+            };
+            for (j, &z2) in z2.iter().enumerate() {
+                let m = self.normal_from_z(z1 * ex - z2 * ey, z1 * ey + z2 * ex);
+                f(i, j, ensure_facing(wo, m));
+            }
+        }
+    }
+
     /// The normal of the slope μ + L z.
     #[inline]
     fn normal_from_z(&self, zx: f64, zy: f64) -> Vec3 {
@@ -639,17 +674,7 @@ impl Ndf for SlopeGaussian {
         if t.s_w == 0.0 {
             return self.sample_normal(u);
         }
-        let a = t.a_s / t.s_w;
-        let z1 = if a >= A_BECKMANN {
-            // z₁ = √2 x with x ∝ (a/√2 − x)⁺ e^(−x²): Beckmann's standard visible slope at
-            // cot θ = a/√2.
-            let (cot, tan) = ((a * FRAC_1_SQRT_2) as f32, (SQRT_2 / a) as f32);
-            let theta = libm::atan2(SQRT_2, a) as f32;
-            let ux = clamp_u(u.x) as f32;
-            SQRT_2 * super::beckmann::visible_slope_x_std(cot, tan, theta, ux) as f64
-        } else {
-            gauss::sample_ramp(a, clamp_u(u.x))
-        };
+        let z1 = visible_z1(t.a_s / t.s_w, u.x);
         let z2 = gauss::inv_std_cdf(clamp_u(u.y));
         let (ex, ey) = (t.vx / t.s_w, t.vy / t.s_w);
         let m = self.normal_from_z(z1 * ex - z2 * ey, z1 * ey + z2 * ex);
@@ -720,6 +745,20 @@ fn facing(wo: Vec3, m: Vec3) -> f64 {
 }
 
 /// m if it faces wo after rounding, else m moved along wo to ⟨wo, m⟩ = [`FACING_NUDGE`].
+/// The whitened visible slope along the view, z₁ ∝ (a − z₁)⁺ φ(z₁), at quantile `u`: for
+/// a ≥ `A_BECKMANN` √2 x with x Beckmann's standard visible slope at cot θ = a/√2
+/// (x ∝ (a/√2 − x)⁺ e^(−x²)), else the `f64` inversion of the ramp.
+fn visible_z1(a: f64, u: f32) -> f64 {
+    if a >= A_BECKMANN {
+        let (cot, tan) = ((a * FRAC_1_SQRT_2) as f32, (SQRT_2 / a) as f32);
+        let theta = libm::atan2(SQRT_2, a) as f32;
+        let ux = clamp_u(u) as f32;
+        SQRT_2 * super::beckmann::visible_slope_x_std(cot, tan, theta, ux) as f64
+    } else {
+        gauss::sample_ramp(a, clamp_u(u))
+    }
+}
+
 fn ensure_facing(wo: Vec3, m: Vec3) -> Vec3 {
     let c = facing(wo, m);
     if c > 0.0 {

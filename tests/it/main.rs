@@ -36,6 +36,7 @@ mod energy_compensation;
 mod frame_handedness;
 mod fresnel;
 mod fresnel_index_matched;
+mod glint_compensation;
 mod glint_footprint;
 mod glint_measured;
 mod glint_normal_map;

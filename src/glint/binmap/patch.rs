@@ -263,6 +263,32 @@ impl<'a> BinMapPatch<'a> {
         self.exact.is_some()
     }
 
+    /// The patch as weighted slope Gaussians, for its albedo estimate (src/glint/kernels/albedo.rs):
+    /// with exact terms each bin of the footprint as a lobe of its mass at the slope of its mean
+    /// direction, as wide as the bin (σ = its radius r_j / 2), or the smoothed patch's lobes;
+    /// without, the masking lobe.
+    pub(crate) fn albedo_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + Clone + '_ {
+        let (bins, lobes, moment) = match &self.exact {
+            Some(e) if self.sigma.is_some() => (None, Some(&e.lobes[..]), None),
+            Some(e) => (Some(&e.bins[..]), None, None),
+            None => (None, None, Some((1.0, self.lobe))),
+        };
+        let bin_lobe = |b: &super::masking::PatchBin| {
+            let m = b.facet.mean;
+            let (sx, sy) = (-m.x / m.z, -m.y / m.z);
+            let v = 0.25 * b.facet.radius * b.facet.radius / (m.z * m.z).max(1e-6);
+            let g = SlopeGaussian::from_moments(
+                [sx, sy, sx * sx + v, sy * sy + v, sx * sy],
+                crate::ndf::SIGMA_MIN_FLOOR,
+            );
+            (b.mass as f32, g)
+        };
+        bins.into_iter()
+            .flat_map(move |b| b.iter().map(bin_lobe))
+            .chain(lobes.into_iter().flat_map(|l| l.iter().copied()))
+            .chain(moment)
+    }
+
     /// The masking lobe (the footprint's filtered-moment Beckmann lobe).
     pub fn masking_lobe(&self) -> &SlopeGaussian {
         &self.lobe

@@ -160,7 +160,7 @@ impl LobeSet {
     }
 
     /// (weight, lobe) pairs.
-    pub fn iter(&self) -> impl Iterator<Item = (f32, &SlopeGaussian)> {
+    pub fn iter(&self) -> impl Iterator<Item = (f32, &SlopeGaussian)> + Clone {
         self.weights().iter().copied().zip(&self.g[..self.n])
     }
 
@@ -385,13 +385,15 @@ impl Ndf for LobeSet {
 }
 
 impl Few<'_> {
-    /// The lobes as (weight, lobe) pairs (empty for [`Few::None`]).
-    pub fn lobes(&self) -> Vec<(f32, SlopeGaussian)> {
-        match self {
-            Few::None => Vec::new(),
-            Few::One(g) => vec![(1.0, *g)],
-            Few::Set(s) => s.iter().map(|(w, g)| (w, *g)).collect(),
-        }
+    /// The lobes as (weight, lobe) pairs without allocating (empty for [`Few::None`]).
+    pub fn iter_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + Clone + '_ {
+        let (one, set) = match self {
+            Few::None => (None, None),
+            Few::One(g) => (Some((1.0, *g)), None),
+            Few::Set(s) => (None, Some(&**s)),
+        };
+        one.into_iter()
+            .chain(set.into_iter().flat_map(|s| s.iter().map(|(w, g)| (w, *g))))
     }
 
     /// Prepares a set for the view `wo` ([`LobeSet::prepare_view`]); one lobe needs nothing.

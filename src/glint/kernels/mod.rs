@@ -1,5 +1,7 @@
 //! Kernels shared by the glint models' builds and patches (crate-private).
 //!
+//! - albedo.rs: the estimate of a patch's single-scattering albedo E(wo) that the energy
+//!   compensation of glint patches gives back.
 //! - cdf.rs: inverting a cumulative table, the first step of every glint sampler.
 //! - filtered_error.rs: the filtered mixture's measured distance to a model's full P-NDF, per
 //!   level (what the models' `filtered_tolerance` is compared with).
@@ -13,6 +15,7 @@
 //! - slope_tree.rs: the implicit quadtree of slope boxes over a regular grid of elements (the
 //!   mixture's lobes, the position-normal elements).
 
+pub(crate) mod albedo;
 pub(crate) mod cdf;
 pub(crate) mod cut;
 pub(crate) mod filtered_error;

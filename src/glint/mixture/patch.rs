@@ -19,6 +19,7 @@ use super::storage::LevelView;
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
+use crate::glint::kernels::albedo::Lobe;
 use crate::glint::kernels::cdf::invert_cdf;
 use crate::glint::kernels::cut::CutStats;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
@@ -61,6 +62,11 @@ impl PatchLevel<'_> {
     /// The level's node grid.
     fn grid(&self) -> [usize; 2] {
         with_level!(self, |lv| lv.grid())
+    }
+
+    /// Node k's mean slope and covariance [Σxx, Σxy, Σyy], from its stored moments.
+    fn mean_cov(&self, k: usize) -> ([f64; 2], [f64; 3]) {
+        with_level!(self, |lv| lv.mean_cov(k))
     }
 }
 
@@ -257,8 +263,8 @@ impl<'a> MixturePatch<'a> {
 
     /// The lobes of the patch when it is one of the few-lobe forms (filtered lobe, sub-texel lobe,
     /// filtered mixture, cut): (weight, lobe) pairs, weights summing to 1; empty otherwise.
-    pub fn few_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
-        self.few.lobes().into_iter()
+    pub fn few_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + Clone + '_ {
+        self.few.iter_lobes()
     }
 
     /// The level of detail l the patch reads: its lobes are the merged lobes of 2^l × 2^l blocks of
@@ -302,10 +308,31 @@ impl<'a> MixturePatch<'a> {
     }
 
     /// The normalised weights W_i and their lobes, for tests and tools: (W, lobe) per slot.
-    pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
+    pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + Clone + '_ {
         let g = self.gathered.as_ref();
         let n = g.map_or(0, |g| g.bufs.weights.len());
         (0..n).filter_map(move |s| g.map(|g| (g.bufs.weights[s], self.slot_lobe(g, s))))
+    }
+
+    /// The patch's lobes (few-lobe form or gathered slots) as the albedo estimate reads them
+    /// (src/glint/kernels/albedo.rs): the gathered slots from their stored moments, without
+    /// forming their slope Gaussians.
+    pub(crate) fn albedo_lobes(&self) -> impl Iterator<Item = Lobe> + Clone + '_ {
+        let nx = self.level.grid()[0];
+        let slots = self.gathered.as_ref().into_iter().flat_map(move |g| {
+            let (lx, ly) = (g.axes[0].len, g.axes[1].len);
+            (0..ly).flat_map(move |j| {
+                let row = g.axes[1].lobe_of_slot(j) * nx;
+                (0..lx).map(move |i| {
+                    let (mu, c) = self.level.mean_cov(row + g.axes[0].lobe_of_slot(i));
+                    Lobe::from_mean_cov(g.bufs.weights[j * lx + i], mu, c)
+                })
+            })
+        });
+        self.few
+            .iter_lobes()
+            .map(|(w, l)| Lobe::of(w, &l))
+            .chain(slots)
     }
 
     /// The lobe of slot s.

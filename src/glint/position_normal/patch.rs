@@ -319,10 +319,10 @@ impl<'a> PositionNormalPatch<'a> {
 
     /// The normalised weights W_i and slope Gaussians N(μ_i, C_i) of the kept elements, or the
     /// filtered mixture's lobes where it serves.
-    pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + '_ {
-        let few = self.few.lobes();
+    pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + Clone + '_ {
+        let few = self.few.iter_lobes();
         let slots = (!self.few_serves()).then(|| self.slots());
-        few.into_iter().chain(
+        few.chain(
             slots
                 .into_iter()
                 .flat_map(|s| s.weights.iter().zip(&s.lobes).map(|(&w, &l)| (w as f32, l))),

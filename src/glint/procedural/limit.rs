@@ -56,6 +56,11 @@ impl<'a> GgxBlend<'a> {
         &self.lobes
     }
 
+    /// The lobes, the weight b of GGX and GGX.
+    pub fn parts(&self) -> (&Few<'a>, f32, Ggx) {
+        (&self.lobes, self.b, self.ggx)
+    }
+
     /// Prepares the lobes for the view `wo` (their V(wo), once: [`Few::prepare_view`]).
     pub fn prepare_view(&mut self, wo: Vec3) {
         self.lobes.prepare_view(wo);

@@ -124,6 +124,29 @@ impl ProceduralPatch<'_> {
         self.limit_weight
     }
 
+    /// The parts of the patch for its albedo estimate (src/glint/kernels/albedo.rs): its slope
+    /// Gaussians with their weights in D_P, and the GGX part as (weight, NDF), if any.
+    pub(crate) fn albedo_parts(
+        &self,
+    ) -> (
+        impl Iterator<Item = (f32, SlopeGaussian)> + Clone + '_,
+        Option<(f32, Ggx)>,
+    ) {
+        let (few, scale, ggx) = match &self.body {
+            Body::Lobes(f) => (Some(f), 1.0, None),
+            Body::Ggx(g) => (None, 0.0, Some((1.0, *g))),
+            Body::Blend(b) => {
+                let (lobes, weight, ggx) = b.parts();
+                (Some(lobes), 1.0 - weight, Some((weight, ggx)))
+            }
+        };
+        let lobes = few
+            .into_iter()
+            .flat_map(|f| f.iter_lobes())
+            .map(move |(w, g)| (w * scale, g));
+        (lobes, ggx)
+    }
+
     /// The expected relative L2 distance ρ of a patch of this footprint to the limit NDF
     /// (what [`PatchOptions::tolerance`] is compared with; for the GGX limit, the part of it that
     /// the footprint's facets carry, src/glint/procedural/ggx.rs).
