@@ -28,7 +28,7 @@
 //! R̄) would need R at every wi, i.e. a full visible-normal integral per evaluation, which a glint
 //! patch cannot afford; this is the trade made by the albedo-scaling layered models of renderers.
 
-use super::compensated::multiple_scattering_fresnel;
+use super::view_compensated::multiple_scattering_lobe;
 use super::{AlbedoEstimate, Bxdf, BxdfSample, LobeFlags, MicrofacetBrdf, lambert::unit_rgb};
 use crate::error::Result;
 use crate::frame::is_upper;
@@ -201,9 +201,9 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
 
     /// The value of the compensation lobe, F_ms (1 − E)/π (0 without compensation).
     fn multiple_scattering_value(&self, e: f32) -> Vec3 {
-        self.compensation.as_ref().map_or(Vec3::ZERO, |c| {
-            multiple_scattering_fresnel(c.f_avg, e) * ((1.0 - e) * FRAC_1_PI)
-        })
+        self.compensation
+            .as_ref()
+            .map_or(Vec3::ZERO, |c| multiple_scattering_lobe(c.f_avg, e))
     }
 
     /// R̂(wo): the specular layer's first-bounce reflectance ∫ F(wo·m) D_wo(m) dm, estimated on

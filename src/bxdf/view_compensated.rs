@@ -64,6 +64,14 @@ pub struct ViewCompensated<D, F> {
     view: ([u32; 3], f32),
 }
 
+/// The compensation lobe's value F_ms (1 − E)/π for a Fresnel average `f_avg` and albedo `e`, with
+/// F_ms Kulla and Conty's multiple-scattering Fresnel at E_avg = `e` (shared with
+/// [`LayeredBrdf::with_energy_compensation`](super::LayeredBrdf::with_energy_compensation)).
+#[inline]
+pub(super) fn multiple_scattering_lobe(f_avg: Vec3, e: f32) -> Vec3 {
+    multiple_scattering_fresnel(f_avg, e) * ((1.0 - e) * FRAC_1_PI)
+}
+
 /// The bits of a direction (the key of the prepared view).
 fn key_of(w: Vec3) -> [u32; 3] {
     [w.x.to_bits(), w.y.to_bits(), w.z.to_bits()]
@@ -134,7 +142,7 @@ impl<D: AlbedoEstimate, F: Fresnel> ViewCompensated<D, F> {
     fn lobe_and_probability(&self, wo: Vec3) -> (Vec3, f32) {
         let e = self.albedo(wo).clamp(0.0, 1.0);
         let f_ms = multiple_scattering_fresnel(self.f_avg, e);
-        let lobe = f_ms * ((1.0 - e) * FRAC_1_PI);
+        let lobe = multiple_scattering_lobe(self.f_avg, e);
         let mean = |v: Vec3| (v.x + v.y + v.z) / 3.0;
         let p = lobe_probability(
             (1.0 - e) * mean(f_ms),
