@@ -212,18 +212,22 @@ fn compensated_samplers_match_their_densities() {
     for &(texels, theta) in cases {
         let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.61), texels, N, N);
         let wo = support::dir(theta, 30.0);
-        let patch = mix.patch(&fp);
+        let mut patch = mix.patch(&fp);
+        patch.prepare_view(wo);
         let comp = ViewCompensated::new(
             MicrofacetBrdf::new(patch.clone(), ConductorFresnel::GOLD),
             wo,
         )
         .unwrap();
-        let coat = LayeredBrdf::new(
+        // Prepared at wo, as `Material::bsdf` prepares it: without the view step every call
+        // re-estimates E(wo).
+        let mut coat = LayeredBrdf::new(
             MicrofacetBrdf::new(patch, ConductorFresnel::GOLD),
             Vec3::new(0.5, 0.2, 0.1),
         )
         .unwrap()
         .with_energy_compensation(f_avg);
+        coat.prepare_view(wo);
         let runs: [(&str, &dyn Bxdf); 2] = [("compensated", &comp), ("compensated coat", &coat)];
         for (label, b) in runs {
             let name = format!("{label} mixture {texels} texels θo {theta}°");
