@@ -43,10 +43,10 @@ fn views() -> Vec<(f64, f64)> {
 const DRAWS: usize = 1024;
 
 /// The largest |E − 1| a compensated patch may show beyond 4 standard errors: the estimate's own
-/// error, measured at most 0.02-0.03 on these maps (docs/results.md, "Energy compensation of glint
-/// patches"; the lobe cubature is within 10⁻² of a fine quadrature, the rest is the four-Gaussian
-/// stand-in for Λ_P at the reflected directions).
-const TOLERANCE: f64 = 0.035;
+/// error, measured at most 0.013 (bumpy) to 0.022 (flakes) for the mixture and 0.008 for the
+/// procedural surface (docs/results.md, "Energy compensation of glint patches": the merge of many
+/// lobes and the four-Gaussian stand-in for Λ_P at the reflected directions).
+const TOLERANCE: f64 = 0.025;
 
 /// For each cell: (label, uncompensated E, estimate, compensated E, its standard error).
 fn furnace_cells(model: &GlintModel, label: &str) -> Vec<(String, f64, f64, f64, f64)> {
@@ -128,9 +128,11 @@ fn compensated_procedural_patches_keep_the_furnace_at_one() {
 /// at four azimuths, 2,048 draws per cell; per model and map the darkest uncompensated furnace, the
 /// largest |E − estimate| and the compensated furnace farthest from 1. Measured, not asserted:
 /// position-normal and the bin map stay outside the mixture's tolerance on some maps (see there).
-/// `cargo test --release --test it -- --ignored glint_compensation::furnace_table --nocapture`.
+/// `cargo test --release --test it -- --ignored glint_compensation::furnace_table --nocapture`;
+/// `BRDF_ONLY=flakes,mixture` (comma-separated map names and model labels) keeps the rows whose map
+/// or model is listed.
 #[test]
-#[ignore = "heavy: ~8 min in release"]
+#[ignore = "heavy: ~10 min in release"]
 fn furnace_table() {
     const SIDE: usize = 256;
     println!("| model | map | darkest E | largest abs(E - estimate) | worst compensated E |");
@@ -159,6 +161,10 @@ fn furnace_table() {
             models.push(("procedural (own surface)", p.into()));
         }
         for (label, model) in &models {
+            let only = std::env::var("BRDF_ONLY").unwrap_or_default();
+            if !only.is_empty() && !only.split(',').any(|o| o == *label || o == name) {
+                continue;
+            }
             let (mut darkest, mut worst_est, mut worst) =
                 (1.0f64, 0.0f64, (0.0f64, 1.0f64, 0.0f64));
             for texels in [16.0f32, 64.0, 256.0, 1024.0, 4096.0] {

@@ -9,15 +9,20 @@
 //!
 //! E(wo) = Σ_i (W_i V_i(wo)/V_P(wo)) E_{m ∼ D_wo,i}[g(wi(m))],  g(wi) = (1 + Λo)/(1 + Λo + Λi)⁺,
 //!
-//! with Λo the patch's own Λ_P(wo). Three approximations make it O(lobes):
-//! - a patch of more than 64 lobes is first merged onto an 8 × 8 grid of slope cells ([`Merged`]):
-//!   one cheap pass over its lobes, then the per-lobe work on at most 64;
+//! with Λo the patch's own Λ_P(wo) and V_P(wo) = (1 + Λo) A_P(wo) its own visible area (never
+//! taken below the lobes' Σ W_i V_i(wo)): where the patch's masking is a conservative bound
+//! (Scarf's, above Σ W_i V_i), its visible normals' mass falls short of 1 by that much and so does
+//! E. Three approximations make it O(lobes):
+//! - a patch of more than [`MERGE_SIDE`]² lobes is first merged onto a [`MERGE_SIDE`]² grid of slope
+//!   cells ([`Merged`]): one cheap pass over its lobes, then the per-lobe work on at most
+//!   [`MERGE_SIDE`]²;
 //! - each lobe's visible average ([`lobe_average`]): g at its mean normal's reflection where the
 //!   lobe reflects [`HORIZON_MARGIN`] widths above the horizon (g is flat there), else an 8 × 3
 //!   grid of its visible normals (Gauss-Legendre quantiles of the visible slope along the view
 //!   through the lobe's own inversion, × Gauss-Hermite across it): g jumps to 0 across such a
 //!   lobe, and a wide lobe's loss sits in its tail, which low-order rules in the whitened slope
-//!   miss;
+//!   miss. A lobe carrying at least [`REFINE_SHARE`] of the patch's visible area has the jump
+//!   located instead ([`refined_average`]), since the 8-point rule misses up to ~5 % of a step;
 //! - Λ_P(wi) at the reflected directions from four slope Gaussians, the lobes pooled on either
 //!   side of the pooled mean along the pooled covariance's principal axes ([`Proxy`]), with the
 //!   patch's exact projected area: O(1) per direction, exact where every lobe faces wi (V is then
@@ -231,8 +236,9 @@ fn g_of(wi: Vec3, lambda_o: f32, lambda_i: f32) -> f32 {
 /// the 8 × 3 product grid of the lobe's visible normals, 8 Gauss-Legendre quantiles of the visible
 /// slope along the view (the lobe's own inversion, so the grid follows D_wo,i into its tail) ×
 /// the 3-point Gauss-Hermite rule across it; for a lobe no wider than [`NARROW_SIGMA`] Λ is taken
-/// once per row.
-fn lobe_average(wo: Vec3, lobe: &SlopeGaussian, lambda_o: f32, proxy: &Proxy) -> f32 {
+/// once per row. With `refine` (the lobe carries much of the patch), a grid whose column has nodes
+/// on both sides of the horizon is replaced by [`refined_average`], which locates the step.
+fn lobe_average(wo: Vec3, lobe: &SlopeGaussian, lambda_o: f32, proxy: &Proxy, refine: bool) -> f32 {
     let l = lobe.cholesky();
     let mu = lobe.mean();
     let sigma = l.x_axis.x.max(l.y_axis.length());
@@ -244,8 +250,12 @@ fn lobe_average(wo: Vec3, lobe: &SlopeGaussian, lambda_o: f32, proxy: &Proxy) ->
     let (mut sum, mut total) = (0.0f64, 0.0f64);
     let mut row_lambda = 0.0f32;
     let narrow = sigma <= NARROW_SIGMA;
+    // Per column across the view: whether some node reflects above the horizon, some below.
+    let (mut above, mut below) = ([false; 3], [false; 3]);
     lobe.visible_grid(wo, &GL_NODES, &GH_NODES, |i, j, m| {
         let wi = 2.0 * wo.dot(m) * m - wo;
+        above[j] |= wi.z > 0.0;
+        below[j] |= wi.z.is_nan() || wi.z <= 0.0;
         if j == 0 || !narrow {
             // Across a narrow lobe's row (the slope across the view) Λ varies far less than along
             // the view: its centre's value serves the row.
@@ -259,11 +269,87 @@ fn lobe_average(wo: Vec3, lobe: &SlopeGaussian, lambda_o: f32, proxy: &Proxy) ->
         sum += w * g_of(wi, lambda_o, row_lambda) as f64;
         total += w;
     });
+    if refine && (0..3).any(|j| above[j] && below[j]) {
+        return refined_average(wo, lobe, lambda_o, proxy);
+    }
     if total > 0.0 {
         (sum / total) as f32
     } else {
         weight_through(wo, mu, lambda_o, proxy)
     }
+}
+
+/// A lobe's visible share of the patch from which it takes [`refined_average`]: the 8-point rule
+/// misses up to ~5 % of a lobe whose reflections cross the horizon (g is a step there), which
+/// matters only where the lobe carries much of the patch (a flake patch of a few facets).
+const REFINE_SHARE: f64 = 0.05;
+
+/// Panels of [`refined_average`] along the view, and the bisection steps that place a horizon
+/// crossing inside one (to 2⁻⁸ of a panel).
+const PANELS: usize = 8;
+const BISECTIONS: usize = 8;
+
+/// The 2-point Gauss-Legendre rule on (0, 1).
+const GL2_NODES: [f32; 2] = [0.211_324_87, 0.788_675_1];
+
+/// E_{m ∼ D_wo,i}[g] for a lobe whose reflections cross the horizon, with the crossing resolved:
+/// per Gauss-Hermite column across the view, the visible slope's quantile axis (0, 1) along it in
+/// [`PANELS`] panels; a panel whose two ends reflect above the horizon takes the 2-point rule, one
+/// whose ends straddle it is cut at the crossing (bisection of the reflection's height) and its
+/// upper part takes the rule, one wholly below gives 0. g is smooth on each part, so the step that
+/// the 8-point rule misses is integrated to the bisection's resolution. About 30 inversions per
+/// column instead of 8. Assumes at most one crossing per panel.
+fn refined_average(wo: Vec3, lobe: &SlopeGaussian, lambda_o: f32, proxy: &Proxy) -> f32 {
+    // The reflection of wo about the visible normal at quantile u along the view and z2 across.
+    let reflect = |u: f32, z2: f64| -> Vec3 {
+        let mut wi = Vec3::NEG_Z;
+        lobe.visible_grid(wo, &[u], &[z2], |_, _, m| wi = 2.0 * wo.dot(m) * m - wo);
+        wi
+    };
+    let g_at = |wi: Vec3| {
+        if wi.z > 0.0 {
+            g_of(wi, lambda_o, proxy.lambda(wi))
+        } else {
+            0.0
+        }
+    };
+    let step = 1.0 / PANELS as f32;
+    let mut sum = 0.0f64;
+    for (&z2, &weight) in GH_NODES.iter().zip(&GH_WEIGHTS) {
+        let mut column = 0.0f64;
+        let mut lo = (0.0f32, reflect(0.0, z2).z);
+        for k in 1..=PANELS {
+            let u = k as f32 * step;
+            let hi = (u, reflect(u, z2).z);
+            let part = match (lo.1 > 0.0, hi.1 > 0.0) {
+                (true, true) => Some((lo.0, hi.0)),
+                (false, false) => None,
+                (lo_up, _) => {
+                    // Bisect the crossing: `a` keeps the side of lo, `b` the side of hi.
+                    let (mut a, mut b) = (lo.0, hi.0);
+                    for _ in 0..BISECTIONS {
+                        let c = 0.5 * (a + b);
+                        if (reflect(c, z2).z > 0.0) == lo_up {
+                            a = c;
+                        } else {
+                            b = c;
+                        }
+                    }
+                    Some(if lo_up { (lo.0, a) } else { (b, hi.0) })
+                }
+            };
+            if let Some((a, b)) = part {
+                let g: f32 = GL2_NODES
+                    .iter()
+                    .map(|&t| g_at(reflect(a + t * (b - a), z2)))
+                    .sum();
+                column += 0.5 * (b - a) as f64 * g as f64;
+            }
+            lo = hi;
+        }
+        sum += weight * column;
+    }
+    sum as f32
 }
 
 /// The estimate of E(wo) (module docs) of the patch D_P = Σ W_i D_i made of `lobes` (weights need
@@ -292,18 +378,35 @@ where
     };
     let merged = Merged::new(lobes, frame);
     let proxy = Proxy::new(merged.lobes());
-    let (mut num, mut den) = (0.0f64, 0.0f64);
-    for (w, lobe) in merged.lobes() {
-        let v = w as f64 * visible_area(&lobe, wo) as f64;
-        if v > 0.0 {
-            num += v * lobe_average(wo, &lobe, lambda_o, &proxy) as f64;
-            den += v;
+    // The lobes' weighted visible areas W_i V_i(wo) first: a lobe's share of them decides its rule.
+    let mut v = [0.0f64; MERGE_SIDE * MERGE_SIDE];
+    for (vi, (w, lobe)) in v.iter_mut().zip(merged.lobes()) {
+        *vi = (w as f64 * visible_area(&lobe, wo) as f64).max(0.0);
+    }
+    let lobes_v: f64 = v[..merged.n].iter().sum();
+    let extra_v: f64 = extra.iter().map(|&(ve, _)| (ve as f64).max(0.0)).sum();
+    let mut num = 0.0f64;
+    for (&vi, (_, lobe)) in v.iter().zip(merged.lobes()) {
+        if vi > 0.0 {
+            let refine = vi >= REFINE_SHARE * (lobes_v + extra_v);
+            num += vi * lobe_average(wo, &lobe, lambda_o, &proxy, refine) as f64;
         }
     }
-    for &(v, e) in extra {
-        if v > 0.0 {
-            num += v as f64 * e.clamp(0.0, 1.0) as f64;
-            den += v as f64;
+    for &(ve, e) in extra {
+        if ve > 0.0 {
+            num += ve as f64 * e.clamp(0.0, 1.0) as f64;
+        }
+    }
+    // The patch's own V_P(wo) = (1 + Λo) A_P(wo) normalises its visible normals; where it exceeds
+    // the lobes' (a conservative masking bound, such as Scarf's), part of D_wo's mass is lost to
+    // that bound and E is lower by V_lobes/V_P.
+    let mut den = lobes_v + extra_v;
+    if extra.is_empty() {
+        let total: f64 = merged.lobes().map(|(w, _)| w as f64).sum();
+        let a = wo.z as f64 - proxy.mean.dot(Vec2::new(wo.x, wo.y)) as f64;
+        let v_patch = (1.0 + lambda_o as f64) * a * total;
+        if v_patch.is_finite() && v_patch > den {
+            den = v_patch;
         }
     }
     if den > 0.0 && (num / den).is_finite() {
@@ -318,7 +421,7 @@ where
 const NARROW_SIGMA: f32 = 0.05;
 
 /// Side of the slope grid that merges the lobes of a patch with more than `MERGE_SIDE²` of them.
-const MERGE_SIDE: usize = 8;
+const MERGE_SIDE: usize = 12;
 
 /// The lobes the estimate runs over: a patch's own when it has at most [`MERGE_SIDE`]² of them,
 /// else its lobes pooled per cell of a [`MERGE_SIDE`]² grid over the pooled mean ± 3 pooled
@@ -521,5 +624,47 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// One tilted narrow lobe (a flake) at views whose reflections sweep through the horizon: the
+    /// estimate, with the step located ([`refined_average`]), against the furnace of the same lobe
+    /// by its own sampler: measured within 0.007, where the 8-point rule alone is off by up to 0.047
+    /// (a step between two of its nodes). A single lobe carries the whole patch, so it always takes
+    /// the refined rule.
+    #[test]
+    fn a_flake_crossing_the_horizon_matches_its_sampled_furnace() {
+        use crate::glint::kernels::lobe_set::LobeSet;
+        let flake =
+            SlopeGaussian::from_moments([0.45, 0.1, 0.2025 + 0.0025, 0.01 + 0.0016, 0.045], 0.03);
+        let mut set = LobeSet::default();
+        set.push(1.0, flake);
+        set.normalise();
+        let mut worst = 0.0f32;
+        // The flake leans ~25° away from these views: its mean reflection meets the horizon at
+        // θo ≈ 40°.
+        for deg in (28..=56).step_by(2) {
+            let t = (deg as f32).to_radians();
+            let wo = Vec3::new(t.sin(), 0.0, t.cos());
+            let e = lobes_albedo(
+                wo,
+                set.lambda(wo),
+                core::iter::once(Lobe::of(1.0, &flake)),
+                None,
+                &[],
+            );
+            let brdf = MicrofacetBrdf::new(set.clone(), NoFresnel);
+            let n = 1 << 16;
+            let mut sum = 0.0f64;
+            for k in 0..n {
+                let u = Vec2::new(
+                    (k as f32 + 0.5) / n as f32,
+                    ((k as f64 * 0.618_033_988_75).fract()) as f32,
+                );
+                sum += brdf.sample(wo, 0.5, u).map_or(0.0, |s| s.weight().x as f64);
+            }
+            let furnace = (sum / n as f64) as f32;
+            worst = worst.max((e - furnace).abs());
+        }
+        assert!(worst < 0.01, "largest |estimate − furnace| {worst}");
     }
 }
