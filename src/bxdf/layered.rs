@@ -133,6 +133,11 @@ impl<D: Ndf, F: Fresnel> LayeredBrdf<D, F> {
     /// ([`crate::bxdf::average_fresnel`]; channels clamped to [0, 1]). The albedo is then
     /// E_s + F_ms (1 − E) + ρ (1 − R̂): 1 for F = 1 up to the estimate's error, at most
     /// 1 − (1 − E)(F − F_ms) ≤ 1 otherwise (docs/bxdf.md).
+    ///
+    /// Call [`LayeredBrdf::prepare_view`] at the shading point's wo before querying it, as
+    /// `Material::bsdf` does: an unprepared compensated layer estimates E(wo) again at every `eval`,
+    /// `pdf` and `sample`, a pass over the patch's lobes each time (a chi-square run of a glint coat
+    /// ran 5× longer that way).
     pub fn with_energy_compensation(mut self, f_avg: Vec3) -> Self
     where
         D: AlbedoEstimate,
