@@ -73,7 +73,7 @@ impl TabulatedAlbedo for Beckmann {
 }
 
 /// The directional albedo E(wo) and E_avg the compensation reads: the isotropic table at α, or the
-/// anisotropic table's slice at (αx, αy) (1.2 kB; with `std` boxed so that isotropic materials stay
+/// anisotropic table's slice at (αx, αy) (2.2 kB; with `std` boxed so that isotropic materials stay
 /// small, without it inline, for there is no heap).
 #[cfg_attr(not(feature = "std"), allow(clippy::large_enum_variant))]
 #[derive(Clone, Debug)]
@@ -83,7 +83,7 @@ enum Albedo {
 }
 
 /// Where the anisotropic slice lives: on the heap with `std`, inline without it (the `no_std` core
-/// does not allocate; the BRDF is then 1.2 kB larger).
+/// does not allocate; the BRDF is then 2.2 kB larger).
 #[cfg(feature = "std")]
 type SliceStorage = Box<AnisotropicAlbedo>;
 #[cfg(not(feature = "std"))]
@@ -145,7 +145,7 @@ pub fn multiple_scattering_fresnel(f_avg: Vec3, e_avg: f32) -> Vec3 {
 /// A microfacet BRDF with Kulla-Conty multiple-scattering energy compensation:
 /// f = f_ss + F_ms (1 − E(wo)) (1 − E(wi)) / (π (1 − E_avg)) (module docs).
 ///
-/// Anisotropic NDFs read the anisotropic table's slice at (αx, αy), built in `new` (a 1.2 kB
+/// Anisotropic NDFs read the anisotropic table's slice at (αx, αy), built in `new` (a 2.2 kB
 /// slice, boxed with the `std` feature and inline without it; the type is `Clone`, not `Copy`);
 /// isotropic ones read the isotropic table.
 ///
