@@ -34,9 +34,11 @@ fn main() -> Res<()> {
         (
             "Energy compensation",
             "The white furnace of the microfacet BRDF before and after Kulla-Conty compensation \
-             against α and θo, and rough gold spheres uncompensated against compensated (the \
-             energy example; preview: 13 values of α, θo every 4°, the spheres from 33 values of \
-             μ, where --full computes 25, every 2° and 129).",
+             against α and θo (isotropic and anisotropic), of glint patches before and after \
+             their own compensation, and rough gold spheres uncompensated against compensated \
+             (the energy example; preview: 13 values of α, θo every 4° (anisotropic 8°, glint \
+             10° at 512 draws), the spheres from 33 values of μ, where --full computes 25, every \
+             2° (4°, 5° at 4,096 draws) and 129).",
             common::energy::run,
         ),
         (

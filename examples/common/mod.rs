@@ -8,6 +8,7 @@
 pub mod compare;
 pub mod curves;
 pub mod energy;
+pub mod energy_glint;
 pub mod grazing;
 pub mod lobes;
 pub mod material;
