@@ -8,30 +8,9 @@ use crate::support;
 use brdf::MicrofacetBrdf;
 use brdf::fresnel::NoFresnel;
 use brdf::glint::binmap::{BinMapParams, PatchOptions};
-use brdf::glint::{
-    BinMap, BrushedParams, FlakesParams, Footprint, GlintNdf, NormalMap, ScratchedParams, brushed,
-    bumpy, flakes, scratched,
-};
+use brdf::glint::{BinMap, Footprint, GlintNdf};
 use brdf::ndf::Ndf;
 use brdf::{Vec2, Vec3};
-
-fn maps(n: usize, seed: u64) -> Vec<(&'static str, NormalMap)> {
-    vec![
-        ("bumpy", bumpy(n, n, 0.25, 4.0, seed).unwrap()),
-        (
-            "brushed",
-            brushed(n, n, BrushedParams::default(), seed).unwrap(),
-        ),
-        (
-            "scratched",
-            scratched(n, n, ScratchedParams::default(), seed).unwrap(),
-        ),
-        (
-            "flakes",
-            flakes(n, n, FlakesParams::default(), seed).unwrap(),
-        ),
-    ]
-}
 
 fn dir(theta: f32, phi: f32) -> Vec3 {
     let (t, p) = (theta.to_radians(), phi.to_radians());
@@ -56,7 +35,7 @@ fn visible_area_ratio_probe() {
         ..exact
     };
     for seed in 1..=3u64 {
-        for (name, map) in maps(n, seed) {
+        for (name, map) in support::procedural_maps_seeded(n, seed) {
             let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
             let mut row = vec![];
             for area in [128.0f32, 256.0, 1024.0, 4096.0, 8192.0] {

@@ -104,28 +104,141 @@ fn the_tolerance_chooses_the_masking_form() {
     }
 }
 
-/// The renderer's furnace of the moment lobe's masking at every footprint a limit can give it
-/// (160-4096 texels with the limit at its floor; four 256² maps, θo = 0°, 45°, 70°, 85°) stays
-/// within 1.5 % of 1 (plus 4 standard errors). Not ≤ 1: Scarf's bound bounds the visible area of
-/// the footprint's own moments, and the mip chain's box-filtered moments differ slightly; measured
-/// up to 1.009 ± 0.004 here, and 1.0135 on flakes at 8192 texels under the default limit
-/// (tests/it/binmap_furnace.rs), hence 1.5 %.
-#[test]
-fn the_moment_lobe_masking_stays_within_one_and_a_half_percent_of_the_furnace() {
-    let n = 2048;
-    for (name, map) in procedural_maps(256) {
-        let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
-        for area in [160.0f32, 256.0, 1024.0, 4096.0] {
-            let fp = Footprint::isotropic_texels(Vec2::new(0.37, 0.61), area, 256, 256);
-            assert!(!bm.patch_with(&fp, &options(0.0), None).has_exact_masking());
-            for theta in [0.0, 45.0, 70.0, 85.0] {
-                let [a, se, _] = measure(&bm, &fp, &options(0.0), view(theta), n);
-                assert!(
-                    a <= 1.015 + 4.0 * se,
-                    "{name} {area} texels θo {theta}°: furnace {a} ± {se}"
-                );
+/// Allowance of the furnace checks beyond 3 standard errors: the `f32` rounding of the sample
+/// weights' sum at views where every weight is 1 (normal incidence on a flat patch: standard
+/// error 0).
+const ROUNDING: f64 = 1e-5;
+
+/// The furnace (mean sample weight, `n` stratified draws) at every view of `thetas` × `phis` of each
+/// footprint, under each of `choices` (label, options); returns the failures (E above 1 + 3
+/// standard errors) and the largest E − 1 in standard errors.
+fn furnace_failures(
+    bm: &BinMap,
+    footprints: &[Footprint],
+    choices: &[(&str, PatchOptions)],
+    thetas: &[f32],
+    phis: &[f32],
+    n: usize,
+) -> (Vec<String>, f64) {
+    let mut failures = Vec::new();
+    let mut worst = f64::NEG_INFINITY;
+    for fp in footprints {
+        for (label, opts) in choices {
+            let patch = bm.patch_with(fp, opts, None);
+            for &theta in thetas {
+                for &phi in phis {
+                    let (t, p) = (theta.to_radians(), phi.to_radians());
+                    let wo = Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+                    let (a, se) = albedo(&MicrofacetBrdf::new(&patch, NoFresnel), wo, n);
+                    if se > 0.0 {
+                        worst = worst.max((a - 1.0) / se);
+                    }
+                    if a > 1.0 + 3.0 * se + ROUNDING {
+                        failures.push(format!(
+                            "{label} {:.0} texels θo {theta}° φo {phi}°: {a:.5} ± {se:.5}",
+                            patch.area_texels()
+                        ));
+                    }
+                }
             }
         }
+    }
+    (failures, worst)
+}
+
+/// The masking choices of the furnace checks: the moment lobe from its floor (the limit at 0), the
+/// defaults, and the footprint's own bins (no limit).
+fn choices() -> [(&'static str, PatchOptions); 3] {
+    [
+        ("moment lobe", options(0.0)),
+        ("defaults", PatchOptions::default()),
+        ("own bins", options(f32::INFINITY)),
+    ]
+}
+
+/// The footprints of the furnace checks on `n`² maps: `area` texels, isotropic at two centres and
+/// 4:1 and 8:1 rotated.
+fn footprints(area: f32, n: usize) -> Vec<Footprint> {
+    [
+        (0.37f32, 0.61f32, 1.0f32, 0.0f32),
+        (0.71, 0.23, 1.0, 0.0),
+        (0.13, 0.87, 4.0, 0.5),
+        (0.52, 0.44, 8.0, 1.1),
+    ]
+    .iter()
+    .map(|&(cx, cy, aniso, rot)| {
+        if aniso == 1.0 {
+            Footprint::isotropic_texels(Vec2::new(cx, cy), area, n, n)
+        } else {
+            let minor = (area / aniso).sqrt() / n as f32;
+            let a = Vec2::new(rot.cos(), rot.sin()) * minor * aniso;
+            let b = Vec2::new(-rot.sin(), rot.cos()) * minor;
+            Footprint::from_differentials(Vec2::new(cx, cy), a, b)
+        }
+    })
+    .collect()
+}
+
+/// The views of the furnace checks: θo = 0-80° every 10° at four azimuths.
+const THETAS: [f32; 9] = [0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0];
+const PHIS: [f32; 4] = [20.0, 110.0, 200.0, 290.0];
+
+/// The renderer's furnace of the bin map stays at most 1 + 3 standard errors at every masking its
+/// options can choose (the moment lobe from its floor, the defaults, the footprint's own bins) on
+/// the four procedural maps at 128², seeds 2 and 3, footprints of 256 texels (four shapes), θo ≤ 80°.
+/// With the moment chain of the map's own slopes in 4 × 4-texel cells read over at most 64 cells,
+/// 93 of these cells failed (scratched, brushed and flakes, the defaults included, up to 8.8 standard errors).
+/// The full grid: `the_furnace_sweep`.
+#[test]
+fn the_furnace_stays_at_most_one_at_any_masking() {
+    let mut failures = Vec::new();
+    for seed in [2u64, 3] {
+        for (name, map) in support::procedural_maps_seeded(128, seed) {
+            let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
+            let (f, _) = furnace_failures(
+                &bm,
+                &footprints(256.0, 128),
+                &choices(),
+                &THETAS,
+                &PHIS,
+                1024,
+            );
+            failures.extend(f.into_iter().map(|f| format!("{name} seed {seed}: {f}")));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The grid, measured: the four procedural maps at 128² for seeds 1-3, footprints of 128,
+/// 256, 1024, 4096 and 8192 texels (four shapes each), θo = 0-80° every 10°, four azimuths, each
+/// masking choice (25,920 cells); prints per map the largest (E − 1) / standard error and every cell
+/// above 1 + 3 standard errors (docs/results.md, "Inverse bin map: the masking level of detail").
+/// `cargo test --release --test it -- --ignored binmap_masking_lod::the_furnace_sweep --nocapture`.
+#[test]
+#[ignore = "~8 min in release"]
+fn the_furnace_sweep() {
+    let n = 128;
+    let mut failures = Vec::new();
+    let mut worst = f64::NEG_INFINITY;
+    for seed in 1..=3u64 {
+        for (name, map) in support::procedural_maps_seeded(n, seed) {
+            let bm = BinMap::build(&map, BinMapParams::default()).unwrap();
+            let fps: Vec<Footprint> = [128.0f32, 256.0, 1024.0, 4096.0, 8192.0]
+                .iter()
+                .flat_map(|&a| footprints(a, n))
+                .collect();
+            let (f, w) = furnace_failures(&bm, &fps, &choices(), &THETAS, &PHIS, 1024);
+            println!("{name} seed {seed}: largest (E − 1) / SE {w:.2}");
+            worst = worst.max(w);
+            failures.extend(f.into_iter().map(|f| format!("{name} seed {seed}: {f}")));
+        }
+    }
+    println!(
+        "largest (E − 1) / SE over the sweep: {worst:.2}; {} cells above 1 + 3 SE",
+        failures.len()
+    );
+    for f in &failures {
+        println!("{f}");
     }
 }
 

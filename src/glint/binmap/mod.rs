@@ -84,8 +84,8 @@ impl BinMapMemory {
 ///
 /// Stored: 𝓑 and 𝓑⁻¹ (2 or 4 + 4 bytes per sub-texel, s² sub-texels per texel), the forest (two
 /// `u32` per internal node), the lookup,
-/// per-bin mean cosines and centre slopes, and the slope-moment mip chain from level
-/// [`MASKING_FIRST_LEVEL`] for the masking lobe (≈ 1.7 bytes per texel). The normal map itself is not
+/// per-bin mean cosines and centre slopes, and the bins' slope-moment mip chain from level
+/// [`MASKING_FIRST_LEVEL`] for the masking lobe (≈ 6.7 bytes per texel). The normal map itself is not
 /// kept. See [`BinMap::memory`].
 ///
 /// # Reference
@@ -303,8 +303,10 @@ impl BinMap {
         }
         let (facets, center_slope) = bin_tables(&bins, &offsets);
         let table = Table::new(params.lookup, offsets, roots);
-        // The masking lobe's moments: only the levels it reads (from MASKING_FIRST_LEVEL), built here.
-        let moments = MomentPyramid::build_from(width, height, map.slopes(), MASKING_FIRST_LEVEL);
+        // The masking lobe's moments: the bins' own, only the levels it reads (from
+        // MASKING_FIRST_LEVEL).
+        let moments =
+            footprint_moments::chain(&bins, &|k| bin_map.get(k).unwrap_or(pole), width, height, s);
         Ok(BinMap {
             width,
             height,

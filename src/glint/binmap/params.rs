@@ -33,31 +33,32 @@ pub const MAX_SUBDIVISIONS: usize = 16;
 /// Default lookup: measured faster than the hash table at 2048² (docs/results.md).
 pub const DEFAULT_LOOKUP: BinLookup = BinLookup::Dense;
 
-/// The finest level of the slope-moment mip chain kept for the masking lobe: level 2 (4 × 4 texels
-/// per moment texel), 20 B / 16 texels ≈ 1.7 B per texel for the whole chain. Footprints narrower
-/// than 4 texels take their masking lobe from level 2.
-pub const MASKING_FIRST_LEVEL: usize = 2;
+/// The finest level of the bins' slope-moment mip chain kept for the masking lobe: level 1 (2 × 2
+/// texels per moment texel), 20 B / 4 texels ≈ 6.7 B per texel for the whole chain. With level 2
+/// (4 × 4 texels) the boundary cells of a footprint mixed in enough slopes from outside it for the
+/// furnace to reach 1.0143 ± 0.0016 (src/glint/binmap/footprint_moments.rs).
+pub const MASKING_FIRST_LEVEL: usize = 1;
 
 /// Default [`PatchOptions::exact_masking_texels`]: 4096 texels, the cost cap of the exact masking
 /// pass. Below it a footprint's masking is the exact Smith terms of its own bins unless the map's
 /// measured error of the O(1) moment lobe is within [`PatchOptions::moment_masking_tolerance`];
-/// that lobe loses up to 10 % of the albedo at θo = 45°, 22 % at 70° and 59 % at 85° on some
-/// procedural maps (bumpy, flakes) and 0.3 % / 2 % / 14 % on others (scratched), hence a
+/// that lobe loses up to 6 % of the albedo at θo = 45°, 12 % at 70° and 18 % at 85° on some
+/// procedural maps (bumpy, flakes) and 0.2 % / 1.5 % / 9 % on others (scratched), hence a
 /// per-map choice (docs/results.md, "Inverse bin map: the masking level of detail").
 pub const DEFAULT_EXACT_MASKING_TEXELS: f32 = 4096.0;
 
 /// Smallest footprint (texels²) that takes the moment lobe's masking whatever
-/// [`PatchOptions::exact_masking_texels`] says: 128. Below it the mip chain's moments (kept from
-/// level [`MASKING_FIRST_LEVEL`], read at radius ½√|A|) are not the footprint's, so Scarf's bound is
-/// not an upper bound on its visible area and the furnace exceeds 1 (measured up to 1.41 at 85° and
-/// 1.10 at 45° on 64-texel footprints); from 128 texels it stays within 1 % of 1 on the test maps,
-/// the excess the default limit also has above 4096 (tests/it/binmap_masking_lod.rs).
+/// [`PatchOptions::exact_masking_texels`] says: 128. Below it the footprint's boundary cells of the
+/// moment chain weigh too much for its moments to be the footprint's, so Scarf's bound need not
+/// bound its visible area (with the chain's former 4 × 4-texel cells the furnace reached 1.41 at 85°
+/// and 1.10 at 45° on 64-texel footprints); from 128 texels the furnace stays at most 1 + 3 standard
+/// errors on the test maps (tests/it/binmap_masking_lod.rs).
 pub const MIN_MOMENT_MASKING_TEXELS: f32 = 128.0;
 
 /// Default [`PatchOptions::moment_masking_tolerance`]: 0.02, a 2 % mean error of G1 at 45° and
-/// 70°. On the procedural maps it serves the moment lobe on scratched (measured 0.004-0.005) and
-/// brushed (0.012-0.014), where its albedo stays within 0.3 % at 45° and 3 % at 70° of the exact
-/// terms', and not on bumpy (0.046-0.048) or flakes (0.026-0.031), which lose up to 10 % and 22 %
+/// 70°. On the procedural maps it serves the moment lobe on scratched (measured 0.003-0.004) and
+/// brushed (0.009-0.010), where its albedo stays within 0.3 % at 45° and 2.3 % at 70° of the exact
+/// terms', and not on bumpy (0.044-0.046) or flakes (0.024-0.028), which lose up to 12 % and 9 %
 /// (docs/results.md, "Inverse bin map: the masking level of detail").
 pub const DEFAULT_MOMENT_MASKING_TOLERANCE: f32 = 0.02;
 

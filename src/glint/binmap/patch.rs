@@ -57,11 +57,12 @@ const SMOOTH_TAIL: f64 = 1e-6;
 /// V(w) = Σ_j mass_j V_j(w) and A(w) = max(Σ_j mass_j (cos θ − w_xy·μ_j), 0), μ_j the centre slope
 /// of bin j (the unsmoothed bins' V under-counted the smoothed D's visible area: white furnace up to
 /// 1.25 at grazing angles before). Larger footprints use the Smith terms of
-/// the footprint's filtered-moment Beckmann lobe ([`SlopeGaussian::from_moments`] of the map's
-/// moment mip chain read over the footprint's exact cell overlaps, at most 64 cells, σ floored at
-/// `sigma_min`; src/glint/binmap/footprint_moments.rs), whose
-/// first two slope moments approximate the footprint's (second moments raised by σ² for the
-/// smoothed variant). See docs/binmap.md and the white furnace in
+/// the footprint's filtered-moment Beckmann lobe ([`SlopeGaussian::from_moments`] of the bins'
+/// moment mip chain read over the footprint's exact cell overlaps, at most 256 cells of 2 × 2
+/// texels, σ floored at `sigma_min`; src/glint/binmap/footprint_moments.rs), whose first two slope
+/// moments are the footprint's D's but for its boundary cells (second moments raised by σ² for the
+/// smoothed variant, whose lobes sit at the bins' centres rather than spread over them: its second
+/// moments are then over-counted by the bins' own spread, the safe side of Scarf's bound). See docs/binmap.md and the white furnace in
 /// tests/it/binmap_furnace.rs. The lobe's V is replaced by Scarf's moment bound
 /// ([`BinMapPatch::moment_bound_visible_area`]) and A by its signed projected area, so Λ is
 /// conservative (a Gaussian's V can be below a spiky distribution's with the same moments).
@@ -252,7 +253,8 @@ impl<'a> BinMapPatch<'a> {
 
     /// Scarf's bound of the visible area from the masking lobe's first two moments
     /// ([`SlopeGaussian::visible_area_bound`]): conservative, so the white furnace stays ≤ 1 whatever
-    /// the footprint's slope distribution when the moments are the footprint's.
+    /// the footprint's slope distribution when the moments are the footprint's (they are, but for
+    /// the boundary cells of the moment chain: src/glint/binmap/footprint_moments.rs).
     pub fn moment_bound_visible_area(&self, w: Vec3) -> f32 {
         self.lobe.visible_area_bound(w)
     }

@@ -3,8 +3,9 @@
 //! Stored: the map size, the build parameters (sub-texel resolution s included), the prefix-sum
 //! offsets of the bins' lists (B + 1) and their tree roots (B), the packed forest, the inverse bin
 //! map 𝓑⁻¹ in the forest's order (u32 per sub-texel of the (s·width) × (s·height) grid), the bin map
-//! 𝓑 itself (u16 per sub-texel, u32 above 2¹⁶ bins), and the coarse slope-moment chain of the
-//! masking lobe. Rebuilt on load (cheap, by the build's own routines): the per-bin tables (centre
+//! 𝓑 itself (u16 per sub-texel, u32 above 2¹⁶ bins), the bins' slope-moment chain of the masking
+//! lobe and its measured errors (a file whose chain starts at level 2 holds the map's own slopes:
+//! its chain is rebuilt from 𝓑 and its errors measured again). Rebuilt on load (cheap, by the build's own routines): the per-bin tables (centre
 //! slopes, masking facets) and the lookup (dense or hash) from the offsets and roots.
 //!
 //! The inverse map and the forest are stored rather than rebuilt because sorting the texels into the
@@ -35,6 +36,10 @@
 use super::forest::NO_TREE;
 use super::lookup::Table;
 use super::{BinIndex, BinLookup, BinMap, BinMapParams, MASKING_FIRST_LEVEL, check_params};
+
+/// The first level of the moment chain in files written when it held the map's own slopes from
+/// 4 × 4-texel cells.
+const LEGACY_MOMENTS_FIRST: usize = 2;
 use crate::Result;
 use crate::glint::MAX_SLOPE;
 use crate::glint::io::format::{self, Decoder, Kind, Stored, invalid};
@@ -185,7 +190,7 @@ impl BinMap {
                         |at, chunk| assigned.add(at, chunk.as_flattened()),
                     )?))
                 };
-                let levels = read_moments(&mut d, &sizes[first..], first)?;
+                let (stored_first, levels) = read_moments(&mut d, &sizes, first)?;
                 // Format version 6 holds the moment-lobe masking's measured errors (at most one
                 // per level of the map); older files get them measured, as a build does.
                 let errors = if d.version() >= 6 {
@@ -194,12 +199,17 @@ impl BinMap {
                     None
                 };
                 d.finish()?;
-                Ok((bin_map, levels, errors, assigned.finish()))
+                Ok((bin_map, stored_first, levels, errors, assigned.finish()))
             })?;
             Ok::<_, crate::Error>((inverse, rest))
         });
-        let (inverse, (bin_map, levels, errors, assigned)) = read?;
-        let errors: Option<Vec<f32>> = errors.map(|e| e.into_iter().map(|[v]| v).collect());
+        let (inverse, (bin_map, stored_first, levels, errors, assigned)) = read?;
+        // A chain from level 2 holds the map's own slopes (files written before the chain became the
+        // bins'): rebuilt from 𝓑 below, and the errors measured on it again.
+        let legacy = stored_first != first;
+        let errors: Option<Vec<f32>> = errors
+            .filter(|_| !legacy)
+            .map(|e| e.into_iter().map(|[v]| v).collect());
         // Relative G1 errors, capped at 1 when measured.
         if let Some(e) = errors.iter().flatten().find(|e| !(0.0..=1.0).contains(*e)) {
             return Err(invalid(format!(
@@ -220,6 +230,18 @@ impl BinMap {
             return Err(disagreement(&inverse, &offsets, &bin_map));
         }
         let (facets, center_slope) = tables.expect("the tables task ran");
+        let moments = if legacy {
+            let pole = bins.bin_of(glam::Vec3::Z).unwrap_or(0);
+            super::footprint_moments::chain(
+                &bins,
+                &|k| bin_map.get(k).unwrap_or(pole),
+                width,
+                height,
+                s,
+            )
+        } else {
+            MomentPyramid::from_parts(first, levels)
+        };
         Ok(BinMap {
             width,
             height,
@@ -233,7 +255,7 @@ impl BinMap {
             table: Table::new(params.lookup, offsets, roots),
             center_slope,
             facets,
-            moments: MomentPyramid::from_parts(first, levels),
+            moments,
             moment_masking_error: Vec::new(),
         }
         .with_masking_errors(errors))
@@ -282,21 +304,28 @@ fn pair(k: u32, b: usize, nb: usize) -> u64 {
     k as u64 * nb as u64 + b as u64
 }
 
-/// The coarse moment chain of the masking lobe: its first level and level count (which must be
-/// `first` and `sizes.len()`), then each level's size (which must be the one in `sizes`) and its
-/// moments.
+/// The masking lobe's moment chain: its first level and level count, then each level's size (which
+/// must be the one in `sizes`, the map's whole chain) and its moments. The first level is `first`
+/// or [`LEGACY_MOMENTS_FIRST`] (older files, whose chain the loader rebuilds); returns it with the
+/// levels read.
 fn read_moments(
     d: &mut Decoder<'_>,
     sizes: &[(usize, usize)],
     first: usize,
-) -> Result<Vec<MomentLevel>> {
+) -> Result<(usize, Vec<MomentLevel>)> {
     let stored_first = d.len("moments first level", usize::MAX)?;
-    let level_count = d.len("moment levels", first + sizes.len())?;
-    if stored_first != first || level_count != sizes.len() {
+    let legacy = LEGACY_MOMENTS_FIRST.min(sizes.len() - 1);
+    if stored_first != first && stored_first != legacy {
         return Err(invalid(format!(
-            "moment chain from level {stored_first} with {level_count} levels; the map keeps \
-             levels {first}..{}",
-            first + sizes.len()
+            "moment chain from level {stored_first}; the map keeps levels from {first}"
+        )));
+    }
+    let sizes = &sizes[stored_first..];
+    let level_count = d.len("moment levels", stored_first + sizes.len())?;
+    if level_count != sizes.len() {
+        return Err(invalid(format!(
+            "moment chain from level {stored_first} with {level_count} levels; the map's has {}",
+            sizes.len()
         )));
     }
     let mut levels = Vec::with_capacity(level_count);
@@ -317,7 +346,7 @@ fn read_moments(
             data,
         });
     }
-    Ok(levels)
+    Ok((stored_first, levels))
 }
 
 /// The fingerprint at `z` of the pairs (k, 𝓑(k)) over every sub-texel k, taken chunk by chunk as 𝓑
@@ -593,6 +622,37 @@ impl Forest<'_> {
 #[cfg(test)]
 mod tests {
     use super::Divisor;
+    use crate::glint::binmap::{BinMap, BinMapParams};
+    use crate::glint::surface::MomentPyramid;
+
+    /// A file whose chain starts at level 2 (the map's own slopes, as files were written before the
+    /// chain became the bins') loads with the chain a build makes and its errors measured again.
+    #[test]
+    fn a_legacy_moment_chain_is_rebuilt_on_load() {
+        let map = crate::glint::bumpy(48, 48, 0.25, 4.0, 3).unwrap();
+        let built = BinMap::build(&map, BinMapParams::default()).unwrap();
+        let mut legacy = built.clone();
+        legacy.moments = MomentPyramid::build_from(48, 48, map.slopes(), 2);
+        legacy.moment_masking_error = vec![0.5; built.moment_masking_error.len()];
+        let mut file = Vec::new();
+        legacy.save(&mut file).unwrap();
+        let loaded = BinMap::load(&mut file.as_slice()).unwrap();
+        let ((lf, ll), (bf, bl)) = (loaded.moments.parts(), built.moments.parts());
+        assert_eq!((lf, ll.len()), (bf, bl.len()));
+        assert_eq!(lf, 1);
+        for (a, b) in ll.iter().zip(bl) {
+            assert_eq!(a.data, b.data);
+        }
+        assert_eq!(
+            loaded.moment_masking_errors(),
+            built.moment_masking_errors()
+        );
+        // The current layout loads as saved.
+        let mut file = Vec::new();
+        built.save(&mut file).unwrap();
+        let again = BinMap::load(&mut file.as_slice()).unwrap();
+        assert_eq!(again.moments.parts().1[0].data, bl[0].data);
+    }
 
     #[test]
     fn divisor_matches_hardware_division() {

@@ -65,12 +65,24 @@ impl MomentPyramid {
     /// level is reduced from the one below it, so the finer levels are computed too (the values are
     /// those of [`MomentPyramid::build`], bit for bit), but each is dropped once the next is made.
     pub fn build_from(width: usize, height: usize, slopes: &[Vec2], first: usize) -> MomentPyramid {
-        let sizes = Self::level_sizes(width, height);
-        let first = first.min(sizes.len() - 1);
         let base: Vec<[f32; 5]> = slopes
             .par_iter()
             .map(|s| [s.x, s.y, s.x * s.x, s.y * s.y, s.x * s.y])
             .collect();
+        Self::build_from_moments(width, height, base, first)
+    }
+
+    /// [`MomentPyramid::build_from`] from level-0 moments given per texel (`width × height`, row
+    /// major): for models whose texel's slope distribution is not one slope (the bin map's
+    /// sub-texel bins).
+    pub fn build_from_moments(
+        width: usize,
+        height: usize,
+        base: Vec<[f32; 5]>,
+        first: usize,
+    ) -> MomentPyramid {
+        let sizes = Self::level_sizes(width, height);
+        let first = first.min(sizes.len() - 1);
         let mut current = MomentLevel {
             width,
             height,

@@ -89,6 +89,29 @@ pub fn proptest_config(cases: u32) -> proptest::test_runner::Config {
     }
 }
 
+/// The four procedural maps at `n`² with the gallery's parameters (as [`procedural_maps`]), every
+/// one of seed `seed`.
+pub fn procedural_maps_seeded(n: usize, seed: u64) -> Vec<(&'static str, brdf::glint::NormalMap)> {
+    use brdf::glint::{
+        BrushedParams, FlakesParams, ScratchedParams, brushed, bumpy, flakes, scratched,
+    };
+    vec![
+        ("bumpy", bumpy(n, n, 0.25, 4.0, seed).unwrap()),
+        (
+            "brushed",
+            brushed(n, n, BrushedParams::default(), seed).unwrap(),
+        ),
+        (
+            "scratched",
+            scratched(n, n, ScratchedParams::default(), seed).unwrap(),
+        ),
+        (
+            "flakes",
+            flakes(n, n, FlakesParams::default(), seed).unwrap(),
+        ),
+    ]
+}
+
 /// The four procedural maps at `n`² with the gallery's parameters and seeds (bumpy: RMS slope 0.25,
 /// ℓ = 4 texels; brushed, scratched, flakes: their defaults), in that order.
 pub fn procedural_maps(n: usize) -> Vec<(&'static str, brdf::glint::NormalMap)> {
