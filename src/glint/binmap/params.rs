@@ -50,8 +50,8 @@ pub const DEFAULT_EXACT_MASKING_TEXELS: f32 = 4096.0;
 /// Smallest footprint (texels²) that takes the moment lobe's masking whatever
 /// [`PatchOptions::exact_masking_texels`] says: 128. Below it the footprint's boundary cells of the
 /// moment chain weigh too much for its moments to be the footprint's, so Scarf's bound need not
-/// bound its visible area (with the chain's former 4 × 4-texel cells the furnace reached 1.41 at 85°
-/// and 1.10 at 45° on 64-texel footprints); from 128 texels the furnace stays at most 1 + 3 standard
+/// bound its visible area (with 4 × 4-texel cells of the map's own slopes the furnace reaches 1.41
+/// at 85° and 1.10 at 45° on 64-texel footprints: docs/binmap.md); from 128 texels the furnace stays at most 1 + 3 standard
 /// errors on the test maps (tests/it/binmap_masking_lod.rs).
 pub const MIN_MOMENT_MASKING_TEXELS: f32 = 128.0;
 

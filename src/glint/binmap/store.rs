@@ -4,9 +4,10 @@
 //! offsets of the bins' lists (B + 1) and their tree roots (B), the packed forest, the inverse bin
 //! map 𝓑⁻¹ in the forest's order (u32 per sub-texel of the (s·width) × (s·height) grid), the bin map
 //! 𝓑 itself (u16 per sub-texel, u32 above 2¹⁶ bins), the bins' slope-moment chain of the masking
-//! lobe and its measured errors (a file whose chain starts at level 2 holds the map's own slopes:
-//! its chain is rebuilt from 𝓑 and its errors measured again). Rebuilt on load (cheap, by the build's own routines): the per-bin tables (centre
-//! slopes, masking facets) and the lookup (dense or hash) from the offsets and roots.
+//! lobe and its measured errors (a chain stored from level 2 holds the map's own slopes: it is
+//! rebuilt from 𝓑 and the errors are measured again). Rebuilt on load (cheap, by the build's own
+//! routines): the per-bin tables (centre slopes, masking facets) and the lookup (dense or hash)
+//! from the offsets and roots.
 //!
 //! The inverse map and the forest are stored rather than rebuilt because sorting the texels into the
 //! trees is most of the build; 𝓑 is stored because deriving it from 𝓑⁻¹ writes one sub-texel at a
@@ -36,10 +37,6 @@
 use super::forest::NO_TREE;
 use super::lookup::Table;
 use super::{BinIndex, BinLookup, BinMap, BinMapParams, MASKING_FIRST_LEVEL, check_params};
-
-/// The first level of the moment chain in files written when it held the map's own slopes from
-/// 4 × 4-texel cells.
-const LEGACY_MOMENTS_FIRST: usize = 2;
 use crate::Result;
 use crate::glint::MAX_SLOPE;
 use crate::glint::io::format::{self, Decoder, Kind, Stored, invalid};
@@ -47,6 +44,10 @@ use crate::glint::io::multiset;
 use crate::glint::surface::{MomentLevel, MomentPyramid};
 use rayon::prelude::*;
 use std::io::{Read, Write};
+
+/// The first level of a stored moment chain in the format's older layout, whose chain holds the
+/// map's own texel slopes from 4 × 4-texel cells (rebuilt from 𝓑 on load).
+const LEGACY_MOMENTS_FIRST: usize = 2;
 
 impl BinMap {
     /// Writes the bin map in the crate's binary format (docs/format.md): size, parameters, 𝓑⁻¹, 𝓑,
@@ -204,8 +205,8 @@ impl BinMap {
             Ok::<_, crate::Error>((inverse, rest))
         });
         let (inverse, (bin_map, stored_first, levels, errors, assigned)) = read?;
-        // A chain from level 2 holds the map's own slopes (files written before the chain became the
-        // bins'): rebuilt from 𝓑 below, and the errors measured on it again.
+        // A chain stored from level 2 holds the map's own slopes (the format's older layout):
+        // rebuilt from 𝓑 below, and the errors measured on it again.
         let legacy = stored_first != first;
         let errors: Option<Vec<f32>> = errors
             .filter(|_| !legacy)
@@ -625,8 +626,8 @@ mod tests {
     use crate::glint::binmap::{BinMap, BinMapParams};
     use crate::glint::surface::MomentPyramid;
 
-    /// A file whose chain starts at level 2 (the map's own slopes, as files were written before the
-    /// chain became the bins') loads with the chain a build makes and its errors measured again.
+    /// A file whose chain starts at level 2 (the map's own slopes: the format's older layout) loads
+    /// with the chain a build makes and its errors measured again.
     #[test]
     fn a_legacy_moment_chain_is_rebuilt_on_load() {
         let map = crate::glint::bumpy(48, 48, 0.25, 4.0, 3).unwrap();
