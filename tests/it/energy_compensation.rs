@@ -575,7 +575,7 @@ fn anisotropic_furnace_near_the_smooth_axis() {
 }
 
 #[test]
-#[ignore = "~2 min: cargo test --release --test it energy_compensation:: -- --ignored anisotropic_furnace_near_the_smooth_axis_sweep --nocapture"]
+#[ignore = "~20 s: cargo test --release --test it energy_compensation:: -- --ignored anisotropic_furnace_near_the_smooth_axis_sweep --nocapture"]
 fn anisotropic_furnace_near_the_smooth_axis_sweep() {
     // 6 pairs × 12 azimuths 0.5-25° from the smooth axis × 7 views: 504 points per family.
     let pairs = [
