@@ -17,7 +17,7 @@
 //! standard errors in 6 of 25,920 cells of that grid (up to 1.0105 ± 0.0031; 64 cells of 4 × 4
 //! texels of the map's own slopes: 1.075, and 125 cells up to 1.0143 ± 0.0016; every texel read
 //! without a cap: 1.0004). docs/results.md, "Inverse bin map: the masking level of detail".
-
+//!
 //! The trilinear lookup at the footprint centre and radius ½√|A| weights a tent around the centre
 //! whose extent and shape are not the footprint's (isotropic, one to two cells of a level whose
 //! cells are as wide as the footprint): the fallback for a footprint that meets no cell.
@@ -37,8 +37,8 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 /// Largest number of cells of the chain in the footprint's bounding box: 256 (a footprint read at
-/// about sixteen cells across). 64 left V_bins/V_lobe up to 1.062 (bumpy, 128 texels) and the furnace
-/// at 1.0143 ± 0.0016 (scratched, 256 texels); 128 the same furnace.
+/// about sixteen cells across). With 64, V_bins/V_lobe reached 1.080 (flakes, 1024 texels); with 128,
+/// 1.062 (bumpy, 128 texels) and the furnace 1.0143 ± 0.0016 (scratched, 256 texels).
 pub(crate) const MAX_FOOTPRINT_CELLS: f64 = 256.0;
 
 /// Sub-cells per axis of the midpoint rule of a bin's second moments ([`bin_moments`]), and of the
