@@ -8,6 +8,16 @@ use crate::glint::HemisphereBins;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
+/// The centre of sub-cell k (row major) of the g × g grid of the unit square: the midpoint rule's
+/// points over a bin's equal-area cell (`HemisphereBins::sample_in_bin`).
+#[inline]
+pub(super) fn sub_cell(k: usize, g: usize) -> Vec2 {
+    Vec2::new(
+        ((k % g) as f32 + 0.5) / g as f32,
+        ((k / g) as f32 + 0.5) / g as f32,
+    )
+}
+
 /// What the exact masking terms need of one bin H_j (see [`BinMapPatch`](super::BinMapPatch)).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(super) struct BinFacet {
@@ -43,11 +53,7 @@ impl BinFacet {
         let g = Self::MEAN_GRID;
         let mut sum = [0.0f64; 2];
         for k in 0..g * g {
-            let u = Vec2::new(
-                ((k % g) as f32 + 0.5) / g as f32,
-                ((k / g) as f32 + 0.5) / g as f32,
-            );
-            let m = bins.sample_in_bin(bin, u);
+            let m = bins.sample_in_bin(bin, sub_cell(k, g));
             sum[0] += m.x as f64;
             sum[1] += m.y as f64;
         }

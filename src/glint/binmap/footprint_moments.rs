@@ -30,10 +30,10 @@
 //! cell overlaps: clip.rs (\[SutherlandHodgman1974\]).
 
 use super::clip::{Overlap, Parallelogram};
+use super::facets::sub_cell;
 use super::params::MASKING_FIRST_LEVEL;
 use crate::glint::HemisphereBins;
 use crate::glint::surface::MomentPyramid;
-use glam::Vec2;
 use rayon::prelude::*;
 
 /// Largest number of cells of the chain in the footprint's bounding box: 256 (a footprint read at
@@ -68,11 +68,7 @@ pub(super) fn bin_moments(bins: &HemisphereBins, used: &[bool]) -> Vec<[f64; 5]>
             };
             let mut sum = [0.0f64; 6];
             for k in 0..g * g {
-                let u = Vec2::new(
-                    ((k % g) as f32 + 0.5) / g as f32,
-                    ((k / g) as f32 + 0.5) / g as f32,
-                );
-                let m = bins.sample_in_bin(b, u);
+                let m = bins.sample_in_bin(b, sub_cell(k, g));
                 let (x, y, z) = (m.x as f64, m.y as f64, (m.z as f64).max(1e-12));
                 // Weighted by cos θ = z: s = −(x, y)/z, so s z = −(x, y), s sᵀ z = (x, y)(x, y)ᵀ/z.
                 sum[0] -= x;
@@ -217,11 +213,7 @@ mod tests {
         for &b in &picks {
             let mut sum = [0.0f64; 6];
             for k in 0..g * g {
-                let u = Vec2::new(
-                    ((k % g) as f32 + 0.5) / g as f32,
-                    ((k / g) as f32 + 0.5) / g as f32,
-                );
-                let m = bins.sample_in_bin(b, u);
+                let m = bins.sample_in_bin(b, sub_cell(k, g));
                 let (x, y, z) = (m.x as f64, m.y as f64, m.z as f64);
                 let s = [-x / z, -y / z];
                 let v = [s[0], s[1], s[0] * s[0], s[1] * s[1], s[0] * s[1]];
