@@ -51,7 +51,7 @@ pub struct GlintScratch {
 
 /// The spare buffers of one type: a stack, so that N live patches hold N buffers and give them
 /// back when they drop.
-struct Pool<T>(Vec<T>);
+struct Pool<T>(Vec<Box<T>>);
 
 impl GlintScratch {
     /// Where the buffers of type `T` are taken from and given back to.
@@ -63,7 +63,7 @@ impl GlintScratch {
     }
 
     /// Runs `f` on the pool of `T` (created empty on first request), under the lock.
-    fn with_pool<T: Send + 'static, R>(&self, f: impl FnOnce(&mut Vec<T>) -> R) -> R {
+    fn with_pool<T: Send + 'static, R>(&self, f: impl FnOnce(&mut Vec<Box<T>>) -> R) -> R {
         let mut pools = self.pools.lock().unwrap_or_else(|p| p.into_inner());
         let i = match pools.iter().position(|p| p.is::<Pool<T>>()) {
             Some(i) => i,
@@ -97,30 +97,36 @@ impl<T> Copy for Home<'_, T> {}
 
 impl<T: Default + Send + 'static> Home<'_, T> {
     /// A spare buffer of the pool (stale content, kept capacity), or an empty one.
-    pub(crate) fn take(self) -> T {
+    pub(crate) fn take(self) -> Box<T> {
         self.scratch
-            .with_pool(|pool: &mut Vec<T>| pool.pop())
+            .with_pool(|pool: &mut Vec<Box<T>>| pool.pop())
             .unwrap_or_default()
     }
 
     /// Puts `buffer` back into the pool.
-    pub(crate) fn give(self, buffer: T) {
+    pub(crate) fn give(self, buffer: Box<T>) {
         self.scratch.with_pool(|pool| pool.push(buffer));
     }
 }
 
 /// Buffers `T` lent to one patch and filled at construction: taken from the caller's scratch (or
-/// fresh), given back when the patch drops. Cloning detaches the clone from the scratch.
+/// fresh), given back when the patch drops. Cloning detaches the clone from the scratch. The
+/// buffers are boxed, so that a patch holding them stays small (a patch is moved a few times
+/// between its model and the renderer's BSDF: a box moves as one pointer).
 pub(crate) struct Lent<'a, T: Default + Send + 'static> {
     home: Option<Home<'a, T>>,
-    val: T,
+    /// `Some` for the whole life of the value; `None` only inside `drop`.
+    val: Option<Box<T>>,
 }
 
 impl<'a, T: Default + Send + 'static> Lent<'a, T> {
     /// Takes buffers from `home` (if any) for the patch's lifetime; their content is stale.
     pub(crate) fn new(home: Option<Home<'a, T>>) -> Self {
         let val = home.map(Home::take).unwrap_or_default();
-        Lent { home, val }
+        Lent {
+            home,
+            val: Some(val),
+        }
     }
 }
 
@@ -128,21 +134,27 @@ impl<T: Default + Send + 'static> std::ops::Deref for Lent<'_, T> {
     type Target = T;
     #[inline]
     fn deref(&self) -> &T {
-        &self.val
+        match &self.val {
+            Some(v) => v,
+            None => unreachable!("a lent buffer is read after its drop"),
+        }
     }
 }
 
 impl<T: Default + Send + 'static> std::ops::DerefMut for Lent<'_, T> {
     #[inline]
     fn deref_mut(&mut self) -> &mut T {
-        &mut self.val
+        match &mut self.val {
+            Some(v) => v,
+            None => unreachable!("a lent buffer is written after its drop"),
+        }
     }
 }
 
 impl<T: Default + Send + 'static> Drop for Lent<'_, T> {
     fn drop(&mut self) {
-        if let Some(home) = self.home.take() {
-            home.give(std::mem::take(&mut self.val));
+        if let (Some(home), Some(val)) = (self.home.take(), self.val.take()) {
+            home.give(val);
         }
     }
 }
@@ -151,13 +163,13 @@ impl<T: Default + Send + 'static + Clone> Clone for Lent<'_, T> {
     fn clone(&self) -> Self {
         Lent {
             home: None,
-            val: self.val.clone(),
+            val: Some(Box::new(T::clone(self))),
         }
     }
 }
 
 impl<T: Default + Send + 'static + std::fmt::Debug> std::fmt::Debug for Lent<'_, T> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.val.fmt(f)
+        T::fmt(self, f)
     }
 }

@@ -329,6 +329,18 @@ impl SlopeGaussian {
         slope_to_normal_f64(self.mean.x as f64, self.mean.y as f64)
     }
 
+    /// The squared Mahalanobis distance q = |L⁻¹(ñ − μ)|² of the slope (`sx`, `sy`) from the mean,
+    /// in `f64`, and the density's peak (L⁻¹)₁₁ (L⁻¹)₂₂ / (2π) = 1/(2π √|Σ|): P22 = peak ·
+    /// exp(−q/2) (the few-lobe sets form the exponential inline, src/glint/kernels/lobe_set.rs).
+    #[cfg(feature = "std")]
+    #[inline]
+    pub(crate) fn mahalanobis2_and_peak_f64(&self, sx: f64, sy: f64) -> (f64, f64) {
+        let [i11, i21, i22] = self.inv_chol.map(f64::from);
+        let (dx, dy) = (sx - self.mean.x as f64, sy - self.mean.y as f64);
+        let (zx, zy) = (i11 * dx, i21 * dx + i22 * dy);
+        (zx * zx + zy * zy, i11 * i22 / (2.0 * PI))
+    }
+
     /// [`SlopeGaussian::p22`] at the slope (`sx`, `sy`) in `f64` (0 for non-finite slopes): for sums
     /// over many lobes at one slope, whose common Jacobian the caller applies once.
     ///

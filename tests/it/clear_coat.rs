@@ -147,16 +147,17 @@ fn diffuse_reflectances_match_a_direct_quadrature() {
     assert!((diffuse_internal_reflectance(1.5) - 0.596).abs() < 1e-3);
 }
 
-/// The furnace bound of a coat over a glint patch of ~32 facets (4 texels): the patch's round
-/// trip q(wo') jumps between its few lobes, and the estimate's six directions need not see its
-/// minimum (measured 0.962 at normal incidence; with four directions that missed the normal it
-/// was 1.058).
+/// The furnace bound of a coat over a glint patch of a few lobes (4 and 64 texels, where the
+/// lattice's tent reads about four lobes per level): the patch's round trip q(wo') jumps between
+/// its few lobes, and the estimate's six directions need not see its minimum (measured 0.745 at 4
+/// texels and 1.026 ± 0.005 at 64, both at normal incidence; with four directions that missed
+/// the normal, 1.058 at 4 texels).
 const FEW_FACETS_BOUND: f32 = 1.06;
 
 /// Conductor microfacet bases (gold and silver GGX α = 0.3, a silver mirror) and a glint base
-/// (a procedural patch of silver facets at 64 and 1,024 texels): the coated furnace never
-/// exceeds 1 (4 standard errors + 10⁻³) in any channel, up to 85°; at 4 texels (~32 facets) it
-/// stays below [`FEW_FACETS_BOUND`]. The plain series 1/(1 − ρ̄_b r_i) with
+/// (a procedural patch of silver facets at 1,024 texels): the coated furnace never exceeds 1 (4
+/// standard errors + 10⁻³) in any channel, up to 85°; at 4 and 64 texels it stays below
+/// [`FEW_FACETS_BOUND`]. The plain series 1/(1 − ρ̄_b r_i) with
 /// ρ̄_b the base's albedo exceeds 1 on the same bases (asserted at normal incidence on gold GGX): why the round trip is measured from the base (src/bxdf/clear_coat.rs, "Internal
 /// reflection").
 #[test]
@@ -206,7 +207,7 @@ fn glossy_and_glint_bases_conserve_energy() {
                 ba.albedo(),
                 ba.round_trip()
             );
-            let bound = if name.starts_with("glint 4 ") {
+            let bound = if name.starts_with("glint 4 ") || name.starts_with("glint 64 ") {
                 FEW_FACETS_BOUND
             } else {
                 1.0 + 1e-3

@@ -156,9 +156,11 @@ fn car_paint_conserves_energy() {
 }
 
 /// The bound of one 30-texel footprint's furnace (the mean over footprints is ≤ 1; see
-/// `car_paint_conserves_energy`): measured up to 1.29 at normal incidence over the 16 footprints
-/// (1.12 at 45°, 1.10 at 75°, 1.03 at 85°).
-const ONE_FOOTPRINT_BOUND: f32 = 1.35;
+/// `car_paint_conserves_energy`): measured up to 1.351 at normal incidence over the 16 footprints
+/// (1.357 at 45°, 1.354 at 75°, 1.173 at 85°). A footprint of ~3 facets reads about four lobes
+/// through the lattice's tent (it read ~10 through the truncated Gaussian kernel, and measured
+/// up to 1.29), so one patch's round trip departs further from the surface's mean one.
+const ONE_FOOTPRINT_BOUND: f32 = 1.45;
 
 /// A white Lambert under the coat, through `Material`: furnace 1 (4 standard errors + 2·10⁻³).
 #[test]

@@ -300,7 +300,8 @@ fn every_patch_holds_few_lobes() {
             most = most.max(s.patch(&f).lobe_count());
         }
         println!("density {density}: at most {most} lobes");
-        assert!(most <= 48, "density {density}: {most} lobes");
+        // At most 2 × 16 candidates and the limit lobe by construction; 16-18 measured.
+        assert!(most <= 24, "density {density}: {most} lobes");
     }
 }
 

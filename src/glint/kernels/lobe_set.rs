@@ -18,7 +18,7 @@
 //! ([`Few::One`]) or a set lent by the caller's scratch ([`Few::Set`]), so that neither a patch's
 //! size nor a shading loop's allocations grow with the set.
 
-use super::lanes::{LANES, ramp_neg_lanes};
+use super::lanes::{exp_neg_half, ramp_neg_lanes};
 use super::prepared_view::PreparedView;
 use crate::glint::scratch::Lent;
 use crate::ndf::{Ndf, SlopeGaussian};
@@ -38,6 +38,8 @@ pub(crate) struct LobeSet {
     g: Vec<SlopeGaussian>,
     /// Slope boxes [min x, min y, max x, max y] (module docs).
     boxes: Vec<[f32; 4]>,
+    /// The mean slope Σ w_i μ_i of the current weights (kept by every change of the set).
+    mean: Vec2,
     /// V(wo) at the view the set was prepared for ([`LobeSet::prepare_view`]); reset by every
     /// change of the set.
     view: PreparedView,
@@ -49,6 +51,10 @@ pub(crate) struct LobeSet {
 /// The largest t = |A_s|/s_w at which a lobe wholly behind w takes the lanes' G(−t) (≈ 4·10⁻³⁴ there,
 /// within the lanes' stated error); beyond it the lobe's own `f64` V.
 const LANE_RAMP_MAX: f64 = 12.0;
+
+/// Lobes per pass of the lane kernel [`ramp_neg_lanes`]: a set holds a
+/// few to a few tens of lobes.
+const CHUNK: usize = 8;
 
 /// Mass of a lobe left outside its slope box: 10⁻⁶, the mixture's default slope tail.
 pub(crate) const BOX_TAIL: f64 = 1.0e-6;
@@ -87,6 +93,7 @@ impl LobeSet {
         self.w.clear();
         self.g.clear();
         self.boxes.clear();
+        self.mean = Vec2::ZERO;
         self.unprepare();
     }
 
@@ -111,6 +118,7 @@ impl LobeSet {
             self.g.push(g);
             self.boxes
                 .push([m.x - half.x, m.y - half.y, m.x + half.x, m.y + half.y]);
+            self.mean += w * m;
             self.n += 1;
             self.unprepare();
         }
@@ -125,6 +133,7 @@ impl LobeSet {
                 *w /= sum;
             }
         }
+        self.mean = self.iter().map(|(w, g)| w * g.mean()).sum();
     }
 
     /// Prepares the set for the view direction `wo`: V(wo), an O(lobes) pass, computed here once
@@ -166,7 +175,7 @@ impl LobeSet {
 
     /// The mean slope Σ w_i μ_i.
     pub fn mean_slope(&self) -> Vec2 {
-        self.iter().map(|(w, g)| w * g.mean()).sum()
+        self.mean
     }
 
     /// Picks lobe i with probability ∝ `p[i]`, rescaling `u` into [0, 1) for the lobe's own draw.
@@ -196,23 +205,23 @@ impl LobeSet {
 impl LobeSet {
     /// `f(i, w_i V_i(w))` for every lobe i in order, for a usable w (w_z > 0, finite):
     /// V_i = A_s⁺ + s_w G(−|A_s|/s_w) (the two branches of `SlopeGaussian::visible_area` in one
-    /// form, since G(z) = z + G(−z)), A_s and s_w per lobe in `f64`, G over [`LANES`] lanes
+    /// form, since G(z) = z + G(−z)), A_s and s_w per lobe in `f64`, G over [`CHUNK`] lanes
     /// ([`ramp_neg_lanes`], relative error < 10⁻⁶). A lobe wholly behind w by more than
     /// [`LANE_RAMP_MAX`] of its s_w, where the lanes' G leaves `f32`'s normal range, takes the
     /// lobe's own `f64` V.
     fn for_each_lobe_area(&self, w: Vec3, mut f: impl FnMut(usize, f32)) {
-        for base in (0..self.n).step_by(LANES) {
-            let len = LANES.min(self.n - base);
-            let mut a = [0.0f64; LANES];
-            let mut sw = [0.0f64; LANES];
-            let mut t = [0.0f64; LANES];
+        for base in (0..self.n).step_by(CHUNK) {
+            let len = CHUNK.min(self.n - base);
+            let mut a = [0.0f64; CHUNK];
+            let mut sw = [0.0f64; CHUNK];
+            let mut t = [0.0f64; CHUNK];
             for (k, g) in self.g[base..base + len].iter().enumerate() {
                 let (ak, sk) = g.area_and_spread(w);
                 (a[k], sw[k], t[k]) = (ak, sk, ak.abs() / sk);
             }
             // A lobe wholly in front of w by more than 8 s_w has V = A_s to `f64` resolution
             // (G(−t)/t < 10⁻¹⁷ there): a chunk of such lobes skips the ramp.
-            let mut ramp = [0.0f32; LANES];
+            let mut ramp = [0.0f32; CHUNK];
             if (0..len).any(|k| !(a[k] > 0.0 && t[k] > 8.0)) {
                 ramp_neg_lanes(&t, &mut ramp);
             }
@@ -272,13 +281,15 @@ impl Ndf for LobeSet {
             return 0.0;
         };
         // The slope and the Jacobian (1 + |ñ|²)² once in `f64`, as `SlopeGaussian::d` forms them
-        // per lobe; the lobes' P22 summed in `f64` and rounded once.
+        // per lobe; the lobes' P22 (the exponential inline, `exp_neg_half`: < 10⁻⁶ relative, 0
+        // past 13 standard deviations) summed in `f64` and rounded once.
         let (sx, sy) = (-(m.x as f64) / m.z as f64, -(m.y as f64) / m.z as f64);
         let mut sum = 0.0f64;
         for i in 0..self.n {
             let b = &self.boxes[i];
             if s.x >= b[0] && s.x <= b[2] && s.y >= b[1] && s.y <= b[3] {
-                sum += self.w[i] as f64 * self.g[i].p22_f64(sx, sy);
+                let (q, peak) = self.g[i].mahalanobis2_and_peak_f64(sx, sy);
+                sum += self.w[i] as f64 * peak * exp_neg_half(q) as f64;
             }
         }
         let j = 1.0 + sx * sx + sy * sy;

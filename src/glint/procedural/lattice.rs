@@ -1,22 +1,20 @@
-//! The facet lattice of a procedural glint surface: its levels (cell size, the facets a lobe
-//! stands for, the lobes' shared width and the spread of their means), the stateless hash that
-//! places each cell's lobe, and the gather of one level's lobes under a footprint kernel.
+//! The facet lattice of a procedural glint surface: its levels, the stateless hash that places
+//! each cell's lobe, and the gather of one level's lobes under the tent of a footprint.
 //!
-//! Level l tiles the uv square with `cells` × `cells` square cells (about 2^l times fewer per side
-//! than level 0, whose cells hold one facet each); every cell holds one lobe, a slope Gaussian
-//! N(μ, β_l² I_axes) at a jittered position in the cell, with μ ~ N(0, diag(τ_l²)) and
-//! β_l² + τ_l² = σ² per axis (σ = α/√2, the limit Beckmann lobe's slope deviation), so that every
-//! lobe of every level has the limit NDF as its mean. A lobe of level l stands for the
-//! n_l = density · spacing_l² facets of its cell: β_l is chosen so that the expected squared L2
-//! distance of the lobe to the limit equals that of n_l facets of roughness σ_f with means drawn
-//! from N(0, σ² − σ_f²) (docs/procedural.md, "Levels"):
-//! 1/β_l² = 1/σ² + (1/σ_f² − 1/σ²) / n_l. A surface of the GGX limit reads a third uniform per
-//! cell, its lobe's variance scale (src/glint/procedural/ggx.rs).
+//! Level l tiles the uv period with `cells` × `cells` cells (about 2^l times fewer per side than
+//! level 0, whose cells hold one facet each on average); every cell holds one lobe at a position
+//! jittered uniformly in the cell, with a standard-normal pair z for its mean (and, for a surface
+//! of the GGX limit, a third uniform for its variance scale, src/glint/procedural/ggx.rs), all
+//! from one hash of (seed, level, cell). The lobes' widths and the spread of their means are set
+//! per patch from the footprint (src/glint/procedural/patch.rs, docs/procedural.md "Lobe
+//! widths"), so that every lobe has the limit NDF as its mean.
+//!
+//! A footprint reads the lobes of the cells around its centre through a separable tent one cell
+//! wide on each side (stretched along u or v by the footprint's anisotropy): about four lobes per
+//! level, the lobe of the cell under the centre always among them, weights continuous in the
+//! centre (bilinear filtering over jittered positions, as a GPU filters a texture level).
 
 use super::params::ProceduralParams;
-
-/// Kernel truncation radius, in Mahalanobis units: lobes with q = dᵀ Σ⁻¹ d ≥ R² weigh 0.
-pub(super) const RADIUS: f64 = 2.5;
 
 /// Largest ratio of the footprint kernel's major to minor standard deviation the gather reads: a
 /// thinner footprint's kernel is widened along its minor axis to this ratio (as a GPU's
@@ -24,9 +22,16 @@ pub(super) const RADIUS: f64 = 2.5;
 pub(super) const MAX_ANISOTROPY: f64 = 2.0;
 
 /// The cells of the finer level a footprint reads are between `CELL_SIGMAS`/2 and `CELL_SIGMAS`
-/// of its kernel's minor standard deviations wide (the coarser level's twice that): the kernel
-/// sees a few lobes per level.
+/// of its kernel's geometric standard deviation (λ1 λ2)^¼ wide (the coarser level's twice that):
+/// the tent over one cell on each side then has a standard deviation of 0.6-1.2 of the
+/// kernel's.
 pub(super) const CELL_SIGMAS: f64 = 3.0;
+
+/// The share of each octave of footprint sizes over which a patch blends its two levels: below
+/// it the finer level alone, across it the weight of the coarser one rises linearly from 0 to 1
+/// (a "brilinear" filter: continuous in the footprint's size like a trilinear one, with one
+/// level's lobes instead of two over most sizes).
+pub(super) const BLEND_BAND: f64 = 0.25;
 
 /// One level of the lattice.
 #[derive(Clone, Copy, Debug)]
@@ -81,7 +86,7 @@ fn mix(mut z: u64) -> u64 {
 
 const GOLDEN: u64 = 0x9e37_79b9_7f4a_7c15;
 
-/// Two 24-bit uniforms in (0, 1) from one hash.
+/// Two 24-bit uniforms in (0, 1) from one hash (bits 40-63 and 16-39).
 #[inline]
 fn uniforms(h: u64) -> [f32; 2] {
     const SCALE: f32 = 1.0 / (1u32 << 24) as f32;
@@ -91,38 +96,39 @@ fn uniforms(h: u64) -> [f32; 2] {
     ]
 }
 
-/// The standard normal quantile Φ⁻¹(u) of u ∈ (0, 1) (`f64` rational approximations, no logarithm
-/// for u ∈ [0.075, 0.925]: `gauss::inv_std_cdf`).
+/// The key of a surface's seed, which every cell's hash mixes in (computed once per gather).
 #[inline]
-fn normal_quantile(u: f32) -> f32 {
-    crate::ndf::gauss::inv_std_cdf(u as f64) as f32
+pub(super) fn seed_key(seed: u64) -> u64 {
+    mix(seed.wrapping_add(GOLDEN))
 }
 
-/// The hash of cell (i, j) of level `level` (indices already wrapped into [0, cells)).
+/// The hash of cell (i, j) of level `level` (indices already wrapped into [0, cells)): one
+/// finaliser of the cell's key, spread by the golden ratio, and the seed's key.
 #[inline]
-fn cell_hash(seed: u64, level: usize, i: u32, j: u32) -> u64 {
+fn cell_hash(seed_key: u64, level: usize, i: u32, j: u32) -> u64 {
     let key = ((level as u64) << 50) ^ ((i as u64) << 25) ^ (j as u64);
-    mix(seed ^ mix(key.wrapping_add(GOLDEN)))
+    mix(key.wrapping_mul(GOLDEN) ^ seed_key)
 }
 
 /// The jitter of a cell's lobe in the cell, in (0, 1)², from the cell's hash.
 #[inline]
 fn jitter(h: u64) -> [f32; 2] {
-    uniforms(mix(h.wrapping_add(GOLDEN)))
+    uniforms(h)
 }
 
-/// The standard-normal coordinates of a cell's lobe mean, from the cell's hash.
+/// The standard-normal coordinates of a cell's lobe mean, from the cell's hash (one more
+/// finaliser, so that they are independent of the jitter), through the normal quantile
+/// (`gauss::inv_std_cdf_f32`, within 4·10⁻⁷ of Φ⁻¹).
 #[inline]
 fn mean_z(h: u64) -> [f32; 2] {
-    let [a, b] = uniforms(mix(h.wrapping_add(GOLDEN.wrapping_mul(2))));
-    [normal_quantile(a), normal_quantile(b)]
+    uniforms(mix(h ^ GOLDEN)).map(crate::ndf::gauss::inv_std_cdf_f32)
 }
 
 /// A third uniform in (0, 1) from the cell's hash, independent of its jitter and mean: the variance
 /// scale of a GGX surface's lobe (src/glint/procedural/ggx.rs).
 #[inline]
 fn scale_uniform(h: u64) -> f32 {
-    uniforms(mix(h.wrapping_add(GOLDEN.wrapping_mul(3))))[0]
+    uniforms(mix(h ^ GOLDEN.wrapping_mul(3)))[0]
 }
 
 /// A footprint kernel: centre and covariance (texels), its principal axes.
@@ -164,28 +170,8 @@ impl Kernel {
         }
     }
 
-    /// The same kernel with both variances raised to at least `floor`.
-    pub fn floored(&self, floor: f64) -> Kernel {
-        let l1 = self.lambda[0].max(floor);
-        Kernel {
-            lambda: [l1, self.lambda[1].max(floor).min(l1)],
-            ..*self
-        }
-    }
-
-    /// Σ⁻¹ as (xx, xy, yy).
-    fn inverse(&self) -> [f64; 3] {
-        let [c, s] = self.e1;
-        let (a, b) = (1.0 / self.lambda[0], 1.0 / self.lambda[1]);
-        [
-            a * c * c + b * s * s,
-            (a - b) * c * s,
-            a * s * s + b * c * c,
-        ]
-    }
-
     /// Σ as (xx, xy, yy).
-    fn covariance(&self) -> [f64; 3] {
+    pub fn covariance(&self) -> [f64; 3] {
         let [c, s] = self.e1;
         let [a, b] = self.lambda;
         [
@@ -193,6 +179,20 @@ impl Kernel {
             (a - b) * c * s,
             a * s * s + b * c * c,
         ]
+    }
+
+    /// The geometric mean of the kernel's two standard deviations, (λ1 λ2)^¼ (texels): the side
+    /// of the isotropic kernel of the same area, which sets the levels the footprint reads.
+    pub fn geometric_sd(&self) -> f64 {
+        (self.lambda[0] * self.lambda[1]).sqrt().sqrt()
+    }
+
+    /// The tent's stretch along u and v: the kernel's marginal standard deviations over its
+    /// geometric one, at least 1 (at most √[`MAX_ANISOTROPY`]).
+    pub fn stretch(&self) -> [f64; 2] {
+        let [sxx, _, syy] = self.covariance();
+        let g = self.geometric_sd().max(1e-300);
+        [sxx, syy].map(|v| (v.sqrt() / g).max(1.0))
     }
 }
 
@@ -208,9 +208,9 @@ pub(super) struct Candidates {
 }
 
 impl Candidates {
-    /// More than a patch can gather (two levels of at most ~20 lobes each within the kernel's
-    /// ellipse; `procedural_glints::every_patch_holds_few_lobes`).
-    pub const CAPACITY: usize = 128;
+    /// What a patch can gather: two levels of at most 4 × 4 cells (a tent at most √2 cells wide
+    /// on each side spans at most four cells per axis).
+    pub const CAPACITY: usize = 32;
 
     pub fn new() -> Candidates {
         Candidates {
@@ -222,83 +222,68 @@ impl Candidates {
     }
 }
 
-/// Adds the lobes of `level` under `kernel` to `out`, their weights
-/// k(p) = exp(−q/2) − exp(−R²/2) (q < R², continuous at the truncation) normalised over the level
-/// and scaled by `scale`. The kernel is floored at the level's cell: both its standard deviations at
-/// least half a cell, so that a cell's lobe always lies within R of the centre. With `scales`, each
-/// lobe's third uniform (the variance scale of a GGX surface) is read too.
+/// Adds the lobes of `level` under the tent of `kernel` to `out`: the lobes of the cells around
+/// the kernel's centre weighted by the separable tent k(p) = (1 − |dx|/H_u)⁺ (1 − |dy|/H_v)⁺,
+/// normalised over the level and scaled by `scale`. The half-widths are the level's cell sides
+/// times the kernel's [`Kernel::stretch`], so at least one cell on both axes: the lobe of the cell
+/// under the centre always weighs, and the level's sum never vanishes. With `scales`, each lobe's
+/// third uniform (the variance scale of a GGX surface) is read too.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn gather_level(
     levels: &[Level],
     index: usize,
-    seed: u64,
+    seed_key: u64,
     kernel: &Kernel,
+    stretch: [f64; 2],
     scale: f32,
     scales: bool,
     out: &mut Candidates,
 ) {
     let level = &levels[index];
     let [s, t] = level.spacing;
-    let kernel = kernel.floored(0.25 * s.max(t) * s.max(t));
-    let [ixx, ixy, iyy] = kernel.inverse();
-    let [sxx, _, syy] = kernel.covariance();
+    let (hu, hv) = (s * stretch[0], t * stretch[1]);
     let [cx, cy] = kernel.center;
-    let (hx, hy) = (RADIUS * sxx.sqrt(), RADIUS * syy.sqrt());
     let (i0, i1) = (
-        ((cx - hx) / s).floor() as i64,
-        ((cx + hx) / s).floor() as i64,
+        ((cx - hu) / s).floor() as i64,
+        ((cx + hu) / s).floor() as i64,
     );
     let (j0, j1) = (
-        ((cy - hy) / t).floor() as i64,
-        ((cy + hy) / t).floor() as i64,
+        ((cy - hv) / t).floor() as i64,
+        ((cy + hv) / t).floor() as i64,
     );
-    let [cells_u, cells_v] = level.cells.map(i64::from);
-    let r2 = RADIUS * RADIUS;
-    let edge = (-0.5 * r2 as f32).exp();
-    // A cell whose rectangle is farther than R major standard deviations from the centre holds no
-    // lobe of the ellipse (its Mahalanobis distance is at least its distance over σ_major).
-    let far2 = r2 * kernel.lambda[0];
+    let [cells_u, cells_v] = level.cells;
+    let (iu, iv) = (1.0 / hu, 1.0 / hv);
     let start = out.len;
     let mut sum = 0.0f64;
+    let mut wj = j0.rem_euclid(cells_v as i64) as u32;
     for j in j0..=j1 {
-        let (y0, y1) = (j as f64 * t - cy, (j + 1) as f64 * t - cy);
-        let ny = if y0 > 0.0 {
-            y0
-        } else if y1 < 0.0 {
-            y1
-        } else {
-            0.0
-        };
+        let y0 = j as f64 * t - cy;
+        let mut wi = i0.rem_euclid(cells_u as i64) as u32;
         for i in i0..=i1 {
-            let (x0, x1) = (i as f64 * s - cx, (i + 1) as f64 * s - cx);
-            let nx = if x0 > 0.0 {
-                x0
-            } else if x1 < 0.0 {
-                x1
-            } else {
-                0.0
-            };
-            if nx * nx + ny * ny >= far2 || out.len == Candidates::CAPACITY {
-                continue;
-            }
-            let (wi, wj) = (i.rem_euclid(cells_u) as u32, j.rem_euclid(cells_v) as u32);
-            let h = cell_hash(seed, index, wi, wj);
-            let jit = jitter(h);
-            let dx = x0 + jit[0] as f64 * s;
-            let dy = y0 + jit[1] as f64 * t;
-            let q = ixx * dx * dx + 2.0 * ixy * dx * dy + iyy * dy * dy;
-            if q >= r2 {
-                continue;
-            }
-            let w = ((-0.5 * q) as f32).exp() - edge;
-            if w > 0.0 {
-                out.w[out.len] = w;
-                out.z[out.len] = mean_z(h);
-                if scales {
-                    out.u[out.len] = scale_uniform(h);
+            if out.len < Candidates::CAPACITY {
+                let h = cell_hash(seed_key, index, wi, wj);
+                let [ju, jv] = jitter(h);
+                let dx = i as f64 * s - cx + ju as f64 * s;
+                let dy = y0 + jv as f64 * t;
+                let w = ((1.0 - dx.abs() * iu).max(0.0) * (1.0 - dy.abs() * iv).max(0.0)) as f32;
+                if w > 0.0 {
+                    out.w[out.len] = w;
+                    out.z[out.len] = mean_z(h);
+                    if scales {
+                        out.u[out.len] = scale_uniform(h);
+                    }
+                    out.len += 1;
+                    sum += w as f64;
                 }
-                out.len += 1;
-                sum += w as f64;
             }
+            wi += 1;
+            if wi == cells_u {
+                wi = 0;
+            }
+        }
+        wj += 1;
+        if wj == cells_v {
+            wj = 0;
         }
     }
     if sum > 0.0 {

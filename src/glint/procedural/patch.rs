@@ -3,23 +3,26 @@
 //! every term of the [`Ndf`](crate::ndf::Ndf) exact over those lobes (src/glint/kernels/lobe_set.rs).
 
 use super::ggx;
-use super::lattice::{CELL_SIGMAS, Candidates, Kernel, Level, gather_level, lobe_widths};
+use super::lattice::{
+    BLEND_BAND, CELL_SIGMAS, Candidates, Kernel, Level, gather_level, lobe_widths, seed_key,
+};
 use super::limit::{GgxBlend, LimitNdf};
 use super::params::{PatchOptions, ProceduralParams};
 use crate::glint::kernels::lobe_set::{Few, LobeSet, box_half_widths};
 use crate::glint::scratch::Lent;
 use crate::glint::{Footprint, GlintScratch};
-use crate::ndf::{Ggx, SlopeGaussian, forward_ndf};
-use glam::{Mat2, Vec2, Vec3};
+use crate::ndf::{Beckmann, Ggx, SlopeGaussian, forward_ndf};
+use glam::{Vec2, Vec3};
 
 /// The P-NDF of one footprint of a [`ProceduralGlints`](super::ProceduralGlints) surface: an
 /// [`Ndf`](crate::ndf::Ndf) with D_P(m) = (1 − b) Σ_i w_i D_i(m) + b D_lim(m).
 ///
-/// - The lobes D_i are those of the lattice level whose cells are 1.5-3 kernel standard deviations
-///   wide (the finer level l) and of the next coarser level, weighted (1 − t) and t by where the
-///   footprint's size falls between them (a trilinear filter over levels, so the P-NDF changes
-///   continuously with the footprint), each level's weights k(p_i) normalised over its lobes
-///   (src/glint/procedural/lattice.rs).
+/// - The lobes D_i are those of the lattice level whose cells are 1.5-3 geometric kernel standard
+///   deviations (λ1 λ2)^¼ wide (the finer level l), weighted by a tent one cell wide on each side
+///   around the footprint's centre (about four lobes), normalised over the level; in the last
+///   quarter of each octave of footprint sizes they are blended with the next coarser level's,
+///   weighted (1 − t) and t (a brilinear filter over levels, so that the P-NDF changes
+///   continuously with the footprint) (src/glint/procedural/lattice.rs).
 /// - All lobes share one width β: each stands for n / K facets, n = density · 4π √det Σ those the
 ///   footprint holds and K = (Σ w)² / Σ w² the lobes the kernel effectively sees, so
 ///   1/β² = 1/σ² + min(1, K/n) (1/σ_f² − 1/σ²) per axis and the patch is as far from the limit, in
@@ -52,6 +55,9 @@ pub struct ProceduralPatch<'a> {
 #[derive(Clone, Debug)]
 enum Body<'a> {
     Lobes(Few<'a>),
+    /// A Beckmann surface's limit alone: the analytic NDF (the same function as the limit's
+    /// centred slope Gaussian, with its cheaper closed forms and sampler) beside that lobe.
+    Beckmann(Beckmann, SlopeGaussian),
     Ggx(Ggx),
     Blend(GgxBlend<'a>),
 }
@@ -61,6 +67,7 @@ macro_rules! to_body {
     ($s:ident, $n:ident => $e:expr) => {
         match &$s.body {
             Body::Lobes($n) => $e,
+            Body::Beckmann($n, _) => $e,
             Body::Ggx($n) => $e,
             Body::Blend($n) => $e,
         }
@@ -71,11 +78,15 @@ forward_ndf!(['a] ProceduralPatch<'a>, to_body);
 
 impl ProceduralPatch<'_> {
     /// The patch that is the limit NDF alone, at continuous level `level` and expected distance
-    /// `distance`.
-    fn limit_alone(limit: LimitNdf, level: f64, distance: f64) -> Self {
+    /// `distance`; a Beckmann limit of roughness `alpha` is served by the analytic [`Beckmann`]
+    /// NDF (the lobe itself where α is out of its range, which validation excludes).
+    fn limit_alone(limit: LimitNdf, alpha: Vec2, level: f64, distance: f64) -> Self {
         ProceduralPatch {
             body: match limit {
-                LimitNdf::Beckmann(g) => Body::Lobes(Few::One(g)),
+                LimitNdf::Beckmann(g) => match Beckmann::new(alpha.x, alpha.y) {
+                    Ok(b) => Body::Beckmann(b, g),
+                    Err(_) => Body::Lobes(Few::One(g)),
+                },
                 LimitNdf::Ggx(g) => Body::Ggx(g),
             },
             level: level as f32,
@@ -93,7 +104,7 @@ impl ProceduralPatch<'_> {
     pub fn prepare_view(&mut self, wo: Vec3) {
         match &mut self.body {
             Body::Lobes(few) => few.prepare_view(wo),
-            Body::Ggx(_) => {}
+            Body::Beckmann(..) | Body::Ggx(_) => {}
             Body::Blend(blend) => blend.prepare_view(wo),
         }
     }
@@ -108,7 +119,7 @@ impl ProceduralPatch<'_> {
         };
         match &self.body {
             Body::Lobes(few) => count(few),
-            Body::Ggx(_) => 1,
+            Body::Beckmann(..) | Body::Ggx(_) => 1,
             Body::Blend(blend) => count(blend.lobes()) + 1,
         }
     }
@@ -132,18 +143,20 @@ impl ProceduralPatch<'_> {
         impl Iterator<Item = (f32, SlopeGaussian)> + Clone + '_,
         Option<(f32, Ggx)>,
     ) {
-        let (few, scale, ggx) = match &self.body {
-            Body::Lobes(f) => (Some(f), 1.0, None),
-            Body::Ggx(g) => (None, 0.0, Some((1.0, *g))),
+        let (few, alone, scale, ggx) = match &self.body {
+            Body::Lobes(f) => (Some(f), None, 1.0, None),
+            Body::Beckmann(_, g) => (None, Some((1.0, *g)), 1.0, None),
+            Body::Ggx(g) => (None, None, 0.0, Some((1.0, *g))),
             Body::Blend(b) => {
                 let (lobes, weight, ggx) = b.parts();
-                (Some(lobes), 1.0 - weight, Some((weight, ggx)))
+                (Some(lobes), None, 1.0 - weight, Some((weight, ggx)))
             }
         };
         let lobes = few
             .into_iter()
             .flat_map(|f| f.iter_lobes())
-            .map(move |(w, g)| (w * scale, g));
+            .map(move |(w, g)| (w * scale, g))
+            .chain(alone);
         (lobes, ggx)
     }
 
@@ -193,28 +206,50 @@ pub(super) fn make_patch<'a>(
         LimitNdf::Beckmann(_) => ((ratio - 1.0).max(0.0) / n).sqrt(),
         LimitNdf::Ggx(_) => ggx::footprint_distance(sigma, sigma_f, n),
     };
-    // The finer level: cells of CELL_SIGMAS/2 to CELL_SIGMAS minor standard deviations
-    // (x = log2(CELL_SIGMAS σ_minor / s0) ≥ 0).
-    let x = (CELL_SIGMAS * kernel.lambda[1].sqrt() / s0).log2().max(0.0);
+    // The finer level: cells of CELL_SIGMAS/2 to CELL_SIGMAS geometric standard deviations
+    // (x = log2(CELL_SIGMAS (λ1 λ2)^¼ / s0) ≥ 0: the kernel's floor keeps both λ ≥ (s0/3)²).
+    let x = (CELL_SIGMAS * kernel.geometric_sd() / s0).log2().max(0.0);
     if footprint_distance <= tol {
         // The patch's own distance is at most this one (exactly so for isotropic α): the
         // limit alone.
-        return ProceduralPatch::limit_alone(limit, x, footprint_distance);
+        return ProceduralPatch::limit_alone(limit, p.alpha, x, footprint_distance);
     }
     let top = levels.len() - 1;
     let (fine, t) = if x >= top as f64 {
         (top, 0.0)
     } else {
+        // The coarser level's weight: 0 over the first 1 − BLEND_BAND of the octave, then rising
+        // linearly to 1 at its end (where the coarser level becomes the finer one).
         let f = x.floor();
-        (f as usize, (x - f) as f32)
+        let t = ((x - f - (1.0 - BLEND_BAND)) / BLEND_BAND).clamp(0.0, 1.0);
+        (f as usize, t as f32)
     };
     let scales = matches!(limit, LimitNdf::Ggx(_));
     let mut cand = Candidates::new();
+    let (key, stretch) = (seed_key(p.seed), kernel.stretch());
     if t < 1.0 {
-        gather_level(levels, fine, p.seed, &kernel, 1.0 - t, scales, &mut cand);
+        gather_level(
+            levels,
+            fine,
+            key,
+            &kernel,
+            stretch,
+            1.0 - t,
+            scales,
+            &mut cand,
+        );
     }
     if t > 0.0 {
-        gather_level(levels, fine + 1, p.seed, &kernel, t, scales, &mut cand);
+        gather_level(
+            levels,
+            fine + 1,
+            key,
+            &kernel,
+            stretch,
+            t,
+            scales,
+            &mut cand,
+        );
     }
     let weights = &cand.w[..cand.len];
     let sum: f64 = weights.iter().map(|&w| w as f64).sum();
@@ -230,7 +265,7 @@ pub(super) fn make_patch<'a>(
         level: x,
     };
     match limit {
-        LimitNdf::Beckmann(lobe) => beckmann_patch(&cand, sum, &widths, lobe, scratch),
+        LimitNdf::Beckmann(lobe) => beckmann_patch(&cand, sum, &widths, p.alpha, lobe, scratch),
         LimitNdf::Ggx(g) => ggx_patch(&cand, sum, &widths, p.alpha, g, scratch),
     }
 }
@@ -261,24 +296,24 @@ fn beckmann_patch<'a>(
     cand: &Candidates,
     sum: f64,
     wd: &Widths,
+    alpha: Vec2,
     limit: SlopeGaussian,
     scratch: Option<&'a GlintScratch>,
 ) -> ProceduralPatch<'a> {
     let (sigma, x) = (wd.sigma, wd.level);
     let (beta2, tau2) = lobe_widths(sigma, wd.sigma_f, wd.r);
-    let shape = SlopeGaussian::new(
-        Vec2::ZERO,
-        Mat2::from_diagonal(Vec2::new(beta2[0] as f32, beta2[1] as f32)),
-    );
-    let (Ok(shape), true) = (shape, cand.len > 0) else {
-        return ProceduralPatch::limit_alone(LimitNdf::Beckmann(limit), x, 0.0);
+    // The diagonal covariance's Cholesky factor directly.
+    let [lx, ly] = beta2.map(|b| b.sqrt() as f32);
+    let shape = SlopeGaussian::from_mean_cholesky(Vec2::ZERO, lx, 0.0, ly);
+    let (Some(shape), true) = (shape, cand.len > 0) else {
+        return ProceduralPatch::limit_alone(LimitNdf::Beckmann(limit), alpha, x, 0.0);
     };
     // The patch's expected distance: ρ² = Σ (w_i/Σw)² (σx σy / (βx βy) − 1).
     let distance =
         ((sigma[0] * sigma[1] / (beta2[0] * beta2[1]).sqrt() - 1.0).max(0.0) / wd.k).sqrt();
     let b = wd.limit_weight(distance);
     if b >= 1.0 {
-        return ProceduralPatch::limit_alone(LimitNdf::Beckmann(limit), x, distance);
+        return ProceduralPatch::limit_alone(LimitNdf::Beckmann(limit), alpha, x, distance);
     }
     let few = {
         let tau = tau2.map(|v| v.sqrt() as f32);
@@ -329,16 +364,16 @@ fn ggx_patch<'a>(
     let distance = ggx::facet_distance(wd.sigma, wd.sigma_f, r, wd.k);
     let b = ggx::limit_weight(distance, r, wd.k, wd.limit_weight(distance));
     if b >= 1.0 || cand.len == 0 {
-        return ProceduralPatch::limit_alone(LimitNdf::Ggx(limit), x, distance);
+        return ProceduralPatch::limit_alone(LimitNdf::Ggx(limit), alpha, x, distance);
     }
-    let alpha = [alpha.x as f64, alpha.y as f64];
+    let alpha64 = [alpha.x as f64, alpha.y as f64];
     let mut set = Lent::<LobeSet>::new(scratch.map(|s| s.home()));
     set.clear();
     let scale = 1.0 / sum as f32;
     let max_var = (crate::glint::MAX_SLOPE as f64).powi(2);
     for i in 0..cand.len {
         let v = ggx::variance_scale(cand.u[i]);
-        let (beta2, tau2) = ggx::scaled_lobe_widths(alpha, v, wd.sigma_f, r);
+        let (beta2, tau2) = ggx::scaled_lobe_widths(alpha64, v, wd.sigma_f, r);
         let z = cand.z[i];
         let mean = Vec2::new(
             (tau2[0].sqrt() * z[0] as f64) as f32,
@@ -360,7 +395,7 @@ fn ggx_patch<'a>(
     }
     set.normalise();
     if set.len() == 0 {
-        return ProceduralPatch::limit_alone(LimitNdf::Ggx(limit), x, distance);
+        return ProceduralPatch::limit_alone(LimitNdf::Ggx(limit), alpha, x, distance);
     }
     let body = if b > 0.0 {
         Body::Blend(GgxBlend::new(Few::Set(set), b, limit))
