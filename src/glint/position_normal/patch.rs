@@ -88,7 +88,8 @@ pub struct PositionNormalPatch<'a> {
     moments_lobe: SlopeGaussian,
     /// Every kept element's weight and lobe (masking, samplers, densities), built with the patch in
     /// buffers lent by the caller's scratch if any; empty when a few-lobe set serves.
-    slots: Lent<'a, Slots>,
+    /// The elements' lobes; `None` where the filtered mixture serves (no buffers taken).
+    slots: Option<Lent<'a, Slots>>,
     /// The filtered mixture or a cut when one serves the footprint ([`Few::None`] for the element
     /// sum).
     few: Few<'a>,
@@ -164,7 +165,7 @@ impl<'a> PositionNormalPatch<'a> {
             mean_slope: Vec2::new(moments[0], moments[1]),
             moments,
             moments_lobe: SlopeGaussian::from_moments(moments, map.params.sigma_r),
-            slots: Lent::new(None),
+            slots: None,
             few: Few::Set(set),
             cut,
             view: PreparedView::NONE,
@@ -258,7 +259,7 @@ impl<'a> PositionNormalPatch<'a> {
             mean_slope: Vec2::new(moments[0], moments[1]),
             moments,
             moments_lobe,
-            slots,
+            slots: Some(slots),
             few: Few::None,
             cut: None,
             view: PreparedView::NONE,
@@ -330,7 +331,13 @@ impl<'a> PositionNormalPatch<'a> {
     }
 
     fn slots(&self) -> &Slots {
-        &self.slots
+        static EMPTY: Slots = Slots {
+            weights: Vec::new(),
+            cdf: Vec::new(),
+            lobes: Vec::new(),
+            index: Vec::new(),
+        };
+        self.slots.as_deref().unwrap_or(&EMPTY)
     }
 
     /// D_P(m) and the number of elements whose contribution was evaluated.

@@ -98,7 +98,7 @@ fn uniforms(h: u64) -> [f32; 2] {
 
 /// The key of a surface's seed, which every cell's hash mixes in (computed once per gather).
 #[inline]
-pub(super) fn seed_key(seed: u64) -> u64 {
+fn seed_key(seed: u64) -> u64 {
     mix(seed.wrapping_add(GOLDEN))
 }
 
@@ -228,17 +228,16 @@ impl Candidates {
 /// times the kernel's [`Kernel::stretch`], so at least one cell on both axes: the lobe of the cell
 /// under the centre always weighs, and the level's sum never vanishes. With `scales`, each lobe's
 /// third uniform (the variance scale of a GGX surface) is read too.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn gather_level(
     levels: &[Level],
     index: usize,
-    seed_key: u64,
+    seed: u64,
     kernel: &Kernel,
-    stretch: [f64; 2],
     scale: f32,
     scales: bool,
     out: &mut Candidates,
 ) {
+    let (seed_key, stretch) = (seed_key(seed), kernel.stretch());
     let level = &levels[index];
     let [s, t] = level.spacing;
     let (hu, hv) = (s * stretch[0], t * stretch[1]);

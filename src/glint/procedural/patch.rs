@@ -4,7 +4,7 @@
 
 use super::ggx;
 use super::lattice::{
-    BLEND_BAND, CELL_SIGMAS, Candidates, Kernel, Level, gather_level, lobe_widths, seed_key,
+    BLEND_BAND, CELL_SIGMAS, Candidates, Kernel, Level, gather_level, lobe_widths,
 };
 use super::limit::{GgxBlend, LimitNdf};
 use super::params::{PatchOptions, ProceduralParams};
@@ -226,30 +226,11 @@ pub(super) fn make_patch<'a>(
     };
     let scales = matches!(limit, LimitNdf::Ggx(_));
     let mut cand = Candidates::new();
-    let (key, stretch) = (seed_key(p.seed), kernel.stretch());
     if t < 1.0 {
-        gather_level(
-            levels,
-            fine,
-            key,
-            &kernel,
-            stretch,
-            1.0 - t,
-            scales,
-            &mut cand,
-        );
+        gather_level(levels, fine, p.seed, &kernel, 1.0 - t, scales, &mut cand);
     }
     if t > 0.0 {
-        gather_level(
-            levels,
-            fine + 1,
-            key,
-            &kernel,
-            stretch,
-            t,
-            scales,
-            &mut cand,
-        );
+        gather_level(levels, fine + 1, p.seed, &kernel, t, scales, &mut cand);
     }
     let weights = &cand.w[..cand.len];
     let sum: f64 = weights.iter().map(|&w| w as f64).sum();
