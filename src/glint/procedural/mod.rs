@@ -11,9 +11,9 @@
 //!
 //! - [`ProceduralGlints::new`] validates the parameters and tabulates the levels (a few dozen
 //!   numbers).
-//! - [`GlintNdf::patch_with`] turns a [`Footprint`] into a [`ProceduralPatch`] of at most a few tens
-//!   of lobes (the kernel's anisotropy is capped), blending into the limit NDF as the footprint
-//!   grows: bounded work at every footprint size.
+//! - [`GlintNdf::patch_with`] turns a [`Footprint`] into a [`ProceduralPatch`] of about 4-6
+//!   lobes per level read (a tent one cell wide around the footprint's centre; at most 33 lobes),
+//!   blending into the limit NDF as the footprint grows: bounded work at every footprint size.
 //! - The mean of the P-NDF over positions is the limit NDF at every footprint size; the patch's
 //!   distance to it falls as 1/√(facets seen) (docs/procedural.md, with the method, its parameters,
 //!   its limits and its measurements).
