@@ -17,12 +17,12 @@
 use brdf::Vec2;
 use brdf::fresnel::ConductorFresnel;
 use brdf::glint::GlintModel;
-use brdf::glint::procedural::{ProceduralGlints, ProceduralLimit, ProceduralParams};
+use brdf::glint::procedural::{ProceduralGlints, ProceduralLimit};
 use brdf::material::{GlintMaterial, Material};
 use brdf::ndf::{Beckmann, Ggx};
 use brdf_examples::common::render::render;
 use brdf_examples::common::render::showcase::progress_bar;
-use brdf_examples::common::render::timing::{tiles_for, timing_scene};
+use brdf_examples::common::render::timing::{procedural_params, tiles_for, timing_scene};
 use std::sync::Arc;
 
 const SIZE: usize = 1024;
@@ -31,13 +31,7 @@ const ALPHA: f32 = 0.091;
 fn material(name: &str, tiles: Vec2) -> Result<Material, Box<dyn std::error::Error>> {
     let silver = ConductorFresnel::SILVER;
     let procedural = |limit| -> Result<Material, Box<dyn std::error::Error>> {
-        let params = ProceduralParams {
-            alpha: Vec2::splat(ALPHA),
-            resolution: [SIZE, SIZE],
-            seed: 7,
-            limit,
-            ..Default::default()
-        };
+        let params = procedural_params(ALPHA, SIZE, 7, limit);
         let model: GlintModel = ProceduralGlints::new(params)?.into();
         Ok(GlintMaterial::new(Arc::new(model), silver)
             .with_uv_scale(tiles)?

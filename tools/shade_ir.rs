@@ -17,15 +17,15 @@
 //! (`mixture+compensated`) is that material with its energy compensation on. docs/results.md,
 //! "Few-lobe patches: instructions per shading point" and "Energy compensation of glint patches".
 
-use brdf::Vec2;
 use brdf::fresnel::ConductorFresnel;
-use brdf::glint::procedural::{ProceduralGlints, ProceduralLimit, ProceduralParams};
+use brdf::glint::procedural::{ProceduralGlints, ProceduralLimit};
 use brdf::glint::{
     BeckmannMixture, BinMap, GlintModel, GlintScratch, PositionNormalMap, ScratchedParams,
     scratched,
 };
 use brdf::material::{GlintMaterial, Material};
 use brdf::ndf::{Beckmann, Ggx};
+use brdf_examples::common::render::timing::procedural_params;
 use brdf_examples::common::shading_points::{points, shade};
 use std::sync::Arc;
 
@@ -49,13 +49,7 @@ fn material(name: &str) -> Result<Material, Box<dyn std::error::Error>> {
         .into()
     };
     let procedural = |limit| -> Result<Material, Box<dyn std::error::Error>> {
-        let params = ProceduralParams {
-            alpha: Vec2::splat(ALPHA),
-            resolution: [SIZE, SIZE],
-            seed: 7,
-            limit,
-            ..Default::default()
-        };
+        let params = procedural_params(ALPHA, SIZE, 7, limit);
         Ok(glint(ProceduralGlints::new(params)?.into()))
     };
     let map = || scratched(SIZE, SIZE, ScratchedParams::default(), 7);

@@ -238,6 +238,24 @@ pub fn tiles_for(scene: &Scene, target: f32, map_size: usize) -> Vec2 {
     unit * k as f32
 }
 
+/// The harness's procedural surfaces: the limit `limit` of roughness `alpha` (the analytic GGX's),
+/// one facet per texel of an `n`² grid (the map's texels), facet α and density at their defaults,
+/// seed `seed` (also `tools/shade_ir.rs` and `tools/frame_ir.rs`).
+pub fn procedural_params(
+    alpha: f32,
+    n: usize,
+    seed: u64,
+    limit: ProceduralLimit,
+) -> ProceduralParams {
+    ProceduralParams {
+        alpha: Vec2::splat(alpha),
+        resolution: [n, n],
+        seed,
+        limit,
+        ..Default::default()
+    }
+}
+
 /// The per-axis RMS slope of `map`: √(⟨s_x² + s_y²⟩ / 2) over its texels.
 pub fn rms_slope(map: &NormalMap) -> f32 {
     let s = map.slopes();
@@ -327,22 +345,11 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         &mut || Ok(PositionNormalMap::build(&map, PositionNormalParams::default())?.into()),
     )?;
     let procedural = timed_build(&["procedural glints"], &mut || {
-        let params = ProceduralParams {
-            alpha: Vec2::splat(alpha),
-            resolution: [n, n],
-            seed: opts.seed,
-            ..Default::default()
-        };
+        let params = procedural_params(alpha, n, opts.seed, ProceduralLimit::Beckmann);
         Ok(ProceduralGlints::new(params)?.into())
     })?;
     let procedural_ggx = timed_build(&["procedural glints (GGX)"], &mut || {
-        let params = ProceduralParams {
-            alpha: Vec2::splat(alpha),
-            resolution: [n, n],
-            seed: opts.seed,
-            limit: ProceduralLimit::Ggx,
-            ..Default::default()
-        };
+        let params = procedural_params(alpha, n, opts.seed, ProceduralLimit::Ggx);
         Ok(ProceduralGlints::new(params)?.into())
     })?;
     println!(
