@@ -222,6 +222,14 @@ impl Candidates {
     }
 }
 
+/// ⌊x⌋ as an integer, for |x| < 2⁶³ (cell indices): the truncation, one less where it rounded up
+/// (without SSE4.1, `f64::floor` is a library call).
+#[inline]
+fn floor_i64(x: f64) -> i64 {
+    let i = x as i64;
+    if (i as f64) > x { i - 1 } else { i }
+}
+
 /// Adds the lobes of `level` under the tent of `kernel` to `out`: the lobes of the cells around
 /// the kernel's centre weighted by the separable tent k(p) = (1 − |dx|/H_u)⁺ (1 − |dy|/H_v)⁺,
 /// normalised over the level and scaled by `scale`. The half-widths are the level's cell sides
@@ -242,14 +250,8 @@ pub(super) fn gather_level(
     let [s, t] = level.spacing;
     let (hu, hv) = (s * stretch[0], t * stretch[1]);
     let [cx, cy] = kernel.center;
-    let (i0, i1) = (
-        ((cx - hu) / s).floor() as i64,
-        ((cx + hu) / s).floor() as i64,
-    );
-    let (j0, j1) = (
-        ((cy - hv) / t).floor() as i64,
-        ((cy + hv) / t).floor() as i64,
-    );
+    let (i0, i1) = (floor_i64((cx - hu) / s), floor_i64((cx + hu) / s));
+    let (j0, j1) = (floor_i64((cy - hv) / t), floor_i64((cy + hv) / t));
     let [cells_u, cells_v] = level.cells;
     let (iu, iv) = (1.0 / hu, 1.0 / hv);
     let start = out.len;
