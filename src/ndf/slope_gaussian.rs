@@ -447,14 +447,6 @@ impl SlopeGaussian {
         (a_s, (vx * vx + vy * vy).sqrt())
     }
 
-    /// A_s(w) = w_z − μ·w_xy in `f64`, as [`SlopeGaussian::area_and_spread`] forms it.
-    #[cfg(feature = "std")]
-    #[inline]
-    pub(crate) fn signed_area_f64(&self, w: Vec3) -> f64 {
-        let (wx, wy, wz) = (w.x as f64, w.y as f64, w.z as f64);
-        wz - (self.mean.x as f64 * wx + self.mean.y as f64 * wy)
-    }
-
     /// tr Σ = l11² + l21² + l22² in `f64` from the stored factor: |Lᵀ w_xy|² ≤ tr Σ |w_xy|².
     #[cfg(feature = "std")]
     #[inline]

@@ -58,7 +58,7 @@ const LANE_RAMP_MAX: f64 = 12.0;
 
 /// The least t = A_s/s_w at which a lobe in front of w takes V_i = A_s (the term s_w G(−t)
 /// dropped is G(−t)/t < φ(t)/t³ < 10⁻⁹ of it: below `f32` rounding).
-const FRONT_T: f64 = 5.5;
+pub(crate) const FRONT_T: f64 = 5.5;
 
 /// Lobes per pass of the lane kernel [`ramp_neg_lanes`]: a set holds a
 /// few to a few tens of lobes.
@@ -213,85 +213,105 @@ impl LobeSet {
     pub fn mean_slope(&self) -> Vec2 {
         self.mean
     }
+}
 
-    /// Picks lobe i with probability ∝ `p[i]`, rescaling `u` into [0, 1) for the lobe's own draw.
-    fn pick(p: &[f32], u: f32) -> Option<(usize, f32)> {
-        let total: f32 = p.iter().sum();
-        if !(total > 0.0 && total.is_finite()) {
-            return None;
+/// `f(i, w_i V_i(w))` for `n` lobes in order, for a usable w (w_z > 0, finite), from each lobe's
+/// `terms(i)` = (w_i, A_s, s_w) (its weight, signed area and spread toward w, in `f64`). Where
+/// `in_front` ([`all_in_front`]), V_i is A_s alone (the term dropped is below `f32` rounding).
+/// Else V_i = A_s⁺ + s_w G(−|A_s|/s_w) (the two branches of `SlopeGaussian::visible_area` in one
+/// form, since G(z) = z + G(−z)), G over [`CHUNK`] lanes ([`ramp_neg_lanes`], relative error
+/// < 10⁻⁶); a lobe wholly behind w by more than [`LANE_RAMP_MAX`] of its s_w, where the lanes' G
+/// leaves `f32`'s normal range, takes `own_v(i)`, the lobe's own `f64` V.
+#[inline]
+pub(crate) fn lobe_areas(
+    n: usize,
+    terms: impl Fn(usize) -> (f32, f64, f64),
+    own_v: impl Fn(usize) -> f32,
+    in_front: bool,
+    mut f: impl FnMut(usize, f32),
+) {
+    if in_front {
+        for i in 0..n {
+            let (wi, a, _) = terms(i);
+            f(i, wi * a as f32);
         }
-        let target = u.clamp(0.0, 1.0) * total;
-        let mut acc = 0.0;
-        let mut last = None;
-        for (i, &pi) in p.iter().enumerate() {
-            if pi <= 0.0 {
-                continue;
-            }
-            last = Some(i);
-            if target < acc + pi {
-                let r = ((target - acc) / pi).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-                return Some((i, r));
-            }
-            acc += pi;
+        return;
+    }
+    for base in (0..n).step_by(CHUNK) {
+        let len = CHUNK.min(n - base);
+        let mut wt = [0.0f32; CHUNK];
+        let mut a = [0.0f64; CHUNK];
+        let mut sw = [0.0f64; CHUNK];
+        let mut t = [0.0f64; CHUNK];
+        for k in 0..len {
+            let (wk, ak, sk) = terms(base + k);
+            (wt[k], a[k], sw[k], t[k]) = (wk, ak, sk, ak.abs() / sk);
         }
-        last.map(|i| (i, 1.0 - f32::EPSILON / 2.0))
+        // A lobe wholly in front of w by more than 8 s_w has V = A_s to `f64` resolution
+        // (G(−t)/t < 10⁻¹⁷ there): a chunk of such lobes skips the ramp.
+        let mut ramp = [0.0f32; CHUNK];
+        if (0..len).any(|k| !(a[k] > 0.0 && t[k] > 8.0)) {
+            ramp_neg_lanes(&t, &mut ramp);
+        }
+        for k in 0..len {
+            let v = if a[k] < 0.0 && t[k] > LANE_RAMP_MAX {
+                own_v(base + k)
+            } else {
+                finite_or_zero((a[k].max(0.0) + sw[k] * ramp[k] as f64) as f32)
+            };
+            f(base + k, wt[k] * v);
+        }
     }
 }
 
-impl LobeSet {
-    /// `f(i, w_i V_i(w))` for every lobe i in order, for a usable w (w_z > 0, finite):
-    /// V_i = A_s⁺ + s_w G(−|A_s|/s_w) (the two branches of `SlopeGaussian::visible_area` in one
-    /// form, since G(z) = z + G(−z)), A_s and s_w per lobe in `f64`, G over [`CHUNK`] lanes
-    /// ([`ramp_neg_lanes`], relative error < 10⁻⁶). A lobe wholly behind w by more than
-    /// [`LANE_RAMP_MAX`] of its s_w, where the lanes' G leaves `f32`'s normal range, takes the
-    /// lobe's own `f64` V.
-    fn for_each_lobe_area(&self, w: Vec3, mut f: impl FnMut(usize, f32)) {
-        if self.all_in_front(w) {
-            // Every V_i is its signed area A_s (in `f64`, as below): no spread, no ramp.
-            for (i, g) in self.g[..self.n].iter().enumerate() {
-                f(i, self.w[i] * g.signed_area_f64(w) as f32);
-            }
-            return;
-        }
-        for base in (0..self.n).step_by(CHUNK) {
-            let len = CHUNK.min(self.n - base);
-            let mut a = [0.0f64; CHUNK];
-            let mut sw = [0.0f64; CHUNK];
-            let mut t = [0.0f64; CHUNK];
-            for (k, g) in self.g[base..base + len].iter().enumerate() {
-                let (ak, sk) = g.area_and_spread(w);
-                (a[k], sw[k], t[k]) = (ak, sk, ak.abs() / sk);
-            }
-            // A lobe wholly in front of w by more than 8 s_w has V = A_s to `f64` resolution
-            // (G(−t)/t < 10⁻¹⁷ there): a chunk of such lobes skips the ramp.
-            let mut ramp = [0.0f32; CHUNK];
-            if (0..len).any(|k| !(a[k] > 0.0 && t[k] > 8.0)) {
-                ramp_neg_lanes(&t, &mut ramp);
-            }
-            for k in 0..len {
-                let i = base + k;
-                let v = if a[k] < 0.0 && t[k] > LANE_RAMP_MAX {
-                    self.g[i].visible_area(w)
-                } else {
-                    finite_or_zero((a[k].max(0.0) + sw[k] * ramp[k] as f64) as f32)
-                };
-                f(i, self.w[i] * v);
-            }
-        }
-    }
+/// Whether every lobe of a set is in front of w by more than [`FRONT_T`] of its spread
+/// (A_s > t s_w), from bounds that cost O(1): A_s ≥ w_z − max over `mean_box` (the box of the
+/// lobes' means, [min x, min y, max x, max y]) of μ·w_xy, and s_w² = |Lᵀ w_xy|² ≤ tr Σ |w_xy|²
+/// (Cauchy-Schwarz) with `trace_max` the largest trace. For a usable w.
+#[inline]
+pub(crate) fn all_in_front(mean_box: &[f32; 4], trace_max: f64, w: Vec3) -> bool {
+    let (wx, wy, wz) = (w.x as f64, w.y as f64, w.z as f64);
+    let b = mean_box;
+    let mx = if wx > 0.0 { b[2] } else { b[0] } as f64;
+    let my = if wy > 0.0 { b[3] } else { b[1] } as f64;
+    let a_min = wz - (mx * wx + my * wy);
+    let s2 = trace_max * (wx * wx + wy * wy);
+    // The margin covers the rounding of the bounds against the lobes' own terms.
+    a_min > 0.0 && a_min * a_min > FRONT_T * FRONT_T * s2 * (1.0 + 1e-9)
+}
 
-    /// Whether every lobe is in front of w by more than [`FRONT_T`] of its spread (A_s > t s_w),
-    /// from bounds that cost O(1): A_s ≥ w_z − max over the box of the means of μ·w_xy, and
-    /// s_w² = |Lᵀ w_xy|² ≤ tr Σ |w_xy|² (Cauchy-Schwarz) with the largest trace. For a usable w.
-    fn all_in_front(&self, w: Vec3) -> bool {
-        let (wx, wy, wz) = (w.x as f64, w.y as f64, w.z as f64);
-        let b = &self.mean_box;
-        let mx = if wx > 0.0 { b[2] } else { b[0] } as f64;
-        let my = if wy > 0.0 { b[3] } else { b[1] } as f64;
-        let a_min = wz - (mx * wx + my * wy);
-        let s2 = self.trace_max * (wx * wx + wy * wy);
-        // The margin covers the rounding of the bounds against the lobes' own terms.
-        a_min > 0.0 && a_min * a_min > FRONT_T * FRONT_T * s2 * (1.0 + 1e-9)
+/// Picks lobe i with probability ∝ `p[i]`, rescaling `u` into [0, 1) for the lobe's own draw.
+pub(crate) fn pick(p: &[f32], u: f32) -> Option<(usize, f32)> {
+    let total: f32 = p.iter().sum();
+    if !(total > 0.0 && total.is_finite()) {
+        return None;
+    }
+    let target = u.clamp(0.0, 1.0) * total;
+    let mut acc = 0.0;
+    let mut last = None;
+    for (i, &pi) in p.iter().enumerate() {
+        if pi <= 0.0 {
+            continue;
+        }
+        last = Some(i);
+        if target < acc + pi {
+            let r = ((target - acc) / pi).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+            return Some((i, r));
+        }
+        acc += pi;
+    }
+    last.map(|i| (i, 1.0 - f32::EPSILON / 2.0))
+}
+
+impl LobeSet {
+    /// `f(i, w_i V_i(w))` for every lobe i in order ([`lobe_areas`]).
+    fn for_each_lobe_area(&self, w: Vec3, f: impl FnMut(usize, f32)) {
+        let front = all_in_front(&self.mean_box, self.trace_max, w);
+        let terms = |i: usize| {
+            let (a, s) = self.g[i].area_and_spread(w);
+            (self.w[i], a, s)
+        };
+        lobe_areas(self.n, terms, |i| self.g[i].visible_area(w), front, f);
     }
 
     /// V(w) = Σ w_i V_i(w), summed in lobe order from +0 (the prepared view's sum is formed the
@@ -394,7 +414,7 @@ impl Ndf for LobeSet {
         if let Some(g) = self.single() {
             return g.sample_normal(u);
         }
-        match Self::pick(self.weights(), u.x) {
+        match pick(self.weights(), u.x) {
             Some((i, ux)) => self.g[i].sample_normal(Vec2::new(ux, u.y)),
             None => Vec3::Z,
         }
@@ -407,7 +427,7 @@ impl Ndf for LobeSet {
         if !(wo.z > 0.0 && wo.is_finite()) {
             return self.sample_normal(u);
         }
-        match self.with_pick_weights(wo, |p| Self::pick(p, u.x)) {
+        match self.with_pick_weights(wo, |p| pick(p, u.x)) {
             Some((i, ux)) => self.g[i].sample_visible(wo, Vec2::new(ux, u.y)),
             None => self.sample_normal(u),
         }
@@ -644,7 +664,7 @@ mod tests {
                     (got - want).abs() <= 1e-6 * want,
                     "V at ({theta}°, {phi}°): {got} against {want}"
                 );
-                if s.all_in_front(w) {
+                if all_in_front(&s.mean_box, s.trace_max, w) {
                     taken += 1;
                     // The bound is conservative: every lobe is in front by more than FRONT_T.
                     for (_, g) in s.iter() {

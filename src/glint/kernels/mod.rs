@@ -10,6 +10,8 @@
 //! - lanes.rs: lane arithmetic that vectorises (`exp2`, the ramp term of V), for the mixture's
 //!   lobe blocks and the lobe sets.
 //! - lobe_set.rs: a small weighted set of slope Gaussians, the few-lobe patches' P-NDF.
+//! - shared_lobes.rs: a weighted set of slope Gaussians of one shape held inline, a procedural
+//!   Beckmann patch's P-NDF.
 //! - mip.rs: trilinear addressing of mip chains over a lobe grid.
 //! - prepared_view.rs: a value a patch computes once for the view it is prepared for (V(wo)).
 //! - slope_tree.rs: the implicit quadtree of slope boxes over a regular grid of elements (the
@@ -27,4 +29,5 @@ pub(crate) mod lanes;
 pub(crate) mod lobe_set;
 pub(crate) mod mip;
 pub(crate) mod prepared_view;
+pub(crate) mod shared_lobes;
 pub(crate) mod slope_tree;

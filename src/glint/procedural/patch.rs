@@ -9,6 +9,7 @@ use super::lattice::{
 use super::limit::{GgxBlend, LimitNdf};
 use super::params::{PatchOptions, ProceduralParams};
 use crate::glint::kernels::lobe_set::{Few, LobeSet, box_half_widths};
+use crate::glint::kernels::shared_lobes::SharedLobes;
 use crate::glint::scratch::Lent;
 use crate::glint::{Footprint, GlintScratch};
 use crate::ndf::{Beckmann, Ggx, SlopeGaussian, forward_ndf};
@@ -54,6 +55,8 @@ pub struct ProceduralPatch<'a> {
 /// them), GGX alone, or facet lobes blended with GGX.
 #[derive(Clone, Debug)]
 enum Body<'a> {
+    /// A Beckmann surface's facet lobes alone: one shape, held inline.
+    Shared(SharedLobes),
     Lobes(Few<'a>),
     /// A Beckmann surface's limit alone: the analytic NDF (the same function as the limit's
     /// centred slope Gaussian, with its cheaper closed forms and sampler) beside that lobe.
@@ -62,10 +65,14 @@ enum Body<'a> {
     Blend(GgxBlend<'a>),
 }
 
+// Every gathered lobe fits a shared-shape set.
+const _: () = assert!(Candidates::CAPACITY <= SharedLobes::CAPACITY);
+
 /// Binds the patch's NDF to `$n` (for [`forward_ndf`]).
 macro_rules! to_body {
     ($s:ident, $n:ident => $e:expr) => {
         match &$s.body {
+            Body::Shared($n) => $e,
             Body::Lobes($n) => $e,
             Body::Beckmann($n, _) => $e,
             Body::Ggx($n) => $e,
@@ -103,6 +110,7 @@ impl ProceduralPatch<'_> {
     /// first view. `Material::bsdf` prepares its glint patches for the shading point's wo.
     pub fn prepare_view(&mut self, wo: Vec3) {
         match &mut self.body {
+            Body::Shared(set) => set.prepare_view(wo),
             Body::Lobes(few) => few.prepare_view(wo),
             Body::Beckmann(..) | Body::Ggx(_) => {}
             Body::Blend(blend) => blend.prepare_view(wo),
@@ -118,6 +126,7 @@ impl ProceduralPatch<'_> {
             Few::Set(s) => s.len(),
         };
         match &self.body {
+            Body::Shared(set) => set.len(),
             Body::Lobes(few) => count(few),
             Body::Beckmann(..) | Body::Ggx(_) => 1,
             Body::Blend(blend) => count(blend.lobes()) + 1,
@@ -143,18 +152,20 @@ impl ProceduralPatch<'_> {
         impl Iterator<Item = (f32, SlopeGaussian)> + Clone + '_,
         Option<(f32, Ggx)>,
     ) {
-        let (few, alone, scale, ggx) = match &self.body {
-            Body::Lobes(f) => (Some(f), None, 1.0, None),
-            Body::Beckmann(_, g) => (None, Some((1.0, *g)), 1.0, None),
-            Body::Ggx(g) => (None, None, 0.0, Some((1.0, *g))),
+        let (few, shared, alone, scale, ggx) = match &self.body {
+            Body::Shared(s) => (None, Some(s), None, 1.0, None),
+            Body::Lobes(f) => (Some(f), None, None, 1.0, None),
+            Body::Beckmann(_, g) => (None, None, Some((1.0, *g)), 1.0, None),
+            Body::Ggx(g) => (None, None, None, 0.0, Some((1.0, *g))),
             Body::Blend(b) => {
                 let (lobes, weight, ggx) = b.parts();
-                (Some(lobes), None, 1.0 - weight, Some((weight, ggx)))
+                (Some(lobes), None, None, 1.0 - weight, Some((weight, ggx)))
             }
         };
         let lobes = few
             .into_iter()
             .flat_map(|f| f.iter_lobes())
+            .chain(shared.into_iter().flat_map(|s| s.iter_lobes()))
             .map(move |(w, g)| (w * scale, g))
             .chain(alone);
         (lobes, ggx)
@@ -246,7 +257,7 @@ pub(super) fn make_patch<'a>(
         level: x,
     };
     match limit {
-        LimitNdf::Beckmann(lobe) => beckmann_patch(&cand, sum, &widths, p.alpha, lobe, scratch),
+        LimitNdf::Beckmann(lobe) => beckmann_patch(&cand, sum, &widths, p.alpha, lobe),
         LimitNdf::Ggx(g) => ggx_patch(&cand, sum, &widths, p.alpha, g, scratch),
     }
 }
@@ -272,14 +283,13 @@ impl Widths {
 }
 
 /// The patch of a Beckmann surface from its gathered lobes `cand` (weights summing to `sum`):
-/// one shared width, the limit lobe among the lobes.
+/// one shared width, held inline, the limit lobe closing the set where it is blended in.
 fn beckmann_patch<'a>(
     cand: &Candidates,
     sum: f64,
     wd: &Widths,
     alpha: Vec2,
     limit: SlopeGaussian,
-    scratch: Option<&'a GlintScratch>,
 ) -> ProceduralPatch<'a> {
     let (sigma, x) = (wd.sigma, wd.level);
     let (beta2, tau2) = lobe_widths(sigma, wd.sigma_f, wd.r);
@@ -296,32 +306,26 @@ fn beckmann_patch<'a>(
     if b >= 1.0 {
         return ProceduralPatch::limit_alone(LimitNdf::Beckmann(limit), alpha, x, distance);
     }
-    let few = {
-        let tau = tau2.map(|v| v.sqrt() as f32);
-        // Slope boxes holding 1 − 10⁻¹² of each lobe (√2 × the half-widths of the shared 10⁻⁶
-        // tail): the facet lobes are narrow and many, and a sampler's draws beyond a box (where D
-        // is 0) stay a 10⁻¹² event per draw.
-        let half = box_half_widths(&shape) * std::f32::consts::SQRT_2;
-        let mut set = Lent::<LobeSet>::new(scratch.map(|s| s.home()));
-        set.clear();
-        let scale = (1.0 - b) / sum as f32;
-        for (w, z) in cand.w[..cand.len].iter().zip(&cand.z[..cand.len]) {
-            if let Some(g) = shape.with_mean(Vec2::new(tau[0] * z[0], tau[1] * z[1])) {
-                set.push_with_half_widths(w * scale, g, half);
-            }
-        }
-        if b > 0.0 {
-            set.push(b, limit);
-        }
-        set.normalise();
-        if set.len() == 0 {
-            Few::One(limit)
-        } else {
-            Few::Set(set)
-        }
-    };
+    let tau = tau2.map(|v| v.sqrt() as f32);
+    // Slope boxes holding 1 − 10⁻¹² of each lobe (√2 × the half-widths of the shared 10⁻⁶ tail):
+    // the facet lobes are narrow and many, and a sampler's draws beyond a box (where D is 0) stay a
+    // 10⁻¹² event per draw.
+    let half = box_half_widths(&shape) * std::f32::consts::SQRT_2;
+    // The facet lobes (one shape, held inline), closed by the limit lobe where it is blended in.
+    let mut set = SharedLobes::new(shape, half);
+    let scale = (1.0 - b) / sum as f32;
+    for (w, z) in cand.w[..cand.len].iter().zip(&cand.z[..cand.len]) {
+        set.push(w * scale, Vec2::new(tau[0] * z[0], tau[1] * z[1]));
+    }
+    if b > 0.0 {
+        set.push_other(b, limit);
+    }
+    set.normalise();
+    if set.len() == 0 {
+        return ProceduralPatch::limit_alone(LimitNdf::Beckmann(limit), alpha, x, distance);
+    }
     ProceduralPatch {
-        body: Body::Lobes(few),
+        body: Body::Shared(set),
         level: x as f32,
         limit_weight: b,
         distance: distance as f32,
