@@ -1,7 +1,8 @@
 //! A small weighted set of slope Gaussians evaluated by brute force: what a glint patch serves
 //! when its level of detail is one lobe (the mixture's filtered lobe and sub-texel limit lobe) or
-//! the filtered mixture of a large footprint (gmm.rs, for the mixture and position-normal), with
-//! the terms of \[Chermain2019\] eq. 9-17 over its lobes:
+//! the filtered mixture of a large footprint (gmm.rs, for the mixture and position-normal), and a
+//! procedural GGX surface's facet lobes (src/glint/procedural/), with the terms of
+//! \[Chermain2019\] eq. 9-17 over its lobes:
 //!
 //! - D(m) = Σ w_i D_i(m) over the lobes whose slope box holds m's slope (their P22 summed at one
 //!   slope in `f64`, times the shared Jacobian (1 + |ñ|²)²): the box of the ellipse
@@ -9,7 +10,9 @@
 //!   query costs a box test per lobe and a density only where it contributes (as the mixture's
 //!   slope boxes at its default tail);
 //! - A(w) = max(cos θ − w_xy·μ, 0), μ = Σ w_i μ_i (the signed areas summed, as the mixture's);
-//! - V(w) = Σ w_i V_i(w) (exact up to the lanes' 10⁻⁶, O(lobes), the ramp term over 16 lanes);
+//! - V(w) = Σ w_i V_i(w) (exact up to the lanes' 10⁻⁶, O(lobes)): each V_i its signed area alone
+//!   where an O(1) bound puts every lobe more than [`FRONT_T`] spreads in front of w, else the ramp
+//!   term over [`CHUNK`] lanes ([`lobe_areas`], shared with src/glint/kernels/shared_lobes.rs);
 //! - `sample_normal`: a lobe ∝ w_i, then its slope Gaussian; density Σ w_i D_i(m) cos θ_m;
 //! - `sample_visible`: a lobe ∝ w_i V_i(wo), then its visible normal; density
 //!   Σ w_i ⟨wo, m⟩⁺ D_i(m) / V(wo).

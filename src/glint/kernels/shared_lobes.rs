@@ -8,7 +8,8 @@
 //!   exponential inline (`exp_neg_half`), the shared peak and Jacobian applied once;
 //! - A(w) = max(cos θ − w_xy·μ, 0), μ = Σ w_i μ_i;
 //! - V(w) = Σ w_i V_i(w), by the lobe sets' own pass ([`lobe_areas`]: the signed areas alone where
-//!   an O(1) bound puts every lobe well in front of w, else the ramp over lanes);
+//!   every lobe is more than `FRONT_T` spreads in front of w, tested exactly since the shared shape
+//!   has one spread toward w, else the ramp over lanes);
 //! - `sample_normal`: a lobe ∝ w_i, then its slope Gaussian; `sample_visible`: a lobe
 //!   ∝ w_i V_i(wo), then its visible normal; their densities Σ w_i D_i cos θ_m and
 //!   ⟨wo, m⟩⁺ D / V(wo).
@@ -21,7 +22,7 @@
 //! does.
 
 use super::lanes::exp_neg_half;
-use super::lobe_set::{FRONT_T, all_in_front, box_half_widths, lobe_areas, pick};
+use super::lobe_set::{FRONT_T, box_half_widths, lobe_areas, pick};
 use super::prepared_view::PreparedView;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Vec2, Vec3};
@@ -37,23 +38,26 @@ pub(crate) struct SharedLobes {
     shape: SlopeGaussian,
     /// The half-widths of every lobe's slope box.
     half: Vec2,
-    /// The last lobe when it has its own shape (with its slope box's half-widths).
+    /// The last lobe when it has its own shape, with its slope box's half-widths (the box of
+    /// `LobeSet::push`).
     other: Option<(SlopeGaussian, Vec2)>,
-    /// The largest trace of the lobes' covariances ([`all_in_front`]).
-    trace_max: f64,
     /// The mean slope Σ w_i μ_i of the current weights.
     mean: Vec2,
-    /// The box of the means, [min x, min y, max x, max y] ([`all_in_front`]).
-    mean_box: [f32; 4],
     /// V(wo) at the prepared view ([`SharedLobes::prepare_view`]), and each lobe's w_i V_i(wo)
-    /// there (the visible sampler's pick weights, whose sum is V(wo)).
+    /// there (the visible sampler's pick weights, whose sum is V(wo)) for a set of at most
+    /// [`SharedLobes::PREPARED`] lobes.
     view: PreparedView,
-    view_lobes: [f32; SharedLobes::CAPACITY],
+    view_lobes: [f32; SharedLobes::PREPARED],
 }
 
 impl SharedLobes {
     /// The most lobes a set holds: a procedural patch's two lattice levels of at most 4 × 4 cells.
     pub const CAPACITY: usize = 32;
+
+    /// The most lobes whose pick weights a prepared set keeps (a patch holds 4-8 lobes, at most 16
+    /// over random footprints; a larger set recomputes them per draw): the set stays small enough
+    /// that a patch holding it moves as cheaply as any other glint patch.
+    pub const PREPARED: usize = 16;
 
     /// An empty set of lobes of shape `shape` (its mean is ignored) with slope boxes of half-widths
     /// `half` around each mean.
@@ -66,16 +70,9 @@ impl SharedLobes {
             shape: shape.with_mean(Vec2::ZERO).unwrap_or(shape),
             half,
             other: None,
-            trace_max: shape.covariance_trace_f64(),
             mean: Vec2::ZERO,
-            mean_box: [
-                f32::INFINITY,
-                f32::INFINITY,
-                f32::NEG_INFINITY,
-                f32::NEG_INFINITY,
-            ],
             view: PreparedView::NONE,
-            view_lobes: [0.0; Self::CAPACITY],
+            view_lobes: [0.0; Self::PREPARED],
         }
     }
 
@@ -93,7 +90,6 @@ impl SharedLobes {
     pub fn push_other(&mut self, w: f32, g: SlopeGaussian) {
         if self.other.is_none() && self.push_entry(w, g.mean()) {
             self.other = Some((g, box_half_widths(&g)));
-            self.trace_max = self.trace_max.max(g.covariance_trace_f64());
         }
     }
 
@@ -104,13 +100,6 @@ impl SharedLobes {
             let i = self.n;
             (self.w[i], self.mx[i], self.my[i]) = (w, mean.x, mean.y);
             self.mean += w * mean;
-            let b = &mut self.mean_box;
-            *b = [
-                b[0].min(mean.x),
-                b[1].min(mean.y),
-                b[2].max(mean.x),
-                b[3].max(mean.y),
-            ];
             self.n += 1;
             self.view = PreparedView::NONE;
         }
@@ -167,24 +156,26 @@ impl SharedLobes {
     /// `f(i, w_i V_i(w))` for every lobe in order, for a usable w ([`lobe_areas`]).
     fn for_each_lobe_area(&self, w: Vec3, f: impl FnMut(usize, f32)) {
         let (wx, wy, wz) = (w.x as f64, w.y as f64, w.z as f64);
-        let bound = all_in_front(&self.mean_box, self.trace_max, w);
         // Every lobe of the shared shape has the same spread toward w; the closing lobe its own.
-        let spread = |g: &SlopeGaussian| if bound { 0.0 } else { g.area_and_spread(w).1 };
-        let s_shared = spread(&self.shape);
-        let s_other = self.other.map_or(0.0, |(g, _)| spread(&g));
+        let s_shared = self.shape.area_and_spread(w).1;
+        let s_other = self.other.map_or(0.0, |(g, _)| g.area_and_spread(w).1);
         let last = self.n.wrapping_sub(1);
         let terms = |i: usize| {
             // A_s = w_z − μ·w_xy as `SlopeGaussian::area_and_spread` forms it, from the stored mean.
             let a = wz - (self.mx[i] as f64 * wx + self.my[i] as f64 * wy);
-            let s = if i == last && self.other.is_some() { s_other } else { s_shared };
+            let s = if i == last && self.other.is_some() {
+                s_other
+            } else {
+                s_shared
+            };
             (self.w[i], a, s)
         };
-        // Where the O(1) bound refuses, the exact test (one spread for all lobes makes it cheap).
-        let front = bound
-            || (0..self.n).all(|i| {
-                let (_, a, s) = terms(i);
-                a > FRONT_T * s
-            });
+        // Every lobe more than `FRONT_T` spreads in front of w (exact: one spread for all lobes
+        // makes the test a pass of multiply-adds).
+        let front = (0..self.n).all(|i| {
+            let (_, a, s) = terms(i);
+            a > FRONT_T * s
+        });
         lobe_areas(self.n, terms, |i| self.lobe(i).visible_area(w), front, f);
     }
 
@@ -201,10 +192,12 @@ impl SharedLobes {
         self.view = PreparedView::NONE;
         if self.n > 1 && wo.z > 0.0 && wo.is_finite() {
             // The terms and their sum as `visible_area` forms them (`lobe_area_sum`).
-            let mut lobes = [0.0f32; Self::CAPACITY];
+            let mut lobes = [0.0f32; Self::PREPARED];
             let mut v = 0.0f32;
             self.for_each_lobe_area(wo, |i, x| {
-                lobes[i] = x;
+                if let Some(l) = lobes.get_mut(i) {
+                    *l = x;
+                }
                 v += x;
             });
             let v = if v.is_finite() { v } else { 0.0 };
@@ -306,11 +299,11 @@ impl Ndf for SharedLobes {
         // The pick weights w_i V_i(wo), the terms of V(wo): the prepared ones at the prepared view,
         // else on the stack.
         let mut p = [0.0f32; Self::CAPACITY];
-        let p = if self.view.is(wo) {
-            &self.view_lobes
+        let p = if self.view.is(wo) && self.n <= Self::PREPARED {
+            &self.view_lobes[..]
         } else {
             self.for_each_lobe_area(wo, |i, x| p[i] = x);
-            &p
+            &p[..]
         };
         match pick(&p[..self.n], u.x) {
             Some((i, ux)) => self.lobe(i).sample_visible(wo, Vec2::new(ux, u.y)),
@@ -411,7 +404,13 @@ mod tests {
         let (shared, general) = sets(closed);
         assert_eq!(shared.len(), 11 + closed as usize);
         let close = |a: f32, b: f32| (a - b).abs() <= 1e-6 * b.abs().max(1e-30);
-        for (t, p) in [(0.0, 0.0), (30.0, 10.0), (60.0, 100.0), (80.0, 190.0), (89.5, 300.0)] {
+        for (t, p) in [
+            (0.0, 0.0),
+            (30.0, 10.0),
+            (60.0, 100.0),
+            (80.0, 190.0),
+            (89.5, 300.0),
+        ] {
             let wo = dir(t, p);
             assert!(close(shared.visible_area(wo), general.visible_area(wo)));
             assert!(close(shared.projected_area(wo), general.projected_area(wo)));

@@ -54,9 +54,14 @@ pub struct ProceduralPatch<'a> {
 /// What a patch holds: slope Gaussians (the facet lobes, with a Beckmann surface's limit lobe among
 /// them), GGX alone, or facet lobes blended with GGX.
 #[derive(Clone, Debug)]
+// The inline lobes are the point: boxing them would allocate per shading point, and the patch is
+// no larger than a mixture patch (asserted below), the largest `GlintPatch`.
+#[allow(clippy::large_enum_variant)]
 enum Body<'a> {
-    /// A Beckmann surface's facet lobes alone: one shape, held inline.
+    /// A Beckmann surface's facet lobes (one shape, held inline), closed by its limit lobe in the
+    /// hand-over.
     Shared(SharedLobes),
+    /// A GGX surface's facet lobes (a lobe set lent by the scratch), or one lobe.
     Lobes(Few<'a>),
     /// A Beckmann surface's limit alone: the analytic NDF (the same function as the limit's
     /// centred slope Gaussian, with its cheaper closed forms and sampler) beside that lobe.
@@ -67,6 +72,12 @@ enum Body<'a> {
 
 // Every gathered lobe fits a shared-shape set.
 const _: () = assert!(Candidates::CAPACITY <= SharedLobes::CAPACITY);
+// A patch holding its lobes inline is no larger than a mixture patch, so that `GlintPatch` (and
+// every glint material's BSDF, moved a few times per shading point) does not grow with it.
+const _: () = assert!(
+    core::mem::size_of::<ProceduralPatch<'static>>()
+        <= core::mem::size_of::<crate::glint::mixture::MixturePatch<'static>>()
+);
 
 /// Binds the patch's NDF to `$n` (for [`forward_ndf`]).
 macro_rules! to_body {
