@@ -154,29 +154,32 @@ impl SharedLobes {
     }
 
     /// `f(i, w_i V_i(w))` for every lobe in order, for a usable w ([`lobe_areas`]).
-    fn for_each_lobe_area(&self, w: Vec3, f: impl FnMut(usize, f32)) {
+    fn for_each_lobe_area(&self, w: Vec3, mut f: impl FnMut(usize, f32)) {
         let (wx, wy, wz) = (w.x as f64, w.y as f64, w.z as f64);
         // Every lobe of the shared shape has the same spread toward w; the closing lobe its own.
         let s_shared = self.shape.area_and_spread(w).1;
         let s_other = self.other.map_or(0.0, |(g, _)| g.area_and_spread(w).1);
-        let last = self.n.wrapping_sub(1);
+        let n_shared = self.n_shared();
+        // A_s = w_z − μ·w_xy as `SlopeGaussian::area_and_spread` forms it, from the stored means;
+        // every lobe more than `FRONT_T` spreads in front of w (exact: one spread for all lobes).
+        let mut a = [0.0f64; Self::CAPACITY];
+        let mut front = true;
+        for i in 0..self.n {
+            a[i] = wz - (self.mx[i] as f64 * wx + self.my[i] as f64 * wy);
+            let s = if i < n_shared { s_shared } else { s_other };
+            front &= a[i] > FRONT_T * s;
+        }
+        if front {
+            for i in 0..self.n {
+                f(i, self.w[i] * a[i] as f32);
+            }
+            return;
+        }
         let terms = |i: usize| {
-            // A_s = w_z − μ·w_xy as `SlopeGaussian::area_and_spread` forms it, from the stored mean.
-            let a = wz - (self.mx[i] as f64 * wx + self.my[i] as f64 * wy);
-            let s = if i == last && self.other.is_some() {
-                s_other
-            } else {
-                s_shared
-            };
-            (self.w[i], a, s)
+            let s = if i < n_shared { s_shared } else { s_other };
+            (self.w[i], a[i], s)
         };
-        // Every lobe more than `FRONT_T` spreads in front of w (exact: one spread for all lobes
-        // makes the test a pass of multiply-adds).
-        let front = (0..self.n).all(|i| {
-            let (_, a, s) = terms(i);
-            a > FRONT_T * s
-        });
-        lobe_areas(self.n, terms, |i| self.lobe(i).visible_area(w), front, f);
+        lobe_areas(self.n, terms, |i| self.lobe(i).visible_area(w), false, f);
     }
 
     /// V(w) = Σ w_i V_i(w), summed in lobe order from +0 (as the prepared view's).
