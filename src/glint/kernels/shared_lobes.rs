@@ -154,6 +154,9 @@ impl SharedLobes {
     }
 
     /// `f(i, w_i V_i(w))` for every lobe in order, for a usable w ([`lobe_areas`]).
+    // The loops index four arrays in step (an iterator over one of them measured 0.2 % slower in
+    // the render example's frame).
+    #[allow(clippy::needless_range_loop)]
     fn for_each_lobe_area(&self, w: Vec3, mut f: impl FnMut(usize, f32)) {
         let (wx, wy, wz) = (w.x as f64, w.y as f64, w.z as f64);
         // Every lobe of the shared shape has the same spread toward w; the closing lobe its own.
