@@ -44,7 +44,7 @@ pub(crate) struct LobeSet {
     /// The mean slope Σ w_i μ_i of the current weights (kept by every change of the set).
     mean: Vec2,
     /// The box of the lobes' means, [min x, min y, max x, max y], and the largest trace of their
-    /// covariances: what [`LobeSet::all_in_front`] bounds every lobe's masking terms by.
+    /// covariances: what [`all_in_front`] bounds every lobe's masking terms by.
     mean_box: [f32; 4],
     trace_max: f64,
     /// V(wo) at the view the set was prepared for ([`LobeSet::prepare_view`]); reset by every

@@ -1,6 +1,8 @@
 //! The patch of a footprint, [`ProceduralPatch`]: the lobes of the one or two lattice levels the
 //! footprint reads, weighted by its kernel, blended into the limit lobe as the footprint grows;
-//! every term of the [`Ndf`](crate::ndf::Ndf) exact over those lobes (src/glint/kernels/lobe_set.rs).
+//! every term of the [`Ndf`](crate::ndf::Ndf) exact over those lobes (a Beckmann surface's in a
+//! shared-shape set held by the patch, src/glint/kernels/shared_lobes.rs; a GGX surface's in a lobe
+//! set lent by the scratch, src/glint/kernels/lobe_set.rs).
 
 use super::ggx;
 use super::lattice::{
