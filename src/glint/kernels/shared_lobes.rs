@@ -22,7 +22,9 @@
 //! does.
 
 use super::lanes::exp_neg_half;
-use super::lobe_set::{FRONT_T, box_half_widths, lobe_areas, pick};
+use super::lobe_set::{
+    FRONT_T, box_half_widths, lobe_areas, pdf_normal_of, pdf_visible_of, pick, visible_over_cos_of,
+};
 use super::prepared_view::PreparedView;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Vec2, Vec3};
@@ -321,27 +323,14 @@ impl Ndf for SharedLobes {
         if let Some(g) = self.single() {
             return g.pdf_normal(m);
         }
-        if !(m.z > 0.0 && m.is_finite()) {
-            return 0.0;
-        }
-        let p = self.d(m) * m.z;
-        if p.is_finite() { p } else { 0.0 }
+        pdf_normal_of(m, || self.d(m))
     }
 
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
         if let Some(g) = self.single() {
             return g.pdf_visible(wo, m);
         }
-        let c = wo.dot(m);
-        if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
-            return 0.0;
-        }
-        let v = self.view_visible_area(wo);
-        if v.is_nan() || v <= 0.0 {
-            return 0.0;
-        }
-        let p = c * self.d(m) / v;
-        if p.is_finite() { p } else { 0.0 }
+        pdf_visible_of(wo, m, || self.d(m), || self.view_visible_area(wo))
     }
 
     /// D(m) / V(wo): [`Ndf::pdf_visible`] without its factor ⟨wo, m⟩.
@@ -349,10 +338,7 @@ impl Ndf for SharedLobes {
         if let Some(g) = self.single() {
             return g.pdf_visible_over_cos_given_d(wo, m, d_m);
         }
-        if !(wo.is_finite() && m.is_finite()) {
-            return 0.0;
-        }
-        crate::ndf::visible_over_cos(wo, m, d_m, self.view_visible_area(wo))
+        visible_over_cos_of(wo, m, d_m, || self.view_visible_area(wo))
     }
 }
 
