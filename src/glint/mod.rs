@@ -125,6 +125,8 @@
 
 pub mod binmap;
 mod compensation;
+mod form;
+mod form_report;
 mod io;
 mod kernels;
 pub mod mixture;
@@ -138,6 +140,8 @@ mod surface;
 mod truth;
 
 pub use binmap::{BinMap, BinMapPatch};
+pub use form::PatchForm;
+pub use form_report::{FormReport, FormRow};
 pub use mixture::{BeckmannMixture, MixturePatch};
 pub use model::{GlintModel, GlintOptions, GlintPatch};
 pub use position_normal::{PositionNormalBrdf, PositionNormalMap, PositionNormalPatch};

@@ -111,6 +111,14 @@ macro_rules! glint_models {
                     $( GlintPatch::$variant(p) => p.prepare_view(wo), )+
                 }
             }
+
+            /// The form of the patch (which of its model's levels of detail serves it, and
+            /// whether its work grows with the footprint): the variant's own `form`.
+            pub fn form(&self) -> super::PatchForm {
+                match self {
+                    $( GlintPatch::$variant(p) => p.form(), )+
+                }
+            }
         }
 
         impl GlintModel {

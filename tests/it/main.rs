@@ -38,6 +38,7 @@ mod fresnel;
 mod fresnel_index_matched;
 mod glint_compensation;
 mod glint_footprint;
+mod glint_forms;
 mod glint_measured;
 mod glint_normal_map;
 mod glint_normal_map_images;

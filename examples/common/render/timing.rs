@@ -356,6 +356,14 @@ pub fn run_timing(out: &Path, opts: &TimingOptions) -> Res<Vec<TimingRow>> {
         "builds ({n}² {what}, default parameters, wall time, with the measured errors of \
          the levels of detail):\n{builds}"
     );
+    // The forms the default options serve on this map, by footprint size: the footprints whose
+    // work grows with their size (gathers) are the ones whose frame time grows with the scale.
+    for model in [&mixture, &bin_map, &position_normal, &procedural]
+        .into_iter()
+        .flatten()
+    {
+        println!("{}", model.forms(&GlintOptions::default()));
+    }
     let plain = |m: &Arc<GlintModel>| GlintMaterial::new(m.clone(), silver);
     let glint = |m: GlintMaterial| -> Box<dyn Fn(Vec2) -> Res<Material>> {
         Box::new(move |tiles| Ok(m.clone().with_uv_scale(tiles)?.into()))

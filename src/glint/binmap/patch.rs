@@ -265,6 +265,17 @@ impl<'a> BinMapPatch<'a> {
         self.exact.is_some()
     }
 
+    /// The form of the patch: exact masking over the footprint's bin list (its bins, or smoothing
+    /// lobes, listed: work growing with the footprint) or the moment lobe's masking.
+    pub fn form(&self) -> crate::glint::PatchForm {
+        match &self.exact {
+            Some(e) => crate::glint::PatchForm::BinList {
+                bins: e.bins.as_slice().len() + e.lobes.as_slice().len(),
+            },
+            None => crate::glint::PatchForm::MomentMasking,
+        }
+    }
+
     /// The patch as weighted slope Gaussians, for its albedo estimate (src/glint/kernels/albedo.rs):
     /// with exact terms each bin of the footprint as a lobe of its mass at the slope of its mean
     /// direction, as wide as the bin (σ = its radius r_j / 2), or the smoothed patch's lobes;

@@ -29,6 +29,7 @@ use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Vec2, Vec3};
 
 mod densities;
+mod form;
 
 /// The level a patch reads, in the mixture's storage.
 #[derive(Clone, Copy, Debug)]

@@ -17,6 +17,7 @@ use crate::glint::Footprint;
 use crate::glint::GlintScratch;
 use crate::glint::kernels::cdf::{invert_cdf, pick_streaming};
 use crate::glint::kernels::cut::CutStats;
+use crate::glint::kernels::filtered_error;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::kernels::prepared_view::PreparedView;
 use crate::glint::kernels::slope_tree::contains;
@@ -24,6 +25,8 @@ use crate::glint::scratch::Lent;
 use crate::math::finite_or_zero;
 use crate::ndf::{Ndf, SlopeGaussian};
 use glam::{Mat2, Vec2, Vec3};
+
+mod form;
 
 /// The per-element lobes of a patch, for the samplers and the untruncated densities; also the
 /// position-normal part of [`GlintScratch`] (only its capacity is kept between patches).
@@ -95,6 +98,8 @@ pub struct PositionNormalPatch<'a> {
     few: Few<'a>,
     /// What the cut did, when a cut serves the patch.
     cut: Option<CutStats>,
+    /// The filtered mixture's measured TV at the footprint's level, when it serves the patch.
+    few_error: f32,
     /// The exact V(wo) at the view the patch was prepared for ([`PositionNormalPatch::prepare_view`];
     /// read by `view_visible_area`, `pdf_visible` and `sample_visible` at that wo).
     view: PreparedView,
@@ -120,7 +125,9 @@ impl<'a> PositionNormalPatch<'a> {
         if area >= options.filtered_area as f64 {
             let mut set: Lent<'a, LobeSet> = Lent::new(scratch.map(|s| s.home()));
             if map.filtered_mixture(c, area, options, &mut set) {
-                return Self::filtered(map, footprint, set, None);
+                let lod = 0.5 * area.max(1e-300).log2();
+                let error = filtered_error::error_at(map.filtered_mixture_errors(), lod);
+                return Self::filtered(map, footprint, set, None, error);
             }
         }
         // NaN options compare false: no cut.
@@ -128,7 +135,8 @@ impl<'a> PositionNormalPatch<'a> {
             let mut set: Lent<'a, LobeSet> = Lent::new(scratch.map(|s| s.home()));
             let stats = map.cut(footprint, options, &mut set);
             if set.len() > 0 {
-                return Self::filtered(map, footprint, set, Some(stats));
+                let error = stats.max_error;
+                return Self::filtered(map, footprint, set, Some(stats), error);
             }
         }
         Self::build(
@@ -145,6 +153,7 @@ impl<'a> PositionNormalPatch<'a> {
         footprint: &Footprint,
         set: Lent<'a, LobeSet>,
         cut: Option<CutStats>,
+        few_error: f32,
     ) -> Self {
         let mut acc = [0.0f64; 5];
         for (w, g) in set.iter() {
@@ -168,6 +177,7 @@ impl<'a> PositionNormalPatch<'a> {
             slots: None,
             few: Few::Set(set),
             cut,
+            few_error,
             view: PreparedView::NONE,
         }
     }
@@ -262,6 +272,7 @@ impl<'a> PositionNormalPatch<'a> {
             slots: Some(slots),
             few: Few::None,
             cut: None,
+            few_error: 0.0,
             view: PreparedView::NONE,
         }
     }

@@ -146,6 +146,18 @@ impl ProceduralPatch<'_> {
         }
     }
 
+    /// The form of the patch: its facet lobes (the limit lobe among them where it is blended in)
+    /// or the limit NDF alone; a few tens of lobes at most, whatever the footprint.
+    pub fn form(&self) -> crate::glint::PatchForm {
+        if self.limit_weight >= 1.0 {
+            crate::glint::PatchForm::Limit
+        } else {
+            crate::glint::PatchForm::Facets {
+                lobes: self.lobe_count(),
+            }
+        }
+    }
+
     /// The continuous lattice level the footprint reads (0: one facet per cell; the patch holds the
     /// levels ⌊level⌋ and ⌊level⌋ + 1).
     pub fn level(&self) -> f32 {
