@@ -1,6 +1,8 @@
 //! The footprint parallelogram in texel units and its exact overlap with axis-aligned rectangles:
-//! a separating-axis classification (inside / outside / partial) for kd-tree nodes and texels, and
-//! the exact area |A ∩ T| of a texel square by polygon clipping.
+//! a separating-axis classification (inside / outside / partial) for kd-tree nodes and texels, the
+//! exact area |A ∩ T| of a rectangle (in closed form where one edge line of A crosses it, by polygon
+//! clipping where two do), and for a row of unit cells the bounds of the cells that meet A and of
+//! those inside it (the moment chain's row-wise read).
 //!
 //! All in `f64`: texel coordinates of a 2048² map need 11 bits, leaving ~40 bits for the fractional
 //! geometry, so rounding in areas is ~1e-12 texel² per texel.
@@ -105,22 +107,32 @@ impl Parallelogram {
         ]
     }
 
+    /// The separating-axis quantities of the rectangle [x0, x1] × [y0, y1] on P's own axes: the
+    /// rectangle's centre in (s, t) and its half ranges (rs, rt) there, or `None` when the axes x
+    /// and y (the bounding boxes) separate it from P.
+    #[inline]
+    fn axes(&self, x0: f64, y0: f64, x1: f64, y1: f64) -> Option<[f64; 4]> {
+        let (hx, hy) = (0.5 * (x1 - x0), 0.5 * (y1 - y0));
+        let (dx, dy) = (0.5 * (x0 + x1) - self.c[0], 0.5 * (y0 + y1) - self.c[1]);
+        if dx.abs() >= hx + self.half_box[0] || dy.abs() >= hy + self.half_box[1] {
+            return None;
+        }
+        let s = self.gs[0] * dx + self.gs[1] * dy;
+        let rs = self.gs[0].abs() * hx + self.gs[1].abs() * hy;
+        let t = self.gt[0] * dx + self.gt[1] * dy;
+        let rt = self.gt[0].abs() * hx + self.gt[1].abs() * hy;
+        Some([s, rs, t, rt])
+    }
+
     /// Classifies the rectangle [x0, x1] × [y0, y1] by the separating-axis theorem on the four edge
     /// normals (x, y and the parallelogram's two): exact for convex polygons. Touching along an edge
     /// or a corner counts as `Outside` (no common area).
     #[inline]
     pub(crate) fn classify(&self, x0: f64, y0: f64, x1: f64, y1: f64) -> Overlap {
-        let (hx, hy) = (0.5 * (x1 - x0), 0.5 * (y1 - y0));
-        let (dx, dy) = (0.5 * (x0 + x1) - self.c[0], 0.5 * (y0 + y1) - self.c[1]);
-        // Axes x and y: bounding boxes.
-        if dx.abs() >= hx + self.half_box[0] || dy.abs() >= hy + self.half_box[1] {
+        let Some([s, rs, t, rt]) = self.axes(x0, y0, x1, y1) else {
             return Overlap::Outside;
-        }
+        };
         // Axes of the parallelogram: the range of s (t) over the rectangle against [−½, ½].
-        let s = self.gs[0] * dx + self.gs[1] * dy;
-        let rs = self.gs[0].abs() * hx + self.gs[1].abs() * hy;
-        let t = self.gt[0] * dx + self.gt[1] * dy;
-        let rt = self.gt[0].abs() * hx + self.gt[1].abs() * hy;
         if s.abs() >= 0.5 + rs || t.abs() >= 0.5 + rt {
             return Overlap::Outside;
         }
@@ -131,15 +143,87 @@ impl Parallelogram {
         }
     }
 
+    /// |P ∩ [x0, x1] × [y0, y1]| in texels², exact: 0 and the rectangle's area where
+    /// [`Parallelogram::classify`] decides, the closed form of [`half_plane_fraction`] where one
+    /// edge line of P alone crosses the rectangle (the other three half-planes of P hold it whole:
+    /// the rectangle's cells along a footprint's sides), and [`Parallelogram::clipped_area`] where
+    /// two or more do (near P's corners, or across a thin P).
+    #[inline]
+    pub(crate) fn overlap_area(&self, x0: f64, y0: f64, x1: f64, y1: f64) -> f64 {
+        let Some([s, rs, t, rt]) = self.axes(x0, y0, x1, y1) else {
+            return 0.0;
+        };
+        if s.abs() >= 0.5 + rs || t.abs() >= 0.5 + rt {
+            return 0.0;
+        }
+        let (w, h) = (x1 - x0, y1 - y0);
+        // Each half-plane of P, g·(p − c) ≤ ½ for g = ±gs, ±gt, cuts the rectangle when the
+        // largest value of g·(p − c) over it, ±s + rs (±t + rt), exceeds ½; it then keeps the
+        // part where the value, counted up from its least (±s − rs at one corner), stays below ½.
+        let (s_hi, s_lo, t_hi, t_lo) = (s + rs > 0.5, rs - s > 0.5, t + rt > 0.5, rt - t > 0.5);
+        let cuts = s_hi as u8 + s_lo as u8 + t_hi as u8 + t_lo as u8;
+        if cuts == 0 {
+            return w * h;
+        }
+        if cuts > 1 {
+            return self.clipped_area(x0, y0, x1, y1);
+        }
+        let (g, e) = if s_hi {
+            (self.gs, 0.5 - s + rs)
+        } else if s_lo {
+            (self.gs, 0.5 + s + rs)
+        } else if t_hi {
+            (self.gt, 0.5 - t + rt)
+        } else {
+            (self.gt, 0.5 + t + rt)
+        };
+        w * h * half_plane_fraction(g[0].abs() * w, g[1].abs() * h, e)
+    }
+
     /// |P ∩ [x0, x0 + 1] × [y0, y0 + 1]|: the exact overlap area of the unit texel square whose lower
     /// corner is (x0, y0), in texels² ∈ [0, 1].
     #[cfg(test)]
     pub(crate) fn texel_overlap(&self, x0: f64, y0: f64) -> f64 {
-        match self.classify(x0, y0, x0 + 1.0, y0 + 1.0) {
-            Overlap::Outside => 0.0,
-            Overlap::Inside => 1.0,
-            Overlap::Partial => self.clipped_area(x0, y0, x0 + 1.0, y0 + 1.0),
+        self.overlap_area(x0, y0, x0 + 1.0, y0 + 1.0)
+    }
+
+    /// For the row of unit cells [i, i + 1] × [y0, y1], bounds on i from P's four half-planes
+    /// g·(p − c) ≤ ½ (g = ±gs, ±gt), each linear in x once y ranges over [y0, y1]:
+    /// `(meet, inside)` with `meet = [lo, hi]` such that the separating-axis test on P's axes
+    /// keeps a cell iff lo − 1 < i < hi (every point's value below ½ for some x of the cell, per
+    /// half-plane), and `inside = [lo, hi]` such that a cell lies in P iff lo ≤ i and i + 1 ≤ hi
+    /// (every point's value at most ½). Bounds may be infinite; a half-plane that misses the whole
+    /// row (P's edge parallel to x) empties them as [∞, −∞].
+    pub(crate) fn row_bounds(&self, y0: f64, y1: f64) -> ([f64; 2], [f64; 2]) {
+        let (mut meet, mut inside) = (
+            [f64::NEG_INFINITY, f64::INFINITY],
+            [f64::NEG_INFINITY, f64::INFINITY],
+        );
+        let (dy0, dy1) = (y0 - self.c[1], y1 - self.c[1]);
+        for g in [self.gs, self.gt] {
+            for sign in [1.0, -1.0] {
+                let (gx, gy) = (sign * g[0], sign * g[1]);
+                let (a, b) = (gy * dy0, gy * dy1);
+                let (least, most) = (a.min(b), a.max(b));
+                // g_x (x − c_x) + (the y part) ≤ ½ holds for x on one side of x*.
+                let (meet_x, inside_x) = ((0.5 - least) / gx, (0.5 - most) / gx);
+                if gx > 0.0 {
+                    meet[1] = meet[1].min(self.c[0] + meet_x);
+                    inside[1] = inside[1].min(self.c[0] + inside_x);
+                } else if gx < 0.0 {
+                    meet[0] = meet[0].max(self.c[0] + meet_x);
+                    inside[0] = inside[0].max(self.c[0] + inside_x);
+                } else {
+                    if least >= 0.5 {
+                        meet = [f64::INFINITY, f64::NEG_INFINITY];
+                    }
+                    if most > 0.5 {
+                        inside = [f64::INFINITY, f64::NEG_INFINITY];
+                    }
+                }
+            }
         }
+        (meet, inside)
     }
 
     /// Area of P ∩ [x0, x1] × [y0, y1] by clipping P's quadrilateral against the rectangle's four
@@ -167,6 +251,31 @@ impl Parallelogram {
         }
         src.area().clamp(0.0, w * h)
     }
+}
+
+/// The fraction of the unit square [0, 1]² where u ξ + v η ≤ e (u, v ≥ 0, u + v > 0): a rectangle's
+/// part on one side of a line, the rectangle mapped onto the unit square with its axes turned so
+/// that the line's value grows along both (u, v its growth across the whole side, e its margin at
+/// the least corner).
+///
+/// With u ≥ v (else the roles swap), the row at height η keeps ξ ≤ f(η) = (e − v η)/u clamped to
+/// [0, 1], and f is linear from f₀ = e/u to f₁ = (e − v)/u, so the fraction is
+/// (1/(f₀ − f₁)) ∫_{f₁}^{f₀} clamp(f, 0, 1) df: the part of [f₁, f₀] in [0, 1] contributes
+/// (b² − a²)/2, the part above 1 its length. Each term is a product or a difference of numbers of
+/// one sign, so the result is accurate to a few ulps also for nearly axis-aligned lines (f₀ − f₁
+/// small), where the fraction tends to clamp(f₀, 0, 1), its value at f₀ = f₁.
+#[inline]
+fn half_plane_fraction(u: f64, v: f64, e: f64) -> f64 {
+    let (u, v) = if u >= v { (u, v) } else { (v, u) };
+    let (hi, lo) = (e / u, (e - v) / u);
+    let span = hi - lo;
+    if span <= 0.0 {
+        return hi.clamp(0.0, 1.0);
+    }
+    let (a, b) = (lo.max(0.0), hi.min(1.0));
+    let middle = if b > a { 0.5 * (b - a) * (a + b) } else { 0.0 };
+    let above = (hi - lo.max(1.0)).max(0.0);
+    ((middle + above) / span).clamp(0.0, 1.0)
 }
 
 /// A convex polygon of at most 8 vertices (a quadrilateral clipped by four half-planes gains at most
@@ -243,142 +352,4 @@ impl Poly {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn axis_aligned_rectangle_overlaps_are_products() {
-        // A rectangle [0.3, 2.8] × [−0.4, 0.7]: the overlap with a texel is the product of the
-        // interval overlaps.
-        let p = Parallelogram::new([1.55, 0.15], [2.5, 0.0], [0.0, 1.1]).unwrap();
-        let ov = |a0: f64, a1: f64, b0: f64| (a1.min(b0 + 1.0) - a0.max(b0)).max(0.0);
-        for j in -2..3 {
-            for i in -1..4 {
-                let expected = ov(0.3, 2.8, i as f64) * ov(-0.4, 0.7, j as f64);
-                let got = p.texel_overlap(i as f64, j as f64);
-                // f64 rounding of a handful of products: 1e-12.
-                assert!(
-                    (got - expected).abs() < 1e-12,
-                    "({i}, {j}): {got} vs {expected}"
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn diamond_in_a_texel() {
-        // A square rotated by 45° centred on the texel centre, half-diagonal d: for d ≤ ½ it lies
-        // inside (area 2d²); for ½ < d < 1 the four corners sticking out are triangles of area
-        // (d − ½)², so the overlap is 2d² − 4(d − ½)².
-        for d in [0.2f64, 0.5, 0.6, 0.9] {
-            let p = Parallelogram::new([0.5, 0.5], [d, d], [-d, d]).unwrap();
-            let expected = if d <= 0.5 {
-                2.0 * d * d
-            } else {
-                2.0 * d * d - 4.0 * (d - 0.5).powi(2)
-            };
-            let got = p.texel_overlap(0.0, 0.0);
-            assert!(
-                (got - expected).abs() < 1e-12,
-                "d = {d}: {got} vs {expected}"
-            );
-        }
-    }
-
-    #[test]
-    fn classification_agrees_with_clipping() {
-        let p = Parallelogram::new([0.3, -0.2], [3.1, 1.2], [-0.7, 2.3]).unwrap();
-        for j in -4..4 {
-            for i in -4..4 {
-                let (x, y) = (i as f64, j as f64);
-                let area = p.clipped_area(x, y, x + 1.0, y + 1.0);
-                match p.classify(x, y, x + 1.0, y + 1.0) {
-                    Overlap::Outside => assert!(area < 1e-12, "{i} {j}: {area}"),
-                    Overlap::Inside => assert!((area - 1.0).abs() < 1e-12, "{i} {j}: {area}"),
-                    Overlap::Partial => assert!(area > -1e-12 && area < 1.0 + 1e-12),
-                }
-            }
-        }
-    }
-
-    /// The vertical extent [y_min, y_max] of the parallelogram's section at abscissa x, if any.
-    fn section(p: &Parallelogram, x: f64) -> Option<(f64, f64)> {
-        let v = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)].map(|(s, t)| p.point(s, t));
-        let mut ys = Vec::new();
-        for k in 0..4 {
-            let (a, b) = (v[k], v[(k + 1) % 4]);
-            let (lo, hi) = (a[0].min(b[0]), a[0].max(b[0]));
-            if x >= lo && x <= hi && hi > lo {
-                ys.push(a[1] + (x - a[0]) / (b[0] - a[0]) * (b[1] - a[1]));
-            }
-        }
-        let lo = ys.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        (lo <= hi).then_some((lo, hi))
-    }
-
-    /// The overlap area by integrating the section's length inside [y0, y1] over x ∈ [x0, x1]: the
-    /// length is linear between the breakpoints (the vertices' abscissas and those where an edge
-    /// crosses y0 or y1), so the trapezoid rule on each piece is exact.
-    fn slab_area(p: &Parallelogram, [x0, y0, x1, y1]: [f64; 4]) -> f64 {
-        let v = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)].map(|(s, t)| p.point(s, t));
-        let mut xs = vec![x0, x1];
-        for k in 0..4 {
-            let (a, b) = (v[k], v[(k + 1) % 4]);
-            xs.push(a[0]);
-            for y in [y0, y1] {
-                if (a[1] - y) * (b[1] - y) < 0.0 {
-                    xs.push(a[0] + (y - a[1]) / (b[1] - a[1]) * (b[0] - a[0]));
-                }
-            }
-        }
-        let mut xs: Vec<f64> = xs.into_iter().filter(|&x| x >= x0 && x <= x1).collect();
-        xs.sort_by(f64::total_cmp);
-        let len = |x: f64| section(p, x).map_or(0.0, |(lo, hi)| (hi.min(y1) - lo.max(y0)).max(0.0));
-        xs.windows(2)
-            .map(|w| 0.5 * (w[1] - w[0]) * (len(w[0]) + len(w[1])))
-            .sum()
-    }
-
-    /// The clipped area against the slab integration, on random parallelograms (thin, rotated,
-    /// larger and smaller than a texel) and every texel around them: equal to 1e-9 texel².
-    #[test]
-    fn clipped_area_matches_slab_integration() {
-        let mut z = 0x2545_F491_4F6C_DD1Du64;
-        let mut unit = || {
-            z ^= z << 13;
-            z ^= z >> 7;
-            z ^= z << 17;
-            (z >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for _ in 0..200 {
-            let c = [4.0 * unit() - 2.0, 4.0 * unit() - 2.0];
-            let (r, ang) = (0.2 + 3.0 * unit(), std::f64::consts::TAU * unit());
-            let a = [r * ang.cos(), r * ang.sin()];
-            let (q, skew) = (0.05 + 2.0 * unit(), 0.3 + 2.5 * unit());
-            let b = [q * (ang + skew).cos(), q * (ang + skew).sin()];
-            let Some(p) = Parallelogram::new(c, a, b) else {
-                continue;
-            };
-            let (lo, hi) = p.bounds();
-            for j in (lo[1].floor() as i64 - 1)..=(hi[1].ceil() as i64) {
-                for i in (lo[0].floor() as i64 - 1)..=(hi[0].ceil() as i64) {
-                    let (x, y) = (i as f64, j as f64);
-                    let got = p.clipped_area(x, y, x + 1.0, y + 1.0);
-                    let want = slab_area(&p, [x, y, x + 1.0, y + 1.0]);
-                    assert!(
-                        (got - want).abs() < 1e-9,
-                        "{c:?} {a:?} {b:?} ({i}, {j}): {got} vs {want}"
-                    );
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn degenerate_edges_are_rejected() {
-        assert!(Parallelogram::new([0.0, 0.0], [1.0, 1.0], [2.0, 2.0]).is_none());
-        assert!(Parallelogram::new([0.0, 0.0], [f64::NAN, 1.0], [0.0, 1.0]).is_none());
-        assert!(Parallelogram::new([0.0, 0.0], [0.0, 0.0], [0.0, 1.0]).is_none());
-    }
-}
+mod tests;

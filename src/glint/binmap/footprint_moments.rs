@@ -22,18 +22,21 @@
 //! whose extent and shape are not the footprint's (isotropic, one to two cells of a level whose
 //! cells are as wide as the footprint): the fallback for a footprint that meets no cell.
 //!
-//! Cost: at most [`MAX_FOOTPRINT_CELLS`] separating-axis tests and a clip per boundary cell,
-//! whatever the footprint's area (docs/results.md).
+//! Cost: whatever the footprint's area, at most [`MAX_FOOTPRINT_CELLS`] cells, read row by row:
+//! each row's cells that meet the footprint and those inside it follow from its edges
+//! ([`Parallelogram::row_bounds`]), the cells inside are summed whole, and only the boundary cells
+//! at each row's ends are measured ([`Parallelogram::overlap_area`]: one edge's closed form, a
+//! clip where two edges cross); docs/results.md.
 //!
 //! # Reference
 //! The moments and the lobe: \[Dupuy2013\] (LEADR moments); Scarf's bound: \[Scarf1958\]; the
 //! cell overlaps: clip.rs (\[SutherlandHodgman1974\]).
 
-use super::clip::{Overlap, Parallelogram};
+use super::clip::Parallelogram;
 use super::facets::sub_cell;
 use super::params::MASKING_FIRST_LEVEL;
 use crate::glint::HemisphereBins;
-use crate::glint::surface::MomentPyramid;
+use crate::glint::surface::{MomentLevel, MomentPyramid};
 use rayon::prelude::*;
 
 /// Largest number of cells of the chain in the footprint's bounding box: 256 (a footprint read at
@@ -142,6 +145,17 @@ pub(crate) fn footprint_moments(
     height: usize,
     para: &Parallelogram,
 ) -> Option<[f32; 5]> {
+    let (level, p) = footprint_level(chain, width, height, para)?;
+    overlap_mean(level, &p).map(|m| m.map(|v| v as f32))
+}
+
+/// The level [`footprint_moments`] reads and the footprint in its cell units.
+fn footprint_level<'c>(
+    chain: &'c MomentPyramid,
+    width: usize,
+    height: usize,
+    para: &Parallelogram,
+) -> Option<(&'c MomentLevel, Parallelogram)> {
     let (lo, hi) = para.bounds();
     let mut level = 0;
     while chain.level(level + 1).is_some() {
@@ -161,156 +175,60 @@ pub(crate) fn footprint_moments(
         l.width as f64 / width as f64,
         l.height as f64 / height as f64,
     );
-    let p = para.scaled(kx, ky)?;
+    Some((l, para.scaled(kx, ky)?))
+}
+
+/// How far (in cells) the analytic row bounds of [`overlap_mean`] are widened toward the
+/// boundary cells: far above their rounding (~10⁻¹³ cells at the coordinates of a 2048² map), so
+/// that a cell they leave out is outside P and a cell they take whole is inside it, exactly as
+/// [`Parallelogram::classify`] would decide.
+const ROW_MARGIN: f64 = 1e-7;
+
+/// The mean of the level's cells (wrapped: the map tiles) weighted by their exact overlaps with `p`
+/// (cell units), in `f64`; `None` if no cell overlaps. Row by row: the row's cells that may meet P
+/// and those that lie inside it come from P's edges ([`Parallelogram::row_bounds`]), so only the
+/// few cells at each end of a row are measured ([`Parallelogram::overlap_area`]) and the cells
+/// between are taken whole. The cells and their order are those of a separating-axis test and a
+/// clip per cell of the bounding box.
+fn overlap_mean(l: &MomentLevel, p: &Parallelogram) -> Option<[f64; 5]> {
     let (lo, hi) = p.bounds();
-    let (i0, i1) = (lo[0].floor() as i64, hi[0].ceil() as i64);
+    let (i0, i1) = (lo[0].floor(), hi[0].ceil());
     let (j0, j1) = (lo[1].floor() as i64, hi[1].ceil() as i64);
     let mut sum = [0.0f64; 5];
     let mut total = 0.0f64;
     for j in j0..j1 {
-        for i in i0..i1 {
-            let (x0, y0) = (i as f64, j as f64);
-            let w = match p.classify(x0, y0, x0 + 1.0, y0 + 1.0) {
-                Overlap::Outside => continue,
-                Overlap::Inside => 1.0,
-                Overlap::Partial => p.clipped_area(x0, y0, x0 + 1.0, y0 + 1.0),
+        let (y0, y1) = (j as f64, j as f64 + 1.0);
+        let (meet, inside) = p.row_bounds(y0, y1);
+        // Cells i with meet₀ − 1 < i < meet₁ meet P; those with inside₀ ≤ i, i + 1 ≤ inside₁ lie in it.
+        let a = (meet[0] - ROW_MARGIN).floor().clamp(i0, i1);
+        let b = (meet[1] + ROW_MARGIN).ceil().clamp(a, i1);
+        let c = (inside[0] + ROW_MARGIN).ceil().clamp(a, b);
+        let d = (inside[1] - ROW_MARGIN).floor().clamp(c, b);
+        let (a, b, c, d) = (a as i64, b as i64, c as i64, d as i64);
+        let row = &l.data[j.rem_euclid(l.height as i64) as usize * l.width..][..l.width];
+        let mut ii = a.rem_euclid(l.width as i64) as usize;
+        for i in a..b {
+            let w = if i >= c && i < d {
+                1.0
+            } else {
+                let x0 = i as f64;
+                p.overlap_area(x0, y0, x0 + 1.0, y1)
             };
-            if w <= 0.0 {
-                continue;
+            if w > 0.0 {
+                let m = &row[ii];
+                for k in 0..5 {
+                    sum[k] += w * m[k] as f64;
+                }
+                total += w;
             }
-            let ii = i.rem_euclid(l.width as i64) as usize;
-            let jj = j.rem_euclid(l.height as i64) as usize;
-            let m = &l.data[jj * l.width + ii];
-            for k in 0..5 {
-                sum[k] += w * m[k] as f64;
+            ii += 1;
+            if ii == l.width {
+                ii = 0;
             }
-            total += w;
         }
     }
-    (total > 0.0).then(|| sum.map(|v| (v / total) as f32))
+    (total > 0.0).then(|| sum.map(|v| v / total))
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use glam::Vec2;
-
-    /// The bins' moments against a finer, independent rule: 64 × 64 points of each bin's
-    /// equal-area cell, for the pole bin, a bin halfway and one at θ ≈ 49° (the ring touching the horizon diverges).
-    #[test]
-    fn bin_moments_match_a_finer_quadrature() {
-        let bins = HemisphereBins::new(15).unwrap();
-        let picks = [
-            bins.bin_of(glam::Vec3::Z).unwrap(),
-            bins.bin_of(glam::Vec3::new(0.5, 0.3, 0.81).normalize())
-                .unwrap(),
-            bins.bin_of(glam::Vec3::new(0.75, 0.1, 0.65).normalize())
-                .unwrap(),
-        ];
-        let used: Vec<bool> = (0..bins.len()).map(|b| picks.contains(&b)).collect();
-        let table = bin_moments(&bins, &used);
-        let g = 64;
-        for &b in &picks {
-            let mut sum = [0.0f64; 6];
-            for k in 0..g * g {
-                let m = bins.sample_in_bin(b, sub_cell(k, g));
-                let (x, y, z) = (m.x as f64, m.y as f64, m.z as f64);
-                let s = [-x / z, -y / z];
-                let v = [s[0], s[1], s[0] * s[0], s[1] * s[1], s[0] * s[1]];
-                for q in 0..5 {
-                    sum[q] += v[q] * z;
-                }
-                sum[5] += z;
-            }
-            for q in 0..5 {
-                let fine = sum[q] / sum[5];
-                let d = (table[b][q] - fine).abs();
-                assert!(
-                    d <= 5e-3 * fine.abs().max(1e-2),
-                    "bin {b} moment {q}: {} vs {fine}",
-                    table[b][q]
-                );
-            }
-        }
-    }
-
-    /// The chain of a bin map holds at level 1 the mean of each 2 × 2-texel cell's sub-texel bin
-    /// moments: a footprint of whole cells reads the mean over its sub-texels of their bins' moments,
-    /// summed here directly from 𝓑.
-    #[test]
-    fn the_chain_holds_the_sub_texels_bin_moments() {
-        let n = 32;
-        let map = crate::glint::bumpy(n, n, 0.25, 4.0, 2).unwrap();
-        let bm = super::super::BinMap::build(&map, super::super::BinMapParams::default()).unwrap();
-        let s = bm.params.subdivisions;
-        let used = vec![true; bm.bins.len()];
-        let table = bin_moments(&bm.bins, &used);
-        // The axis-aligned 8 × 8-texel square at texels [8, 16) × [12, 20): whole level-1 cells.
-        let p = Parallelogram::new([12.0, 16.0], [8.0, 0.0], [0.0, 8.0]).unwrap();
-        let read = footprint_moments(&bm.moments, n, n, &p).unwrap();
-        let mut want = [0.0f64; 5];
-        let mut count = 0.0;
-        for j in 12 * s..20 * s {
-            for i in 8 * s..16 * s {
-                let b = bm.bin_map.get(j * n * s + i).unwrap();
-                for q in 0..5 {
-                    want[q] += table[b][q];
-                }
-                count += 1.0;
-            }
-        }
-        for q in 0..5 {
-            let w = want[q] / count;
-            assert!(
-                (read[q] as f64 - w).abs() <= 1e-5 * w.abs().max(1e-3),
-                "{q}: {} vs {w}",
-                read[q]
-            );
-        }
-    }
-
-    /// A footprint that covers whole cells of the chosen level reads exactly their mean: an
-    /// axis-aligned 8 × 8-texel square on a 32² map is read at level 2 (cells of 4 × 4 texels, 9
-    /// cells meet its bounding box), as the mean of its four cells; one shifted by half
-    /// a cell weights its nine cells by ¼, ½ and 1 (overlaps of 2 × 2, 2 × 4 and 4 × 4 texels).
-    #[test]
-    fn cell_aligned_footprints_read_their_cells() {
-        let n = 32;
-        let slopes: Vec<Vec2> = (0..n * n)
-            .map(|k| Vec2::new((k % n) as f32 * 0.01, (k / n) as f32 * -0.02))
-            .collect();
-        let chain = MomentPyramid::build_from(n, n, &slopes, 2);
-        let l = chain.level(0).unwrap();
-        let cell = |i: usize, j: usize| l.data[j * l.width + i];
-        let mean = |w: &[(usize, usize, f64)]| {
-            let t: f64 = w.iter().map(|c| c.2).sum();
-            std::array::from_fn::<f64, 5, _>(|k| {
-                w.iter()
-                    .map(|&(i, j, x)| x * cell(i, j)[k] as f64)
-                    .sum::<f64>()
-                    / t
-            })
-        };
-        let read = |c: [f64; 2]| {
-            let p = Parallelogram::new(c, [8.0, 0.0], [0.0, 8.0]).unwrap();
-            footprint_moments(&chain, n, n, &p).unwrap()
-        };
-        let aligned = read([8.0, 12.0]);
-        let want = mean(&[(1, 2, 1.0), (2, 2, 1.0), (1, 3, 1.0), (2, 3, 1.0)]);
-        let shifted = read([10.0, 14.0]);
-        let mut w = vec![];
-        for (j, wy) in [(2usize, 0.5), (3, 1.0), (4, 0.5)] {
-            for (i, wx) in [(1usize, 0.5), (2, 1.0), (3, 0.5)] {
-                w.push((i, j, wx * wy));
-            }
-        }
-        let want_shifted = mean(&w);
-        for k in 0..5 {
-            // f32 storage of the result: 1e-6 relative.
-            assert!((aligned[k] as f64 - want[k]).abs() <= 1e-6 * want[k].abs() + 1e-9);
-            assert!(
-                (shifted[k] as f64 - want_shifted[k]).abs() <= 1e-6 * want_shifted[k].abs() + 1e-9
-            );
-        }
-    }
-}
+mod tests;

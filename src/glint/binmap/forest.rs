@@ -145,7 +145,8 @@ pub struct QueryStats {
     pub nodes: usize,
     /// Texels tested individually (in partially covered leaves).
     pub texels: usize,
-    /// Texels whose overlap needed polygon clipping.
+    /// Texels the footprint's boundary crosses (their overlap measured exactly: in closed form where
+    /// one edge of the footprint crosses the texel, by polygon clipping where two do).
     pub clipped: usize,
 }
 
@@ -226,7 +227,7 @@ impl TreeView<'_> {
                 Overlap::Inside => 1.0,
                 Overlap::Partial => {
                     stats.clipped += 1;
-                    p.clipped_area(i, j, i + 1.0, j + 1.0)
+                    p.overlap_area(i, j, i + 1.0, j + 1.0)
                 }
             };
         }

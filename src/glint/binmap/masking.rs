@@ -146,7 +146,7 @@ impl<'a> ExactMasking<'a> {
                     let ov = match p.classify(x, y, x + 1.0, y + 1.0) {
                         Overlap::Outside => continue,
                         Overlap::Inside => 1.0,
-                        Overlap::Partial => p.clipped_area(x, y, x + 1.0, y + 1.0),
+                        Overlap::Partial => p.overlap_area(x, y, x + 1.0, y + 1.0),
                     };
                     if ov > 0.0 {
                         let bin = map.bin_map.get((j * w + i) as usize).unwrap_or(0);
