@@ -11,15 +11,16 @@
 //! `Collected` is the frame's count (deterministic: independent of the machine's load), the same
 //! work the harness times. MATERIAL: `ggx` and `beckmann` (analytic, α = 0.091, the harness's α for its scratched
 //! map), `procedural` and `procedural-ggx` (the harness's procedural surfaces: that α as the limit,
-//! one facet per texel of a 1024² grid, seed 7), `bin-map` (the default build of the harness's 1024²
-//! `scratched` map of seed 7; the build runs under callgrind too, outside the toggled function);
+//! one facet per texel of a 1024² grid, seed 7), `bin-map` and `mixture` (the default builds of the
+//! harness's 1024² `scratched` map of seed 7; the build runs under callgrind too, outside the
+//! toggled function);
 //! silver, default options. docs/results.md, "Procedural glints" and "Inverse bin map: the masking
 //! level of detail".
 
 use brdf::Vec2;
 use brdf::fresnel::ConductorFresnel;
 use brdf::glint::procedural::{ProceduralGlints, ProceduralLimit};
-use brdf::glint::{BinMap, GlintModel, ScratchedParams, scratched};
+use brdf::glint::{BeckmannMixture, BinMap, GlintModel, ScratchedParams, scratched};
 use brdf::material::{GlintMaterial, Material};
 use brdf::ndf::{Beckmann, Ggx};
 use brdf_examples::common::render::render;
@@ -44,9 +45,13 @@ fn material(name: &str, tiles: Vec2) -> Result<Material, Box<dyn std::error::Err
         "beckmann" => Material::microfacet(Beckmann::isotropic(ALPHA)?, silver),
         "procedural" => procedural(ProceduralLimit::Beckmann)?,
         "procedural-ggx" => procedural(ProceduralLimit::Ggx)?,
-        "bin-map" => {
+        "bin-map" | "mixture" => {
             let map = scratched(SIZE, SIZE, ScratchedParams::default(), 7)?;
-            let model: GlintModel = BinMap::build(&map, Default::default())?.into();
+            let model: GlintModel = if name == "mixture" {
+                BeckmannMixture::build(&map, Default::default())?.into()
+            } else {
+                BinMap::build(&map, Default::default())?.into()
+            };
             GlintMaterial::new(Arc::new(model), silver)
                 .with_uv_scale(tiles)?
                 .into()
