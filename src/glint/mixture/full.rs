@@ -72,6 +72,7 @@ impl FullStorage {
         let mut levels = Vec::with_capacity(1 + merged.len());
         levels.push(LobeLevel {
             grid: [nx, ny],
+            finite: super::levels::all_finite(&moments),
             moments,
             blocks,
             tree,
@@ -224,10 +225,14 @@ impl LevelView for FullLevel<'_> {
     }
 
     /// The raw moments' mean (the lobe's own, its fallback, for non-finite moments), as
-    /// [`LevelView::mean_cov`] gives it, without the covariance.
+    /// [`LevelView::mean_cov`] gives it, without the covariance. A level whose moments are all
+    /// finite (every level a build or a load makes from a valid map) skips the test per node.
     #[inline]
     fn mean(&self, k: usize) -> [f64; 2] {
         let m = &self.data.moments[k];
+        if self.data.finite {
+            return [m[0] as f64, m[1] as f64];
+        }
         // The f64 sum of five f32 values is finite exactly when each is (it cannot overflow).
         let sum: f64 = m.iter().map(|&v| v as f64).sum();
         if sum.is_finite() {
@@ -450,6 +455,34 @@ mod tests {
                     |v: &[[f32; 5]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
                 assert_eq!(bits(&pyramid.levels[l - 1]), bits(&up), "{nx}×{ny} mip {l}");
                 prev = up;
+            }
+        }
+    }
+
+    /// A node's mean read without the finiteness test (every moment of the level finite) is
+    /// `mean_cov`'s mean bit for bit, and so it is with the test, on a level with a non-finite
+    /// moment (the lobe's own mean there, its fallback).
+    #[test]
+    fn the_mean_is_mean_cov_s_bit_for_bit() {
+        use super::super::storage::{LevelView, LobeStore};
+        let (nx, ny) = (17, 11);
+        for poisoned in [false, true] {
+            let mut m = moments(nx * ny, 5);
+            if poisoned {
+                m[37] = [f32::NAN, 0.1, 0.2, f32::INFINITY, 0.0];
+            }
+            let s = FullStorage::new(nx, ny, m, 0.01, 5.26, None, None);
+            assert_eq!(s.level(0).data.finite, !poisoned);
+            for l in 0..s.levels.len() {
+                let lv = s.level(l);
+                for k in 0..lv.grid()[0] * lv.grid()[1] {
+                    let (a, b) = (lv.mean(k), lv.mean_cov(k).0);
+                    assert_eq!(
+                        a.map(f64::to_bits),
+                        b.map(f64::to_bits),
+                        "level {l} node {k}"
+                    );
+                }
             }
         }
     }

@@ -430,7 +430,10 @@ pub(super) fn gather<'b, L: LevelView>(
     let mut lod_error = 0.0f64;
     // Level 0 has no merge error (its term is 0).
     let merged = lv.level() > 0;
-    weights.reserve(w.len());
+    // Written in slot order, as the walk below visits the slots (no capacity test per slot).
+    weights.clear();
+    weights.resize(w.len(), 0.0);
+    let mut out = weights.iter_mut();
     for_each_slot_lobe(&axes, nx, w, |wi, k| {
         let wn = *wi * inv;
         acc += wn;
@@ -450,7 +453,9 @@ pub(super) fn gather<'b, L: LevelView>(
             m1[0] += wn * mu[0];
             m1[1] += wn * mu[1];
         }
-        weights.push(wn as f32);
+        if let Some(o) = out.next() {
+            *o = wn as f32;
+        }
     });
     let (rects, n_rects) = block_weights(&axes, &mut bufs);
     // Σ W = 1 up to rounding; the covariance is floored at 0 against cancellation.
@@ -521,7 +526,22 @@ fn block_weights(axes: &[AxisSlots; 2], bufs: &mut SlotBuffers) -> ([BlockRect; 
                 let end = ((bx + 1) * SIDE).min(r.x.1);
                 let o = row + (bx - r.bx0) * LANES + x % SIDE;
                 let sx = (x as i64 + x_off) as usize;
-                block_weights[o..o + (end - x)].copy_from_slice(&src[sx..sx + (end - x)]);
+                let (dst, from) = (
+                    &mut block_weights[o..o + (end - x)],
+                    &src[sx..sx + (end - x)],
+                );
+                if let (Ok(d), Ok(f)) = (
+                    <&mut [f32; SIDE]>::try_from(&mut *dst),
+                    <&[f32; SIDE]>::try_from(from),
+                ) {
+                    // A whole block row: one fixed-size move (a library call per short slice
+                    // otherwise).
+                    *d = *f;
+                } else {
+                    for (d, f) in dst.iter_mut().zip(from) {
+                        *d = *f;
+                    }
+                }
                 x = end;
             }
         }

@@ -75,6 +75,14 @@ pub(super) struct LobeLevel {
     /// The merge errors e_r(n) ∈ [0, 1] per node, one vector per resolution r of
     /// [`LOD_RESOLUTIONS`] (see the module docs); empty vectors at level 0 (exact).
     pub error: [Vec<f32>; N_RES],
+    /// Whether every raw moment is finite ([`all_finite`], when the level is made): a node's
+    /// mean is then its raw moments' own, with no test per node.
+    pub finite: bool,
+}
+
+/// Whether every value of every moment vector is finite.
+pub(super) fn all_finite(moments: &[[f32; 5]]) -> bool {
+    moments.iter().flatten().all(|v| v.is_finite())
 }
 
 impl LobeLevel {
@@ -303,6 +311,7 @@ pub(super) fn build_levels(
         let blocks = LobeBlocks::build(w, h, &gaussians, pad);
         out.push(LobeLevel {
             grid: [w, h],
+            finite: all_finite(&moments),
             moments,
             blocks,
             tree,
