@@ -19,13 +19,13 @@
 //! \[Atanasov2020\] §2.3 (forest of 2D kd-trees, implicit splits, contiguous node ranges, one integer
 //! list).
 
-use super::clip::{Overlap, Parallelogram};
+use super::clip::{AxisTests, Overlap, Parallelogram};
 
 /// Sentinel for "no tree" (lists of at most `leaf` texels).
 pub(crate) const NO_TREE: u32 = u32::MAX;
 
 /// An axis-aligned region of integer texel coordinates [x0, x1) × [y0, y1).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 struct Region {
     x0: u32,
     y0: u32,
@@ -153,6 +153,12 @@ pub struct QueryStats {
 impl TreeView<'_> {
     /// Σ_k |P ∩ T_k| over the texels of the range [start, end) (a bin's list), using its tree `root`
     /// when there is one. `P` is in the map's texel coordinates (one periodic image).
+    ///
+    /// The walk classifies each node's region by P's separating axes ([`AxisTests`]): a region
+    /// outside P adds nothing, one inside adds its texel count, a partly covered one descends to
+    /// its children, or is a leaf whose texels are classified one by one, those P's boundary crosses
+    /// measured exactly ([`Parallelogram::overlap_area`]). Texels inside P are counted as an
+    /// integer.
     pub(crate) fn area(
         &self,
         p: &Parallelogram,
@@ -161,76 +167,153 @@ impl TreeView<'_> {
         root: u32,
         stats: &mut QueryStats,
     ) -> f64 {
-        let region = Region {
-            x0: 0,
-            y0: 0,
-            x1: self.width,
-            y1: self.height,
+        let walk = Walk {
+            view: self,
+            p,
+            tests: AxisTests::new(p),
         };
-        self.node_area(p, start, end, root, region, stats)
+        let root = Node {
+            start: start as u32,
+            end: end as u32,
+            // A range of at most a leaf is scanned whatever the table holds for its tree.
+            node: if end - start > self.leaf {
+                root
+            } else {
+                NO_TREE
+            },
+            region: Region {
+                x0: 0,
+                y0: 0,
+                x1: self.width,
+                y1: self.height,
+            },
+        };
+        let mut sum = Sum::default();
+        if let Some(root) = walk.visit(root, &mut sum, stats) {
+            walk.descend(root, &mut sum, stats);
+        }
+        sum.inside as f64 + sum.partial
     }
+}
 
-    fn node_area(
-        &self,
-        p: &Parallelogram,
-        start: usize,
-        end: usize,
-        node: u32,
-        region: Region,
-        stats: &mut QueryStats,
-    ) -> f64 {
+/// A query's area: the texels inside P (counted) and the overlaps of those P's boundary crosses.
+#[derive(Default)]
+struct Sum {
+    inside: usize,
+    partial: f64,
+}
+
+/// A node of a walk: the range [start, end) of the inverse map, the internal node's index (or
+/// [`NO_TREE`] for a leaf) and the region.
+#[derive(Clone, Copy, Default)]
+struct Node {
+    start: u32,
+    end: u32,
+    node: u32,
+    region: Region,
+}
+
+/// Room for the nodes a walk leaves for later (both children of a node partly covered).
+const PENDING: usize = 16;
+
+/// One query's walk: the forest, P and its separating-axis tests.
+struct Walk<'a> {
+    view: &'a TreeView<'a>,
+    p: &'a Parallelogram,
+    tests: AxisTests,
+}
+
+impl Walk<'_> {
+    /// Classifies `n`: adds it to `sum` when it is outside P, inside P or a partly covered leaf,
+    /// and returns it when it is a partly covered internal node.
+    #[inline(always)]
+    fn visit(&self, n: Node, sum: &mut Sum, stats: &mut QueryStats) -> Option<Node> {
         stats.nodes += 1;
-        let class = p.classify(
-            region.x0 as f64,
-            region.y0 as f64,
-            region.x1 as f64,
-            region.y1 as f64,
-        );
-        match class {
-            Overlap::Outside => 0.0,
+        let r = n.region;
+        match self.tests.rect(r.x0, r.y0, r.x1, r.y1) {
+            Overlap::Outside => None,
             // Every texel of the node lies inside: its pre-filtered area is its texel count.
-            Overlap::Inside => (end - start) as f64,
-            Overlap::Partial if end - start > self.leaf && node != NO_TREE => {
-                let n = node as usize;
-                let (mid, right) = (self.nodes[n] as usize, self.nodes[n + 1]);
-                let (lr, rr) = region.children();
-                let left_node = if mid - start > self.leaf {
-                    node + 2
-                } else {
-                    NO_TREE
-                };
-                let right_node = if end - mid > self.leaf {
-                    right
-                } else {
-                    NO_TREE
-                };
-                self.node_area(p, start, mid, left_node, lr, stats)
-                    + self.node_area(p, mid, end, right_node, rr, stats)
+            Overlap::Inside => {
+                sum.inside += (n.end - n.start) as usize;
+                None
             }
-            Overlap::Partial => self.leaf_area(p, start, end, stats),
+            Overlap::Partial if n.node != NO_TREE => Some(n),
+            Overlap::Partial => {
+                self.leaf(n.start as usize, n.end as usize, sum, stats);
+                None
+            }
         }
     }
 
-    fn leaf_area(
-        &self,
-        p: &Parallelogram,
-        start: usize,
-        end: usize,
-        stats: &mut QueryStats,
-    ) -> f64 {
-        let mut sum = 0.0;
-        for &k in &self.inverse[start..end] {
-            let (i, j) = ((k % self.width) as f64, (k / self.width) as f64);
-            stats.texels += 1;
-            sum += match p.classify(i, j, i + 1.0, j + 1.0) {
-                Overlap::Outside => 0.0,
-                Overlap::Inside => 1.0,
-                Overlap::Partial => {
-                    stats.clipped += 1;
-                    p.overlap_area(i, j, i + 1.0, j + 1.0)
+    /// The subtree of the partly covered internal node `n`, depth first: a loop down the path of
+    /// partly covered children, the second child kept on a small stack where both are (rarely: P's
+    /// boundary mostly crosses one of the two), and a recursion in the stack's place should it
+    /// fill.
+    fn descend(&self, mut n: Node, sum: &mut Sum, stats: &mut QueryStats) {
+        let (nodes, leaf) = (self.view.nodes, self.view.leaf);
+        let internal = |count: u32, node: u32| {
+            if count as usize > leaf { node } else { NO_TREE }
+        };
+        let mut pending = [Node::default(); PENDING];
+        let mut len = 0;
+        loop {
+            let i = n.node as usize;
+            let (mid, right) = (nodes[i], nodes[i + 1]);
+            let (lr, rr) = n.region.children();
+            let left = Node {
+                start: n.start,
+                end: mid,
+                node: internal(mid - n.start, n.node + 2),
+                region: lr,
+            };
+            let right = Node {
+                start: mid,
+                end: n.end,
+                node: internal(n.end - mid, right),
+                region: rr,
+            };
+            n = match (self.visit(left, sum, stats), self.visit(right, sum, stats)) {
+                (Some(l), Some(r)) => {
+                    match pending.get_mut(len) {
+                        Some(slot) => {
+                            *slot = r;
+                            len += 1;
+                        }
+                        None => self.descend(r, sum, stats),
+                    }
+                    l
+                }
+                (Some(c), None) | (None, Some(c)) => c,
+                (None, None) => {
+                    if len == 0 {
+                        return;
+                    }
+                    len -= 1;
+                    pending[len]
                 }
             };
         }
-        sum
+    }
+
+    /// The texels of a partly covered leaf, one by one.
+    #[inline(never)]
+    fn leaf(&self, start: usize, end: usize, sum: &mut Sum, stats: &mut QueryStats) {
+        let width = self.view.width;
+        stats.texels += end - start;
+        for &k in &self.view.inverse[start..end] {
+            let (i, j) = (k % width, k / width);
+            match self.tests.texel(i, j) {
+                Overlap::Outside => {}
+                Overlap::Inside => sum.inside += 1,
+                Overlap::Partial => {
+                    stats.clipped += 1;
+                    let (x, y) = (i as f64, j as f64);
+                    sum.partial += self.p.overlap_area(x, y, x + 1.0, y + 1.0);
+                }
+            }
+        }
     }
 }
+
+#[cfg(test)]
+mod tests;

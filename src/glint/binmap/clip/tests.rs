@@ -252,3 +252,87 @@ fn degenerate_edges_are_rejected() {
     assert!(Parallelogram::new([0.0, 0.0], [f64::NAN, 1.0], [0.0, 1.0]).is_none());
     assert!(Parallelogram::new([0.0, 0.0], [0.0, 0.0], [0.0, 1.0]).is_none());
 }
+
+/// A classification against the exact area: `Outside` only with area 0 and `Inside` only with the
+/// whole rectangle, to `tol` texel² (the rounding of the coordinates of a rectangle touching P).
+fn agrees_with_area(class: Overlap, area: f64, whole: f64, tol: f64) -> bool {
+    match class {
+        Overlap::Outside => area <= tol,
+        Overlap::Inside => area >= whole - tol,
+        Overlap::Partial => true,
+    }
+}
+
+/// The walk's tests against [`Parallelogram::classify`] on the random parallelograms (rotated,
+/// thin, smaller than a texel) at three scales up to 100 texels, moved onto integer coordinates
+/// ≥ 0 and to the edge of the first row and column (a periodic image cut by the map's border),
+/// for unit texels and for integer rectangles from 1 × 1 to a few times the parallelogram's size
+/// around it. Where the two decide differently, the rectangle touches P's boundary: the exact area
+/// must then agree with both decisions to 1e-9 of the rectangle's area (the coordinates are
+/// ≤ 2000; the tests' rounding is ~1e-13 texels there).
+#[test]
+fn axis_tests_agree_with_classify() {
+    let mut z = 0x5EED_F0E5_7000_0001u64;
+    let mut next = |n: u32| {
+        z ^= z << 13;
+        z ^= z >> 7;
+        z ^= z << 17;
+        ((z >> 33) % n as u64) as u32
+    };
+    let (mut differ, mut rects) = (0, 0);
+    for (k, p0) in random_parallelograms(1500).into_iter().enumerate() {
+        let scale = [1.0, 7.5, 25.0][k % 3];
+        let Some(p) = p0.scaled(scale, scale) else {
+            continue;
+        };
+        let (lo, hi) = p.bounds();
+        let shift = if k % 7 == 0 {
+            [-lo[0] - 0.5 * (hi[0] - lo[0]), -lo[1]]
+        } else {
+            [1000.0 + 0.37 * k as f64 - lo[0], 900.0 - lo[1]]
+        };
+        let p = p.translated(shift);
+        let tests = AxisTests::new(&p);
+        let (lo, hi) = p.bounds();
+        let (span_x, span_y) = (
+            (hi[0] - lo[0]).ceil() as u32 + 2,
+            (hi[1] - lo[1]).ceil() as u32 + 2,
+        );
+        let (bx, by) = (
+            (lo[0].floor() - 1.0).max(0.0) as u32,
+            (lo[1].floor() - 1.0).max(0.0) as u32,
+        );
+        for _ in 0..60 {
+            let (i, j) = (bx + next(span_x + 1), by + next(span_y + 1));
+            let (x, y) = (i as f64, j as f64);
+            let (old, new) = (p.classify(x, y, x + 1.0, y + 1.0), tests.texel(i, j));
+            if old != new {
+                differ += 1;
+                let area = p.overlap_area(x, y, x + 1.0, y + 1.0);
+                assert!(
+                    agrees_with_area(old, area, 1.0, 1e-9)
+                        && agrees_with_area(new, area, 1.0, 1e-9),
+                    "{p:?} texel ({i}, {j}): {old:?} vs {new:?}, area {area}"
+                );
+            }
+            let (w, h) = (1 + next(2 * span_x), 1 + next(2 * span_y));
+            let (x0, y0) = (bx + next(span_x + 1), by + next(span_y + 1));
+            let (x1, y1) = (x0 + w, y0 + h);
+            let (fx0, fy0, fx1, fy1) = (x0 as f64, y0 as f64, x1 as f64, y1 as f64);
+            let (old, new) = (p.classify(fx0, fy0, fx1, fy1), tests.rect(x0, y0, x1, y1));
+            rects += 1;
+            if old != new {
+                differ += 1;
+                let (area, whole) = (p.overlap_area(fx0, fy0, fx1, fy1), (w * h) as f64);
+                assert!(
+                    agrees_with_area(old, area, whole, 1e-9 * whole)
+                        && agrees_with_area(new, area, whole, 1e-9 * whole),
+                    "{p:?} [{x0}, {x1}] × [{y0}, {y1}]: {old:?} vs {new:?}, area {area}"
+                );
+            }
+        }
+    }
+    assert!(rects > 50_000, "{rects} rectangles");
+    // Decisions differ only on rectangles touching P, which random parallelograms rarely do.
+    assert!(differ < rects / 100, "{differ} of {rects} decisions differ");
+}
