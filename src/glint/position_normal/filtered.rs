@@ -107,29 +107,29 @@ impl PositionNormalMap {
     }
 
     /// Whether `options` serve a footprint centred at `c` of `area` elements (as
-    /// [`footprint_in_elements`] gives them) by the filtered mixture; if so, its lobes into `set`.
+    /// [`footprint_in_elements`] gives them) by the filtered mixture; if so, its lobes into `set`
+    /// and its measured error at the footprint's level returned.
     pub(super) fn filtered_mixture(
         &self,
         c: [f64; 2],
         area: f64,
         options: &PatchOptions,
         set: &mut LobeSet,
-    ) -> bool {
+    ) -> Option<f32> {
         // NaN options compare false: never served.
         let large = area >= options.filtered_area as f64;
         if !large {
-            return false;
+            return None;
         }
         let lod = 0.5 * area.max(1e-300).log2();
         let tolerance = options.filtered_tolerance;
-        let within = tolerance == f32::INFINITY
-            || filtered_error::error_at(self.filtered_mixture_errors(), lod) <= tolerance;
-        if !within {
-            return false;
+        let error = filtered_error::error_at(self.filtered_mixture_errors(), lod);
+        if !(tolerance == f32::INFINITY || error <= tolerance) {
+            return None;
         }
         self.filtered_chain()
             .lookup(|k| self.element_marginal(k), c, lod, set);
-        set.len() > 0
+        (set.len() > 0).then_some(error)
     }
 
     /// A cut of the filtered-mixture hierarchy for `footprint` (src/glint/kernels/cut.rs) into

@@ -17,7 +17,6 @@ use crate::glint::Footprint;
 use crate::glint::GlintScratch;
 use crate::glint::kernels::cdf::{invert_cdf, pick_streaming};
 use crate::glint::kernels::cut::CutStats;
-use crate::glint::kernels::filtered_error;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::kernels::prepared_view::PreparedView;
 use crate::glint::kernels::slope_tree::contains;
@@ -124,9 +123,7 @@ impl<'a> PositionNormalPatch<'a> {
         let (c, area) = footprint_in_elements(map, footprint);
         if area >= options.filtered_area as f64 {
             let mut set: Lent<'a, LobeSet> = Lent::new(scratch.map(|s| s.home()));
-            if map.filtered_mixture(c, area, options, &mut set) {
-                let lod = 0.5 * area.max(1e-300).log2();
-                let error = filtered_error::error_at(map.filtered_mixture_errors(), lod);
+            if let Some(error) = map.filtered_mixture(c, area, options, &mut set) {
                 return Self::filtered(map, footprint, set, None, error);
             }
         }

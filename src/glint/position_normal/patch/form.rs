@@ -3,6 +3,7 @@
 
 use super::PositionNormalPatch;
 use crate::glint::PatchForm;
+use crate::glint::kernels::lobe_set::Few;
 
 impl PositionNormalPatch<'_> {
     /// The form of the patch: the filtered mixture (with its measured TV at this level), a cut of
@@ -12,7 +13,7 @@ impl PositionNormalPatch<'_> {
     pub fn form(&self) -> PatchForm {
         let lobes = self.few.iter_lobes().count();
         match (&self.few, self.cut) {
-            (crate::glint::kernels::lobe_set::Few::None, _) => PatchForm::Gathered {
+            (Few::None, _) => PatchForm::Gathered {
                 level: 0,
                 lobes: self.count,
             },
