@@ -8,6 +8,7 @@
 
 use super::masking::{ExactMasking, PatchBin, bin_lipschitz_radius};
 use super::patch::BinMapPatch;
+use crate::glint::kernels::cdf::rehash;
 use crate::math::finite_or_zero;
 use crate::ndf::Ndf;
 use crate::warp::{hemisphere_to_square_equal_area, square_to_gaussian_2d};
@@ -94,22 +95,6 @@ fn sample_bilinear(u: Vec2, v: &[f32; 4]) -> Vec2 {
     Vec2::new(x, y)
 }
 
-/// Two further uniform numbers derived from the bits of `u` (SplitMix64 finaliser), for the direction
-/// within the bin: independent of the point in A for every practical purpose, deterministic in `u`.
-fn rehash(u: Vec2) -> Vec2 {
-    let mut z =
-        ((u.x.to_bits() as u64) << 32 | u.y.to_bits() as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut next = || {
-        z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut x = z;
-        x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        x ^= x >> 31;
-        (x >> 40) as f32 / (1u64 << 24) as f32
-    };
-    Vec2::new(next(), next())
-}
-
 impl Ndf for BinMapPatch<'_> {
     /// D(h) = mass_j / (|H| c̄_j) for the bin j ∋ h, or the smoothed Σ_j mass_j D_j(h).
     ///
@@ -162,7 +147,7 @@ impl Ndf for BinMapPatch<'_> {
             .clamp(Vec2::ZERO, Vec2::splat(1.0 - f32::EPSILON / 2.0));
         let k = self.texel_at(u);
         let bin = self.map.bin_map.get(k).unwrap_or(0);
-        self.direction_for_bin(bin, rehash(u))
+        self.direction_for_bin(bin, rehash(u, 0))
     }
 
     /// The density of [`Ndf::sample_normal`]: mass_j / |H| (unsmoothed) or D(m) cos θ_m (smoothed).

@@ -1,5 +1,8 @@
 //! Discrete sampling from a cumulative table: the first step of every glint sampler (pick a lobe,
-//! element or texel ∝ its weight, then sample inside it).
+//! element or texel ∝ its weight, then sample inside it); and further uniform numbers derived from
+//! the bits of used ones, for a sampler's second step or a redraw.
+
+use glam::Vec2;
 
 /// Inverts an increasing cumulative table (not necessarily normalised) at u ∈ [0, 1): returns the
 /// slot k with cdf[k − 1] ≤ u · total < cdf[k] and u rescaled to [0, 1) inside that slot, so that
@@ -49,6 +52,24 @@ pub(crate) fn pick_streaming(
         acc += v;
     }
     (chosen.0, chosen.1.clamp(0.0, 1.0 - f32::EPSILON / 2.0))
+}
+
+/// Two further uniform numbers in [0, 1) derived from the bits of `u` and `round` (two steps of
+/// the SplitMix64 sequence seeded by the bits, Steele et al. 2014): deterministic in (u, round),
+/// independent of u and of the other rounds for every practical purpose.
+pub(crate) fn rehash(u: Vec2, round: u64) -> Vec2 {
+    const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;
+    let seed = (u.x.to_bits() as u64) << 32 | u.y.to_bits() as u64;
+    let mut z = seed.wrapping_add(GOLDEN.wrapping_mul(1 + 2 * round));
+    let mut next = || {
+        z = z.wrapping_add(GOLDEN);
+        let mut x = z;
+        x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        x ^= x >> 31;
+        (x >> 40) as f32 / (1u64 << 24) as f32
+    };
+    Vec2::new(next(), next())
 }
 
 #[cfg(test)]

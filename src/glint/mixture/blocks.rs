@@ -52,6 +52,37 @@ pub(super) struct LobeBlock {
 const _: () = assert!(std::mem::size_of::<LobeBlock>() == 512);
 
 impl LobeBlock {
+    /// Asks the CPU to bring the block's eight cache lines into its caches (a hint: no effect on
+    /// any value; nothing on targets other than x86-64).
+    #[inline(always)]
+    pub(super) fn prefetch(&self) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            let p = (self as *const LobeBlock).cast::<i8>();
+            for line in 0..std::mem::size_of::<LobeBlock>() / 64 {
+                // SAFETY: a prefetch is a hint that never faults and reads nothing into the
+                // program; `p + 64 line` stays inside `self` (512 bytes); SSE, which it needs, is
+                // part of the x86-64 baseline.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(64 * line)) };
+            }
+        }
+    }
+
+    /// Whether slope `s` lies in lane `lane`'s slope box (`k2` = k²): where [`p22_lanes`] counts
+    /// the lane.
+    #[inline]
+    pub(super) fn in_box(&self, lane: usize, s: Vec2, k2: f32) -> bool {
+        let (dx, dy) = (s.x - self.mx[lane], s.y - self.my[lane]);
+        in_box(dx, dy, self.l11[lane], self.l21[lane], self.l22[lane], k2)
+    }
+
+    /// The mean slope μ of lane `lane`, as D and the masking read it.
+    #[inline(always)]
+    pub(super) fn mean(&self, lane: usize) -> [f64; 2] {
+        [self.mx[lane] as f64, self.my[lane] as f64]
+    }
+
     /// A block of zeros (a decode target: every lane is overwritten before use).
     #[inline]
     pub(super) fn zeroed() -> LobeBlock {
@@ -175,15 +206,22 @@ pub(super) fn p22_lanes<const BOXED: bool>(
         let zx = b.j11[i] * dx;
         let zy = b.j21[i] * dx + b.j22[i] * dy;
         let e = exp2_lanes(-(zx * zx + zy * zy));
-        let (l11, l21, l22) = (b.l11[i], b.l21[i], b.l22[i]);
-        // `&`, not `&&`: both tests are evaluated, so the lane loop has no branch.
-        let inside = (dx * dx <= k2 * (l11 * l11)) & (dy * dy <= k2 * (l21 * l21 + l22 * l22));
+        let inside = in_box(dx, dy, b.l11[i], b.l21[i], b.l22[i], k2);
         let v = w[i] * (b.j11[i] * b.j22[i]) * e;
         p[i] = if BOXED { select(inside, v) } else { v };
     }
     for i in 0..LANES {
         acc[i] += p[i] as f64;
     }
+}
+
+/// Whether the offset (dx, dy) = s − μ of a slope from a lane's mean lies in the lane's slope box
+/// |dx| ≤ k L₁₁, |dy| ≤ k √(L₂₁² + L₂₂²) (`k2` = k²), in `f32`: the one test of [`p22_lanes`] and
+/// of the samplers' draws ([`LobeBlock::in_box`]), so that both agree on every slope.
+#[inline(always)]
+fn in_box(dx: f32, dy: f32, l11: f32, l21: f32, l22: f32, k2: f32) -> bool {
+    // `&`, not `&&`: both tests are evaluated, so the lane loop has no branch.
+    (dx * dx <= k2 * (l11 * l11)) & (dy * dy <= k2 * (l21 * l21 + l22 * l22))
 }
 
 /// The factor that turns the sums of [`p22_lanes`] into P22: 1/(2π) ÷ (½ log₂ e).

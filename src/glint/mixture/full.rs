@@ -243,6 +243,17 @@ impl LevelView for FullLevel<'_> {
         }
     }
 
+    #[inline(always)]
+    fn prefetch_block(&self, bx: usize, by: usize) {
+        self.data.blocks.block(bx, by).prefetch();
+    }
+
+    /// The stored block lane's mean.
+    #[inline(always)]
+    fn lane_mean(&self, _: usize, bx: usize, by: usize, lane: usize) -> [f64; 2] {
+        self.data.blocks.block(bx, by).mean(lane)
+    }
+
     #[inline]
     fn error(&self, k: usize, res: usize) -> f32 {
         self.data

@@ -1,151 +1,33 @@
 //! The per-footprint work of a patch (done once, when it is made): the footprint's Gaussian in lobe
-//! units, the level of detail's error pass and the gather at a level (choice.rs chooses the form): the rectangle of nodes
-//! within `weight_sigmas` of the effective Gaussian k_i ∗ k_P, their normalised weights W_i (stored
-//! densely per "slot" of the rectangle, with a cdf for sampling, and again in the lobe blocks'
-//! layout), the patch mean slope and covariance and the level's error bound. An axis of the
-//! rectangle at least one period long is folded onto the node grid (a node's slot then carries the
-//! sum of its periodic images' weights), so a patch never holds more slots than the level has
-//! nodes.
+//! units, the level of detail's error pass and the gather at a level (choice.rs chooses the form):
+//! the rectangle of nodes within `weight_sigmas` of the effective Gaussian k_i ∗ k_P (slots.rs),
+//! their normalised weights W_i written in the lobe blocks' layout with a cdf per block, the patch
+//! mean slope and covariance and the level's error bound. An axis of the rectangle at least one
+//! period long is folded onto the node grid (a node's lane then carries the sum of its periodic
+//! images' weights), so a patch never holds more slots than the level has nodes.
 //!
 //! Generic over the storage ([`LobeStore`], [`LevelView`]): compiled once per storage.
 
 use super::blocks::SIDE;
 use super::params::{PatchOptions, SeedKernel};
+use super::slots::{AxisSlots, BlockRect, block_rects};
 use super::storage::{LevelView, LobeStore};
 use crate::glint::Footprint;
 use crate::glint::kernels::lanes::LANES;
 use crate::glint::scratch::Lent;
 use glam::Vec2;
 
-/// The slots of one axis of the weight rectangle.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct AxisSlots {
-    /// First unwrapped lobe index (unused when folded).
-    start: i64,
-    /// Number of slots.
-    pub len: usize,
-    /// Lobes along this axis.
-    pub n: usize,
-    /// Folded onto [0, n) (slot = lobe index).
-    folded: bool,
-}
-
-impl AxisSlots {
-    /// Lobe indices I with |I + ½ − c| ≤ half, folded if they span a period or more.
-    fn new(c: f64, half: f64, n: usize) -> AxisSlots {
-        let lo = (c - 0.5 - half).ceil();
-        let hi = (c - 0.5 + half).floor();
-        let len = if hi >= lo { (hi - lo) as usize + 1 } else { 1 };
-        let start = if hi >= lo {
-            lo as i64
-        } else {
-            (c - 0.5).round() as i64
-        };
-        if len >= n {
-            AxisSlots {
-                start,
-                len: n,
-                n,
-                folded: true,
-            }
-        } else {
-            AxisSlots {
-                start,
-                len,
-                n,
-                folded: false,
-            }
-        }
-    }
-
-    /// The slot of unwrapped lobe index I (which must lie in the rectangle).
-    #[inline]
-    fn slot_of_unwrapped(&self, i: i64) -> usize {
-        if self.folded {
-            i.rem_euclid(self.n as i64) as usize
-        } else {
-            (i - self.start) as usize
-        }
-    }
-
-    /// The lobe index of a slot.
-    #[inline]
-    pub fn lobe_of_slot(&self, s: usize) -> usize {
-        if self.folded {
-            s
-        } else {
-            (self.start + s as i64).rem_euclid(self.n as i64) as usize
-        }
-    }
-
-    /// The unwrapped lobe indices whose weights are summed (the whole ±half range when folded).
-    fn unwrapped_range(&self, c: f64, half: f64) -> (i64, i64) {
-        if self.folded {
-            (
-                (c - 0.5 - half).ceil() as i64,
-                (c - 0.5 + half).floor() as i64,
-            )
-        } else {
-            (self.start, self.start + self.len as i64 - 1)
-        }
-    }
-
-    /// Segments [lo, hi) of lobe indices with slot = i + off, covering the slots.
-    fn segments(&self) -> ([(usize, usize, i64); 2], usize) {
-        let mut out = [(0, 0, 0); 2];
-        if self.folded {
-            out[0] = (0, self.n, 0);
-            return (out, 1);
-        }
-        let first = self.start.rem_euclid(self.n as i64) as usize;
-        let run = self.len.min(self.n - first);
-        out[0] = (first, first + run, -(first as i64));
-        if run < self.len {
-            out[1] = (0, self.len - run, run as i64);
-            (out, 2)
-        } else {
-            (out, 1)
-        }
-    }
-}
-
 /// The per-slot buffers of a patch: the mixture's buffer type in a
 /// [`GlintScratch`](crate::glint::GlintScratch).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SlotBuffers {
-    /// Normalised W per slot, row major (slot_y * len_x + slot_x), summing to 1.
-    pub weights: Vec<f32>,
-    /// Cumulative weights (f64), last = Σ of `weights` in f64.
-    pub cdf: Vec<f64>,
-    /// The weights again in the lobe blocks' layout: per [`BlockRect`], its blocks row major, 16
-    /// lanes each (0 for lanes outside the rectangle or the grid).
+    /// The normalised weights W_i in the lobe blocks' layout: per [`BlockRect`], its blocks row
+    /// major, 16 lanes each (0 for lanes outside the rectangle or the grid); they sum to 1.
     pub block_weights: Vec<f32>,
-}
-
-/// One (x segment × y segment) rectangle of a patch's lobes, with its blocks.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct BlockRect {
-    /// Lobe ranges [lo, hi) along x and y.
-    pub x: (usize, usize),
-    pub y: (usize, usize),
-    /// First block and the block counts along x and y.
-    pub bx0: usize,
-    pub by0: usize,
-    pub bw: usize,
-    pub bh: usize,
-    /// Offset of the rectangle's first block in `block_weights`, in lanes.
-    offset: usize,
-}
-
-impl BlockRect {
-    /// The lane weights of block (bx, by) (absolute block coordinates, inside the rectangle).
-    /// `#[inline(always)]`: called inside the block passes, whose AVX2 copy inlines only what is
-    /// forced (simd.rs, `dispatch`).
-    #[inline(always)]
-    pub fn weights<'w>(&self, bw: &'w [f32], bx: usize, by: usize) -> &'w [f32; LANES] {
-        let o = self.offset + ((by - self.by0) * self.bw + (bx - self.bx0)) * LANES;
-        bw[o..o + LANES].try_into().expect("16 lanes")
-    }
+    /// Cumulative Σ W per block, in `block_weights`' order (f64; the last is Σ W).
+    pub block_cdf: Vec<f64>,
+    /// The raw weights of the level-of-detail search's error pass, per slot.
+    work: Vec<f64>,
 }
 
 /// The gathered lobes of a footprint.
@@ -365,7 +247,7 @@ pub(super) fn lod_error_of<L: LevelView>(
     res: usize,
     bufs: &mut Lent<'_, SlotBuffers>,
 ) -> f64 {
-    let w = &mut bufs.cdf;
+    let w = &mut bufs.work;
     let axes = slot_weights(weight_sigmas, lv, eff, w);
     let nx = lv.grid()[0];
     let (mut total, mut err) = (0.0f64, 0.0f64);
@@ -400,10 +282,15 @@ fn for_each_slot_lobe<T>(
     }
 }
 
-/// The normalised weights of the level's nodes over the footprint (`eff`), their cdf and block
-/// layout, the patch mean slope, its covariance when `second_moments` (what the approximate
-/// masking reads; the lobes' covariances are not read otherwise) and the level-of-detail bound at
-/// the resolution of index `res`, in `bufs`.
+/// The normalised weights of the level's nodes over the footprint (`eff`) in the lobe blocks'
+/// layout with their cdf per block, the patch mean slope, its covariance when `second_moments`
+/// (what the approximate masking reads; the lobes' covariances are not read otherwise) and the
+/// level-of-detail bound at the resolution of index `res`, in `bufs`.
+///
+/// One pass over the rectangle's unwrapped nodes, row by row: each node's raw Gaussian weight (the
+/// row recurrence of [`Effective`]) is added straight into its block lane (a folded axis adds its
+/// periodic images into the same lane) while the raw sums Σ w, Σ w μ (and Σ w (Σ + μ μᵀ), Σ w e)
+/// accumulate in `f64`; a last pass over the lanes scales them by 1/Σ w and forms the block cdf.
 pub(super) fn gather<'b, L: LevelView>(
     weight_sigmas: f32,
     lv: L,
@@ -412,54 +299,122 @@ pub(super) fn gather<'b, L: LevelView>(
     second_moments: bool,
     mut bufs: Lent<'b, SlotBuffers>,
 ) -> Gathered<'b> {
-    // Raw weights are summed into the cdf buffer, then normalised and accumulated in place.
-    let SlotBuffers { weights, cdf, .. } = &mut *bufs;
-    weights.clear();
-    let axes = slot_weights(weight_sigmas, lv, eff, cdf);
+    let t = weight_sigmas as f64;
+    let half = [t * eff.cov[0].sqrt(), t * eff.cov[2].sqrt()];
+    let axes = [
+        AxisSlots::new(eff.c[0], half[0], lv.grid()[0]),
+        AxisSlots::new(eff.c[1], half[1], lv.grid()[1]),
+    ];
+    let (rects, n_rects, lanes) = block_rects(&axes);
+    let n_ys = axes[1].segments().1;
+    // The slot at which each axis's second segment begins (its length when it has one).
+    let run = [axes[0].first_run(), axes[1].first_run()];
+    debug_assert!(run[0] >= axes[0].len || axes[0].segments().1 == 2);
+    let (i0, i1) = axes[0].unwrapped_range(eff.c[0], half[0]);
+    let (j0, j1) = axes[1].unwrapped_range(eff.c[1], half[1]);
+    let count_x = (i1 - i0 + 1).max(0) as usize;
     let nx = lv.grid()[0];
-    let w = cdf;
-    let total: f64 = w.iter().sum();
+    let SlotBuffers {
+        block_weights,
+        block_cdf,
+        ..
+    } = &mut *bufs;
+    block_weights.clear();
+    block_weights.resize(lanes, 0.0);
+    // The blocks are asked for one block row ahead of the rows that read them (the first rows
+    // now), so that their loads overlap instead of stalling one lane at a time; the passes then
+    // find them in the caches.
+    let prefetch_row = |by: usize| {
+        for r in &rects[..n_rects] {
+            if (r.by0..r.by0 + r.bh).contains(&by) {
+                for bx in r.bx0..r.bx0 + r.bw {
+                    lv.prefetch_block(bx, by);
+                }
+            }
+        }
+    };
+    for r in &rects[..n_rects] {
+        prefetch_row(r.by0);
+    }
+    let (mut total, mut lod_error) = (0.0f64, 0.0f64);
+    // Σ w μ and Σ w (Σ + μ μᵀ) with the lobes' covariances as D uses them.
+    let mut m1 = [0.0f64; 2];
+    let mut m2 = [0.0f64; 3];
+    // Level 0 has no merge error (its term is 0).
+    let merged = lv.level() > 0;
+    let sx0 = axes[0].slot_of_unwrapped(i0);
+    let x0 = axes[0].lobe_of_slot(sx0);
+    for j in j0..=j1 {
+        let sy = axes[1].slot_of_unwrapped(j);
+        let y = axes[1].lobe_of_slot(sy);
+        let ry = usize::from(sy >= run[1]);
+        if y.is_multiple_of(SIDE) {
+            prefetch_row(y / SIDE + 1);
+        }
+        let row_k = y * nx;
+        // The lane of node (x, y) in rectangle r: base(r) + (x / 4) · 16 + x mod 4, with base(r)
+        // = r's offset + its block row's offset + the row's lanes − r.bx0 · 16 (never negative at a
+        // node of r, so the sum is formed in wrapping arithmetic).
+        let base = |r: &BlockRect| {
+            (r.offset + (y / SIDE - r.by0) * r.bw * LANES + (y % SIDE) * SIDE)
+                .wrapping_sub(r.bx0 * LANES)
+        };
+        let mut sx = sx0;
+        let mut x = x0;
+        let mut row = base(&rects[usize::from(sx >= run[0]) * n_ys + ry]);
+        for w in eff.row_weights(i0, j).take(count_x) {
+            let k = row_k + x;
+            total += w;
+            if second_moments {
+                let (mu, cov) = lv.mean_cov(k);
+                m1[0] += w * mu[0];
+                m1[1] += w * mu[1];
+                m2[0] += w * (cov[0] + mu[0] * mu[0]);
+                m2[1] += w * (cov[1] + mu[0] * mu[1]);
+                m2[2] += w * (cov[2] + mu[1] * mu[1]);
+            } else {
+                let mu = lv.lane_mean(k, x / SIDE, y / SIDE, (y % SIDE) * SIDE + x % SIDE);
+                m1[0] += w * mu[0];
+                m1[1] += w * mu[1];
+            }
+            if merged {
+                lod_error += w * lv.error(k, res) as f64;
+            }
+            block_weights[row.wrapping_add((x / SIDE) * LANES + x % SIDE)] += w as f32;
+            // The next unwrapped node: its slot and node wrap at the grid's edge, where an
+            // unfolded axis enters its second segment.
+            sx += 1;
+            x += 1;
+            if x == axes[0].n {
+                x = 0;
+                if axes[0].folded {
+                    sx = 0;
+                } else if sx < axes[0].len {
+                    row = base(&rects[n_ys + ry]);
+                }
+            }
+        }
+    }
     // total ≥ the nearest node's weight ≥ exp(−½ · 2 · 0.5²/v) with v the smallest variance of
     // Σ_eff: σ_k² ≈ 0.18 at level 0 (≈ 0.06), (σ_k² + (4^l − 1)/12)/4^l > 1/12 at level l (> 0.04)
     // (|d| ≤ ½ per axis), so the division is safe.
     let inv = if total > 0.0 { 1.0 / total } else { 0.0 };
-    let mut acc = 0.0;
-    // Σ W μ and Σ W (Σ + μ μᵀ) with the lobes' covariances as D uses them.
-    let mut m1 = [0.0f64; 2];
-    let mut m2 = [0.0f64; 3];
-    let mut lod_error = 0.0f64;
-    // Level 0 has no merge error (its term is 0).
-    let merged = lv.level() > 0;
-    // Written in slot order, as the walk below visits the slots (no capacity test per slot).
-    weights.clear();
-    weights.resize(w.len(), 0.0);
-    let mut out = weights.iter_mut();
-    for_each_slot_lobe(&axes, nx, w, |wi, k| {
-        let wn = *wi * inv;
-        acc += wn;
-        *wi = acc;
-        if merged {
-            lod_error += wn * lv.error(k, res) as f64;
+    let inv32 = inv as f32;
+    block_cdf.clear();
+    let mut acc = 0.0f64;
+    for block in block_weights.chunks_exact_mut(LANES) {
+        let mut sum = 0.0f64;
+        for w in block.iter_mut() {
+            *w *= inv32;
+            sum += *w as f64;
         }
-        if second_moments {
-            let (mu, cov) = lv.mean_cov(k);
-            m1[0] += wn * mu[0];
-            m1[1] += wn * mu[1];
-            m2[0] += wn * (cov[0] + mu[0] * mu[0]);
-            m2[1] += wn * (cov[1] + mu[0] * mu[1]);
-            m2[2] += wn * (cov[2] + mu[1] * mu[1]);
-        } else {
-            let mu = lv.mean(k);
-            m1[0] += wn * mu[0];
-            m1[1] += wn * mu[1];
-        }
-        if let Some(o) = out.next() {
-            *o = wn as f32;
-        }
-    });
-    let (rects, n_rects) = block_weights(&axes, &mut bufs);
+        acc += sum;
+        block_cdf.push(acc);
+    }
+    let m1 = [m1[0] * inv, m1[1] * inv];
     // Σ W = 1 up to rounding; the covariance is floored at 0 against cancellation.
     let slope_cov = if second_moments {
+        let m2 = m2.map(|v| v * inv);
         [
             (m2[0] - m1[0] * m1[0]).max(0.0),
             m2[1] - m1[0] * m1[1],
@@ -474,109 +429,53 @@ pub(super) fn gather<'b, L: LevelView>(
         rects,
         n_rects,
         mean_slope: Vec2::new(m1[0] as f32, m1[1] as f32),
-        lod_error,
+        lod_error: lod_error * inv,
         slope_cov,
     }
 }
 
-/// Lays the slot weights out per lobe block: one [`BlockRect`] per (x segment × y segment) of
-/// the slots (at most 4, disjoint in lobe space), each covering the blocks its lobes touch.
-fn block_weights(axes: &[AxisSlots; 2], bufs: &mut SlotBuffers) -> ([BlockRect; 4], usize) {
-    let (xs, nxs) = axes[0].segments();
-    let (ys, nys) = axes[1].segments();
-    let mut rects = [BlockRect::default(); 4];
-    let mut offs = [(0i64, 0i64); 4];
-    let mut n = 0;
-    let mut total = 0;
-    for &(x_lo, x_hi, x_off) in &xs[..nxs] {
-        for &(y_lo, y_hi, y_off) in &ys[..nys] {
-            let (bx0, by0) = (x_lo / SIDE, y_lo / SIDE);
-            let (bw, bh) = (x_hi.div_ceil(SIDE) - bx0, y_hi.div_ceil(SIDE) - by0);
-            rects[n] = BlockRect {
-                x: (x_lo, x_hi),
-                y: (y_lo, y_hi),
-                bx0,
-                by0,
-                bw,
-                bh,
-                offset: total,
-            };
-            offs[n] = (x_off, y_off);
-            total += bw * bh * LANES;
-            n += 1;
-        }
+impl Gathered<'_> {
+    /// Number of slots (nodes with a weight) of the patch.
+    pub fn slot_count(&self) -> usize {
+        self.axes[0].len * self.axes[1].len
     }
-    let SlotBuffers {
-        weights,
-        block_weights,
-        ..
-    } = bufs;
-    block_weights.clear();
-    block_weights.resize(total, 0.0);
-    let lx = axes[0].len;
-    for (r, &(x_off, y_off)) in rects[..n].iter().zip(&offs[..n]) {
-        for y in r.y.0..r.y.1 {
-            let sy = (y as i64 + y_off) as usize;
-            let src = &weights[sy * lx..(sy + 1) * lx];
-            let row = r.offset + (y / SIDE - r.by0) * r.bw * LANES + (y % SIDE) * SIDE;
-            // The row's lobes block by block: up to SIDE consecutive lanes per block.
-            let mut x = r.x.0;
-            while x < r.x.1 {
-                let bx = x / SIDE;
-                let end = ((bx + 1) * SIDE).min(r.x.1);
-                let o = row + (bx - r.bx0) * LANES + x % SIDE;
-                let sx = (x as i64 + x_off) as usize;
-                let (dst, from) = (
-                    &mut block_weights[o..o + (end - x)],
-                    &src[sx..sx + (end - x)],
-                );
-                if let (Ok(d), Ok(f)) = (
-                    <&mut [f32; SIDE]>::try_from(&mut *dst),
-                    <&[f32; SIDE]>::try_from(from),
-                ) {
-                    // A whole block row: one fixed-size move (a library call per short slice
-                    // otherwise).
-                    *d = *f;
-                } else {
-                    for (d, f) in dst.iter_mut().zip(from) {
-                        *d = *f;
-                    }
-                }
-                x = end;
-            }
-        }
+
+    /// The weight lane of slot (sx, sy) in `block_weights`.
+    fn lane_of_slot(&self, sx: usize, sy: usize) -> usize {
+        let (x, y) = (self.axes[0].lobe_of_slot(sx), self.axes[1].lobe_of_slot(sy));
+        let n_ys = self.axes[1].segments().1;
+        let rx = usize::from(sx >= self.axes[0].first_run());
+        let ry = usize::from(sy >= self.axes[1].first_run());
+        let r = &self.rects[rx * n_ys + ry];
+        r.offset
+            + ((y / SIDE - r.by0) * r.bw + (x / SIDE - r.bx0)) * LANES
+            + (y % SIDE) * SIDE
+            + x % SIDE
     }
-    (rects, n)
+
+    /// The normalised weight W of slot s (row major over the slot rectangle) and its node's index
+    /// on a level of `nx` nodes per row.
+    pub fn slot(&self, s: usize, nx: usize) -> (f32, usize) {
+        let lx = self.axes[0].len;
+        let (sx, sy) = (s % lx, s / lx);
+        let w = self.bufs.block_weights[self.lane_of_slot(sx, sy)];
+        let k = self.axes[1].lobe_of_slot(sy) * nx + self.axes[0].lobe_of_slot(sx);
+        (w, k)
+    }
+
+    /// The node of lane `lane` of `block_weights` on a level of `nx` nodes per row.
+    pub fn node_of_lane(&self, lane: usize, nx: usize) -> usize {
+        let r = self.rects[..self.n_rects]
+            .iter()
+            .rev()
+            .find(|r| r.offset <= lane)
+            .unwrap_or(&self.rects[0]);
+        let local = lane - r.offset;
+        let (b, l) = (local / LANES, local % LANES);
+        let (bx, by) = (r.bx0 + b % r.bw.max(1), r.by0 + b / r.bw.max(1));
+        (by * SIDE + l / SIDE) * nx + bx * SIDE + l % SIDE
+    }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn axis_segments_cover_the_slots_once() {
-        for &(c, half, n) in &[
-            (0.2, 1.3, 8usize),
-            (7.9, 2.0, 8),
-            (3.5, 0.1, 8),
-            (4.0, 9.0, 8),
-            (0.5, 0.0, 1),
-        ] {
-            let a = AxisSlots::new(c, half, n);
-            let (seg, k) = a.segments();
-            let mut seen = vec![0; a.len];
-            for &(lo, hi, off) in &seg[..k] {
-                for i in lo..hi {
-                    let s = (i as i64 + off) as usize;
-                    assert_eq!(a.lobe_of_slot(s), i, "{c} {half} {n}");
-                    seen[s] += 1;
-                }
-            }
-            assert!(seen.iter().all(|&v| v == 1), "{c} {half} {n}: {seen:?}");
-            let (lo, hi) = a.unwrapped_range(c, half);
-            for i in lo..=hi {
-                assert!(a.slot_of_unwrapped(i) < a.len);
-            }
-        }
-    }
-}
+mod tests;

@@ -42,7 +42,8 @@
 //!    (the sub-texel limit lobe), `full.rs` and `compact.rs` (its two implementations),
 //!    `compact_encode.rs` (the compact encoder);
 //! 6. `model.rs` ([`BeckmannMixture`]: the build's derived parts and accessors);
-//! 7. `gather.rs` (per-footprint work: weights, the levels' error pass), `choice.rs` (which form
+//! 7. `slots.rs` (a footprint's slot rectangle and its lobe blocks), `gather.rs` (per-footprint
+//!    work: weights, the levels' error pass), `choice.rs` (which form
 //!    serves a footprint: sub-texel lobe, filtered mixture, cut, filtered lobe or gather), `passes.rs` (the per-query loops over
 //!    blocks, generic over the storage), `patch.rs` ([`MixturePatch`]);
 //! 8. `measured.rs` (the public build, whose last step measures the filtered mixture's errors with
@@ -68,6 +69,7 @@ mod params;
 mod passes;
 mod patch;
 mod simd;
+mod slots;
 mod storage;
 mod store;
 mod sub_texel;

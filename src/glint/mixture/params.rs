@@ -48,8 +48,9 @@ pub const DEFAULT_WEIGHT_SIGMAS: f32 = 3.0;
 /// Default tail mass left outside a lobe's slope bounding box: 10⁻⁶.
 ///
 /// The box is that of the ellipse holding 1 − tail of the lobe, k² = −2 ln(tail) (k = 5.26 here);
-/// D_P ignores a lobe outside its box, so D_P integrates to at least 1 − tail and the samplers (which
-/// draw the untruncated lobes) disagree with the pdf by at most `tail` in total variation. The paper
+/// D_P ignores a lobe outside its box, so D_P integrates to at least 1 − tail; the samplers draw each
+/// lobe within its box (redrawing the rare draws outside it), so their densities are D_P's own
+/// lobes renormalised by at most 1/(1 − tail) each. The paper
 /// uses the 99 % box (tail 0.01, k = 3.03): 1.8× fewer lobes touched per query (docs/mixture.md) but
 /// a normalisation error up to 1 %.
 pub const DEFAULT_SLOPE_TAIL: f32 = 1.0e-6;

@@ -1,6 +1,5 @@
-//! The patch's per-query loops over lobe blocks: D_P's walk ([`SumP22`]), the untruncated D of the
-//! pdfs ([`UntruncatedSum`]), the exact visible area V_P ([`VisibleSum`]) and the visible sampler's
-//! pick ([`VisiblePick`]). Each is a [`BlockPass`], generic over the storage's level view
+//! The patch's per-query loops over lobe blocks: D_P's walk ([`SumP22`]), the exact visible area
+//! V_P ([`VisibleSum`]) and the visible sampler's pick ([`VisiblePick`]). Each is a [`BlockPass`], generic over the storage's level view
 //! ([`LevelView`]) and compiled once per storage and per instruction set (`simd::dispatch`): the
 //! storage and the instruction set are chosen above the loop, once per query, never per block.
 
@@ -70,31 +69,6 @@ impl<L: LevelView> BlockPass for SumP22<'_, L> {
             );
         }
         (acc.iter().sum::<f64>(), blocks_seen)
-    }
-}
-
-/// The pdfs' loop: Σ W P22 over every lane of every block of the patch (no box), without the 1/(2π)
-/// factor.
-pub(super) struct UntruncatedSum<'g, L> {
-    pub lv: L,
-    pub g: &'g Gathered<'g>,
-    pub s: Vec2,
-}
-
-impl<L: LevelView> BlockPass for UntruncatedSum<'_, L> {
-    type Out = f64;
-    #[inline(always)]
-    fn run<I: Isa>(self) -> f64 {
-        let mut acc = [0.0f64; LANES];
-        for_each_patch_block(
-            &self.lv,
-            self.g,
-            #[inline(always)]
-            |b, wts, _, _| {
-                blocks::p22_lanes::<false>(b, wts, self.s, 0.0, &mut acc);
-            },
-        );
-        acc.iter().sum()
     }
 }
 

@@ -13,14 +13,14 @@ use super::full::FullLevel;
 use super::gather::{FootprintLobes, Gathered, SlotBuffers};
 use super::model::{BeckmannMixture, Storage};
 use super::params::{MaskingMode, PatchOptions};
-use super::passes::{SumP22, UntruncatedSum, VisiblePick, VisibleSum};
+use super::passes::{SumP22, VisiblePick, VisibleSum};
 use super::simd::{self, Simd};
 use super::storage::LevelView;
 use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
 use crate::glint::kernels::albedo::Lobe;
-use crate::glint::kernels::cdf::invert_cdf;
+use crate::glint::kernels::cdf::{invert_cdf, pick_streaming, rehash};
 use crate::glint::kernels::cut::CutStats;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::kernels::prepared_view::PreparedView;
@@ -82,9 +82,10 @@ impl PatchLevel<'_> {
 ///   docs/mixture.md for why the per-lobe areas are not clamped as in eq. 17).
 ///   [`MaskingMode::Approximate`]: the same A_P and Scarf's upper bound of V_P from the patch's slope
 ///   mean and covariance (O(1) per direction; sound: never creates energy, see docs/mixture.md).
-/// - Samplers: `sample_normal` draws a lobe ∝ W_i then its slope Gaussian (exactly D_P cos θ);
-///   `sample_visible` draws a lobe ∝ W_i V_i(wo) then that lobe's visible normal, density
-///   Σ W_i ⟨wo,m⟩⁺ D_i / V_P(wo) = `pdf_visible` (exact V_P in both masking modes).
+/// - Samplers: `sample_normal` draws a lobe ∝ W_i then its slope Gaussian within the lobe's slope
+///   box (D_P cos θ); `sample_visible` draws a lobe ∝ W_i V_i(wo) then that lobe's visible normal
+///   within its box, density ⟨wo,m⟩⁺ D_P / V_P(wo) = `pdf_visible` (exact V_P in both masking
+///   modes), both up to each lobe's mass outside its box (≤ ~10⁻⁶ relative).
 /// - Few-lobe forms (one slope Gaussian or a few, evaluated by brute force, O(1) per query):
 ///   below [`PatchOptions::sub_texel_area`] the sub-texel limit lobe
 ///   (src/glint/mixture/sub_texel.rs); from [`PatchOptions::filtered_area`] the filtered mixture
@@ -104,13 +105,13 @@ impl PatchLevel<'_> {
 ///   that explicit step (nothing is kept lazily: a patch that was not prepared computes V_P(wo) per
 ///   query), and takes the D_P(h) that `MicrofacetBrdf::eval_pdf` already evaluated
 ///   ([`Ndf::pdf_visible_given_d`]). A renderer's `eval_pdf` at k directions and one `sample` at the
-///   prepared wo then cost k + 1 D_P walks, k + 1 untruncated passes (the pdfs), one V_P(wo) pass,
-///   the sampler's pick pass and, with exact masking, k + 1 V_P(wi) passes; every value is the one
-///   an unprepared patch returns.
-/// - What approximate masking cannot make O(1): the densities. `pdf_visible` and `pdf_normal` are
-///   sums over the lobes at m (one pass; the density of a mixture is the sum of its lobes'), and
-///   `sample_visible` picks a lobe ∝ W_i V_i(wo), which needs the exact V_P(wo) (one pass per
-///   view, shared with the pdfs) and a pick pass. Picking ∝ W_i instead (O(log lobes) by the
+///   prepared wo then cost k + 1 D_P walks, one V_P(wo) pass, the sampler's pick pass and, with
+///   exact masking, k + 1 V_P(wi) passes (the pdfs read D_P from the walk: the samplers draw each
+///   lobe within its slope box, [`MixturePatch::sample_lobe_in_box`]); every value is the one an
+///   unprepared patch returns.
+/// - What approximate masking cannot make O(1): the sampler. `sample_visible` picks a lobe
+///   ∝ W_i V_i(wo), which needs the exact V_P(wo) (one pass per view, shared with the pdfs) and a
+///   pick pass. Picking ∝ W_i instead (O(log lobes) by the
 ///   weights' CDF) would make the density Σ W_i ⟨wo,m⟩⁺ D_i / V_i(wo), whose pass costs a V_i per
 ///   lobe at every pdf, and bound the sample weight by F · max_i V_i(wo)/V_P(wo) instead of F
 ///   (src/bxdf/microfacet.rs, "Sample weights"); [`crate::bxdf::Sampling::Normals`] already is
@@ -298,7 +299,7 @@ impl<'a> MixturePatch<'a> {
 
     /// Number of lobe slots (weights) the patch holds (0 for the filtered lobe).
     pub fn lobe_count(&self) -> usize {
-        self.gathered.as_ref().map_or(0, |g| g.bufs.weights.len())
+        self.gathered.as_ref().map_or(0, Gathered::slot_count)
     }
 
     /// The patch mean slope μ_P = Σ W_i μ_i (the filtered lobe's mean under the level of detail).
@@ -311,8 +312,14 @@ impl<'a> MixturePatch<'a> {
     /// The normalised weights W_i and their lobes, for tests and tools: (W, lobe) per slot.
     pub fn weighted_lobes(&self) -> impl Iterator<Item = (f32, SlopeGaussian)> + Clone + '_ {
         let g = self.gathered.as_ref();
-        let n = g.map_or(0, |g| g.bufs.weights.len());
-        (0..n).filter_map(move |s| g.map(|g| (g.bufs.weights[s], self.slot_lobe(g, s))))
+        let nx = self.level.grid()[0];
+        let n = g.map_or(0, Gathered::slot_count);
+        (0..n).filter_map(move |s| {
+            g.map(|g| {
+                let (w, k) = g.slot(s, nx);
+                (w, self.level.lobe(k))
+            })
+        })
     }
 
     /// The patch's lobes (few-lobe form or gathered slots) as the albedo estimate reads them
@@ -321,28 +328,16 @@ impl<'a> MixturePatch<'a> {
     pub(crate) fn albedo_lobes(&self) -> impl Iterator<Item = Lobe> + Clone + '_ {
         let nx = self.level.grid()[0];
         let slots = self.gathered.as_ref().into_iter().flat_map(move |g| {
-            let (lx, ly) = (g.axes[0].len, g.axes[1].len);
-            (0..ly).flat_map(move |j| {
-                let row = g.axes[1].lobe_of_slot(j) * nx;
-                (0..lx).map(move |i| {
-                    let (mu, c) = self.level.mean_cov(row + g.axes[0].lobe_of_slot(i));
-                    Lobe::from_mean_cov(g.bufs.weights[j * lx + i], mu, c)
-                })
+            (0..g.slot_count()).map(move |s| {
+                let (w, k) = g.slot(s, nx);
+                let (mu, c) = self.level.mean_cov(k);
+                Lobe::from_mean_cov(w, mu, c)
             })
         });
         self.few
             .iter_lobes()
             .map(|(w, l)| Lobe::of(w, &l))
             .chain(slots)
-    }
-
-    /// The lobe of slot s.
-    #[inline]
-    fn slot_lobe(&self, g: &Gathered, s: usize) -> SlopeGaussian {
-        let lx = g.axes[0].len;
-        let nx = self.level.grid()[0];
-        self.level
-            .lobe(g.axes[1].lobe_of_slot(s / lx) * nx + g.axes[0].lobe_of_slot(s % lx))
     }
 
     /// D_P(m) and the number of lobes whose D_i was evaluated: 16 per lobe block whose box (and
@@ -376,22 +371,6 @@ impl<'a> MixturePatch<'a> {
             SumP22 { lv, g, s, k2 }
         ));
         (sum * blocks::p22_scale(), blocks_seen * blocks::LANES)
-    }
-
-    /// Σ W_i D_i(m) over every gathered lobe (no slope box), lanes in `f32`, the sum in `f64`.
-    fn untruncated_d(&self, g: &Gathered, m: Vec3) -> f64 {
-        let Some(s) = normal_to_slope(m) else {
-            return 0.0;
-        };
-        if !s.is_finite() {
-            return 0.0;
-        }
-        let sum = with_level!(self.level, |lv| simd::dispatch(
-            self.simd,
-            UntruncatedSum { lv, g, s }
-        ));
-        let c = 1.0 + s.length_squared() as f64;
-        sum * blocks::p22_scale() * c * c
     }
 
     /// Exact V_P(w) = Σ W_i V_i(w) (0 for invalid w) by the lobe blocks ([`blocks::visible_lanes`]:
@@ -464,9 +443,15 @@ impl<'a> MixturePatch<'a> {
     /// comparison. The filtered lobe's A under the level of detail.
     pub fn paper_projected_area(&self, w: Vec3) -> f32 {
         match &self.gathered {
-            Some(g) => (0..g.bufs.weights.len())
-                .map(|s| g.bufs.weights[s] as f64 * self.slot_lobe(g, s).projected_area(w) as f64)
-                .sum::<f64>() as f32,
+            Some(g) => {
+                let nx = self.level.grid()[0];
+                (0..g.slot_count())
+                    .map(|s| {
+                        let (wi, k) = g.slot(s, nx);
+                        wi as f64 * self.level.lobe(k).projected_area(w) as f64
+                    })
+                    .sum::<f64>() as f32
+            }
             None => self.few.projected_area(w),
         }
     }
@@ -496,7 +481,43 @@ impl<'a> MixturePatch<'a> {
             return self.sample_normal(u);
         }
         let r = r.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-        self.level.lobe(k).sample_visible(wo, Vec2::new(r, u.y))
+        self.sample_lobe_in_box(k, Some(wo), Vec2::new(r, u.y))
+    }
+
+    /// Lobe k's visible normal for `wo` (its normal if `None`) **within its slope box**, the box
+    /// D_P counts it in ([`blocks::p22_lanes`]): a draw outside the box (probability ≤ ~10⁻⁶, the
+    /// lobe's truncated tail) is redrawn with numbers derived from u ([`rehash`]), up to
+    /// [`MAX_REDRAWS`] times, then replaced by the lobe's mean normal, which lies in the box. So the
+    /// samplers' densities are those of D_P's own truncated lobes, renormalised by each lobe's mass
+    /// in its box (1 − ≤ ~10⁻⁶), and the pdfs read them from D_P.
+    fn sample_lobe_in_box(&self, k: usize, wo: Option<Vec3>, u: Vec2) -> Vec3 {
+        let lobe = self.level.lobe(k);
+        let draw = |u: Vec2| match wo {
+            Some(wo) => lobe.sample_visible(wo, u),
+            None => lobe.sample_normal(u),
+        };
+        let mut m = draw(u);
+        for round in 0..MAX_REDRAWS {
+            if self.in_lobe_box(k, m) {
+                return m;
+            }
+            m = draw(rehash(u, round));
+        }
+        if self.in_lobe_box(k, m) {
+            m
+        } else {
+            let mu = lobe.mean();
+            Vec3::new(-mu.x, -mu.y, 1.0).normalize()
+        }
+    }
+
+    /// Whether normal m's slope lies in lobe k's slope box (the test of [`blocks::p22_lanes`]).
+    fn in_lobe_box(&self, k: usize, m: Vec3) -> bool {
+        let Some(s) = normal_to_slope(m) else {
+            return false;
+        };
+        let k2 = self.box_k * self.box_k;
+        with_level!(self.level, |lv| lane_in_box(&lv, k, s, k2))
     }
 
     /// This patch running its block loops in the baseline copy (`baseline`) or in the copy the CPU
@@ -561,8 +582,13 @@ impl Ndf for MixturePatch<'_> {
         let Some(g) = &self.gathered else {
             return self.few.sample_normal(u);
         };
-        let (s, ux) = invert_cdf(&g.bufs.cdf, u.x);
-        self.slot_lobe(g, s).sample_normal(Vec2::new(ux, u.y))
+        // The block by its cdf, then the lane in it by the rescaled u.x.
+        let (b, ub) = invert_cdf(&g.bufs.block_cdf, u.x);
+        let lanes = &g.bufs.block_weights[b * blocks::LANES..(b + 1) * blocks::LANES];
+        let total: f64 = lanes.iter().map(|&w| w as f64).sum();
+        let (lane, ux) = pick_streaming(ub, total, lanes.iter().map(|&w| w as f64));
+        let k = g.node_of_lane(b * blocks::LANES + lane, self.level.grid()[0]);
+        self.sample_lobe_in_box(k, None, Vec2::new(ux, u.y))
     }
 
     /// m ~ Σ W_i ⟨wo,m⟩⁺ D_i(m) / V_P(wo): lobe ∝ W_i V_i(wo) with u.x (rescaled), then that lobe's
@@ -575,10 +601,9 @@ impl Ndf for MixturePatch<'_> {
         }
     }
 
-    /// Σ W_i D_i(m) cos θ_m over **every** gathered lobe (no slope-box truncation): exactly the
-    /// density of [`Ndf::sample_normal`] where D_P > 0, and 0 where D_P = 0 (outside every lobe's
-    /// slope box, where the sampler lands with probability at most `slope_tail`; `MicrofacetBrdf`
-    /// then returns no sample). Differs from `d(m) cos θ_m` by at most the truncated tail. O(lobes).
+    /// D_P(m) cos θ_m: the density of [`Ndf::sample_normal`], whose lobes are drawn within the slope
+    /// boxes D_P counts them in (up to each lobe's mass outside its box, ≤ ~10⁻⁶ relative); 0 where
+    /// D_P is. One D_P walk (none when D_P is given).
     fn pdf_normal(&self, m: Vec3) -> f32 {
         self.pdf_normal_with(m, || self.d(m))
     }
@@ -588,9 +613,10 @@ impl Ndf for MixturePatch<'_> {
         self.pdf_normal_with(m, || d_m)
     }
 
-    /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe, with the exact V_P in every masking
-    /// mode: exactly the density of [`Ndf::sample_visible`] where D_P > 0, and 0 where D_P = 0.
-    /// O(lobes).
+    /// ⟨wo, m⟩⁺ D_P(m) / V_P(wo), with the exact V_P in every masking mode: the density of
+    /// [`Ndf::sample_visible`] (its lobes drawn within their slope boxes, up to each lobe's mass
+    /// outside its box, ≤ ~10⁻⁶ relative); 0 where D_P is. One D_P walk (none when D_P is given)
+    /// and V_P(wo) (the prepared view's, else one pass).
     fn pdf_visible(&self, wo: Vec3, m: Vec3) -> f32 {
         self.pdf_visible_with(wo, m, || self.d(m))
     }
@@ -615,4 +641,18 @@ impl Ndf for MixturePatch<'_> {
             (None, _) => self.few_view_visible_area(wo),
         }
     }
+}
+
+/// Redraws of a lobe's sample that fell outside its slope box before the lobe's mean stands in
+/// ([`MixturePatch::sample_lobe_in_box`]): each redraw fails with probability ≤ ~10⁻⁶.
+const MAX_REDRAWS: u64 = 8;
+
+/// Whether slope `s` lies in node k's slope box on level `lv` (its block lane's test).
+fn lane_in_box<L: LevelView>(lv: &L, k: usize, s: Vec2, k2: f32) -> bool {
+    use super::blocks::SIDE;
+    let nx = lv.grid()[0];
+    let (x, y) = (k % nx, k / nx);
+    let mut scratch = L::scratch();
+    lv.block(x / SIDE, y / SIDE, &mut scratch)
+        .in_box((y % SIDE) * SIDE + x % SIDE, s, k2)
 }

@@ -56,6 +56,23 @@ pub(super) trait LevelView: Copy + std::fmt::Debug {
         self.mean_cov(k).0
     }
 
+    /// Node k's mean slope as the gather reads it, k being lane `lane` of block (bx, by): the
+    /// block lane's (the mean D and the exact masking evaluate, in `f32`) where the blocks are
+    /// stored, so that the gather reads the memory the passes read next; [`LevelView::mean`]
+    /// otherwise.
+    #[inline(always)]
+    fn lane_mean(&self, k: usize, bx: usize, by: usize, lane: usize) -> [f64; 2] {
+        let _ = (bx, by, lane);
+        self.mean(k)
+    }
+
+    /// Asks the CPU to load block (bx, by) where the blocks are stored (a hint, no effect on
+    /// any value; nothing otherwise).
+    #[inline(always)]
+    fn prefetch_block(&self, bx: usize, by: usize) {
+        let _ = (bx, by);
+    }
+
     /// The merge-error bound of node k valid at the resolution of index `res` in
     /// [`super::LOD_RESOLUTIONS`] (0 at level 0, which is exact).
     fn error(&self, k: usize, res: usize) -> f32;

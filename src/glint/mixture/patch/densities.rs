@@ -1,6 +1,7 @@
 //! The patch's densities ([`Ndf::pdf_normal`], [`Ndf::pdf_visible`] and its per-cosine form)
-//! and its few-lobe view: the exact sums over every gathered lobe, 0 where D_P is (the density
-//! contract), V(wo) prepared for the patch's view.
+//! and its few-lobe view: for gathered lobes, D_P itself (the samplers draw each lobe within the
+//! slope box D_P counts it in), 0 where D_P is (the density contract), V(wo) prepared for the
+//! patch's view.
 
 use super::MixturePatch;
 use crate::glint::kernels::lobe_set::Few;
@@ -42,16 +43,16 @@ impl MixturePatch<'_> {
     /// [`Ndf::pdf_normal`], with `d` giving D_P(m) for the density contract's check.
     #[inline]
     pub(super) fn pdf_normal_with(&self, m: Vec3, d: impl FnOnce() -> f32) -> f32 {
-        let Some(g) = &self.gathered else {
+        if self.gathered.is_none() {
             return self.few.pdf_normal(m);
-        };
-        // 0 where D_P is (outside every lobe's slope box): one density contract for every NDF.
-        if !(m.z > 0.0 && m.is_finite()) || d() <= 0.0 {
+        }
+        if !(m.z > 0.0 && m.is_finite()) {
             return 0.0;
         }
-        let p = self.untruncated_d(g, m) * m.z as f64;
-        let p = p as f32;
-        if p.is_finite() { p } else { 0.0 }
+        // D_P's own lobes, truncated to their slope boxes as the sampler draws them (0 where D_P
+        // is: one density contract for every NDF).
+        let p = d() * m.z;
+        if p.is_finite() && p > 0.0 { p } else { 0.0 }
     }
 
     /// [`Ndf::pdf_visible`], with `d` giving D_P(m) for the density contract's check and V_P(wo)
@@ -73,8 +74,8 @@ impl MixturePatch<'_> {
         self.visible_density(wo, m, d, true)
     }
 
-    /// Σ W_i ⟨wo, m⟩⁺ D_i(m) / V_P(wo) over every gathered lobe (0 where D_P = `d()` is 0), without
-    /// the factor ⟨wo, m⟩ where `over_cos`.
+    /// ⟨wo, m⟩⁺ D_P(m) / V_P(wo) with D_P(m) = `d()` (0 where it is 0), without the factor ⟨wo, m⟩
+    /// where `over_cos`: the visible sampler's density, its lobes drawn within their slope boxes.
     #[inline]
     fn visible_density(&self, wo: Vec3, m: Vec3, d: impl FnOnce() -> f32, over_cos: bool) -> f32 {
         let Some(g) = &self.gathered else {
@@ -84,8 +85,10 @@ impl MixturePatch<'_> {
         if !(wo.z > 0.0 && c > 0.0 && m.z > 0.0 && wo.is_finite() && m.is_finite()) {
             return 0.0;
         }
-        // 0 where D_P is (outside every lobe's slope box): one density contract for every NDF.
-        if d() <= 0.0 {
+        // D_P's own lobes, truncated to their slope boxes as the sampler draws them (0 where D_P
+        // is: one density contract for every NDF).
+        let d = d();
+        if d.is_nan() || d <= 0.0 {
             return 0.0;
         }
         let v = self.view_exact_visible_area(g, wo);
@@ -93,7 +96,7 @@ impl MixturePatch<'_> {
             return 0.0;
         }
         let k = if over_cos { 1.0 } else { c as f64 };
-        let p = (k * self.untruncated_d(g, m) / v) as f32;
+        let p = (k * d as f64 / v) as f32;
         if p.is_finite() { p } else { 0.0 }
     }
 }
