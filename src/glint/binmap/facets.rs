@@ -5,6 +5,7 @@
 
 use crate::frame::normal_to_slope;
 use crate::glint::HemisphereBins;
+use crate::warp::square_to_hemisphere_equal_area;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
@@ -90,7 +91,7 @@ impl BinFacet {
 /// carried to the orbit's other bins: an eighth of the work, equal to the direct computation up to
 /// f32 rounding (`mirrored_facets_match_direct_ones`). The centre and the mean cosine of every bin
 /// are its own.
-pub(super) fn bin_tables(bins: &HemisphereBins, offsets: &[u32]) -> (Vec<BinFacet>, Vec<Vec2>) {
+pub(super) fn bin_tables(bins: &HemisphereBins, offsets: &[u32]) -> BinTables {
     let n = bins.n();
     let occupied = |b: usize| offsets[b + 1] > offsets[b];
     // The canonical facet of every orbit that holds an occupied bin, indexed by its canonical bin.
@@ -136,7 +137,51 @@ pub(super) fn bin_tables(bins: &HemisphereBins, offsets: &[u32]) -> (Vec<BinFace
     let center_slope = (0..bins.len())
         .map(|b| normal_to_slope(bins.center(b)).unwrap_or(Vec2::ZERO))
         .collect();
-    (facets, center_slope)
+    BinTables {
+        facets,
+        center_slope,
+        corners: corner_grid(bins),
+    }
+}
+
+/// The per-bin tables a bin map derives from its bins and lists ([`bin_tables`]).
+pub(super) struct BinTables {
+    /// The masking facet of every bin.
+    pub facets: Vec<BinFacet>,
+    /// The slope of every bin's centre direction.
+    pub center_slope: Vec<Vec2>,
+    /// The directions of the (n + 1)² corners of the bins' cells, row major ([`corners_of`]).
+    pub corners: Vec<Vec3>,
+}
+
+/// The equal-area images of the grid points (i/n, j/n), 0 ≤ i, j ≤ n, row major: the corners of
+/// every bin's cell, computed with the arithmetic of [`HemisphereBins::sample_in_bin`] at
+/// u ∈ {0, 1}², so each is bit for bit the direction that call returns.
+fn corner_grid(bins: &HemisphereBins) -> Vec<Vec3> {
+    let n = bins.n();
+    let nf = n as f32;
+    (0..(n + 1) * (n + 1))
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (k % (n + 1), k / (n + 1));
+            square_to_hemisphere_equal_area(Vec2::new(i as f32 / nf, j as f32 / nf))
+        })
+        .collect()
+}
+
+/// The four corner directions of `bin`'s cell from the grid of [`corner_grid`], in the order
+/// (0, 0), (1, 0), (0, 1), (1, 1) of the cell's square coordinates.
+#[inline]
+pub(super) fn corners_of(corners: &[Vec3], bins: &HemisphereBins, bin: usize) -> [Vec3; 4] {
+    let (i, j) = bins.cell(bin);
+    let row = bins.n() + 1;
+    let k = j * row + i;
+    [
+        corners[k],
+        corners[k + 1],
+        corners[k + row],
+        corners[k + row + 1],
+    ]
 }
 
 /// Column (or row) `i` of an n-cell axis folded onto its first half: (the folded index, whether it
@@ -181,7 +226,7 @@ mod tests {
             for b in 0..bins.len() {
                 offsets.push(offsets[b] + u32::from(b % 3 == 0));
             }
-            let (facets, _) = bin_tables(&bins, &offsets);
+            let facets = bin_tables(&bins, &offsets).facets;
             for (b, f) in facets.iter().enumerate() {
                 let want = if b % 3 == 0 {
                     BinFacet::new(&bins, b)
@@ -238,6 +283,26 @@ mod tests {
                     assert!(
                         (mean - tab).abs() <= 4.0 * se + 1e-5,
                         "n={n} bin={bin} axis {i}: sampled {mean} vs tabulated {tab} (se {se})"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The corner grid gives every bin's corners bit for bit as `sample_in_bin` computes them.
+    #[test]
+    fn corner_grid_is_sample_in_bin_at_the_corners() {
+        for n in [1, 15, 255] {
+            let bins = HemisphereBins::new(n).expect("odd n");
+            let grid = corner_grid(&bins);
+            for b in 0..bins.len() {
+                let want = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+                    .map(|(x, y)| bins.sample_in_bin(b, Vec2::new(x, y)));
+                let got = corners_of(&grid, &bins, b);
+                for (g, w) in got.iter().zip(&want) {
+                    assert_eq!(
+                        g.to_array().map(f32::to_bits),
+                        w.to_array().map(f32::to_bits)
                     );
                 }
             }

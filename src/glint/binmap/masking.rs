@@ -9,7 +9,7 @@
 
 use super::BinMap;
 use super::clip::{Overlap, Parallelogram};
-use super::facets::BinFacet;
+use super::facets::{BinFacet, corners_of};
 use crate::glint::HemisphereBins;
 use crate::glint::scratch::Lent;
 use crate::math::finite_or_zero;
@@ -140,7 +140,19 @@ impl<'a> ExactMasking<'a> {
             let (lo, hi) = p.bounds();
             let (i0, i1) = ((lo[0].floor() as i64).max(0), (hi[0].ceil() as i64).min(w));
             let (j0, j1) = ((lo[1].floor() as i64).max(0), (hi[1].ceil() as i64).min(h));
+            // 𝓑's rows are asked for a few rows ahead of the row read (a hint), so that their
+            // loads overlap.
+            const AHEAD: i64 = 4;
+            let span = |j: i64| ((j * w + i0) as usize, (j * w + i1) as usize);
+            for j in j0..(j0 + AHEAD).min(j1) {
+                let (a, b) = span(j);
+                map.bin_map.prefetch(a, b);
+            }
             for j in j0..j1 {
+                if j + AHEAD < j1 {
+                    let (a, b) = span(j + AHEAD);
+                    map.bin_map.prefetch(a, b);
+                }
                 for i in i0..i1 {
                     let (x, y) = (i as f64, j as f64);
                     let ov = match p.classify(x, y, x + 1.0, y + 1.0) {
@@ -188,23 +200,14 @@ impl<'a> ExactMasking<'a> {
             for (ai, m) in a.iter_mut().zip(f.mean.to_array()) {
                 *ai += m as f64 * scale;
             }
-            let corner = |x: f32, y: f32| map.bins.sample_in_bin(bin, Vec2::new(x, y));
-            // The left corners of bin j are the right corners of bin j − 1 of the same row (the
-            // same points of the square, so the same f32 directions): reuse them when the previous
-            // bin of the sorted list is that one (half the equal-area map evaluations on dense
-            // footprints).
-            let [c00, c01] = match bins_out.last() {
-                Some(p) if p.bin as usize + 1 == bin && !bin.is_multiple_of(map.bins.n()) => {
-                    [p.corners[1], p.corners[3]]
-                }
-                _ => [corner(0.0, 0.0), corner(0.0, 1.0)],
-            };
+            // The cell's corner directions from the map's corner grid: what
+            // `sample_in_bin(bin, corner)` returns, bit for bit, without the equal-area map.
             bins_out.push(PatchBin {
                 bin: bin as u32,
                 mass: mass * inv_area,
                 scale: scale as f32,
                 facet: f,
-                corners: [c00, corner(1.0, 0.0), c01, corner(1.0, 1.0)],
+                corners: corners_of(&map.corners, &map.bins, bin),
             });
         }
         let total: f32 = bins.as_slice().iter().map(|b| b.scale).sum();

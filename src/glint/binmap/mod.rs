@@ -45,9 +45,9 @@ use crate::error::{Error, Result};
 use crate::frame::slope_to_normal;
 use crate::glint::surface::MomentPyramid;
 use crate::glint::{Footprint, GlintNdf, GlintScratch, HemisphereBins, NormalMap};
-use facets::{BinFacet, bin_tables};
+use facets::{BinFacet, BinTables, bin_tables};
 use forest::{NO_TREE, TreeView};
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use lookup::Table;
 use rayon::prelude::*;
 
@@ -107,6 +107,8 @@ pub struct BinMap {
     /// Per bin: mean direction (its z is the mean cosine c̄_j), centre and radius; sampled only for
     /// non-empty bins (`BinFacet::empty` otherwise).
     facets: Vec<BinFacet>,
+    /// The directions of the bins' cell corners, (n + 1)² of them (facets.rs, `corner_grid`).
+    corners: Vec<Vec3>,
     moments: MomentPyramid,
     /// The moment-lobe masking's measured error per level (masking_choice.rs), measured by the
     /// build (or read from a file).
@@ -134,6 +136,24 @@ impl BinIndex {
         match self {
             BinIndex::U16(v) => v.get(k).map(|&b| b as usize),
             BinIndex::U32(v) => v.get(k).map(|&b| b as usize),
+        }
+    }
+
+    /// Asks the CPU for the entries [k0, k1) (a hint; nothing for an empty or out-of-range span).
+    #[inline]
+    pub(super) fn prefetch(&self, k0: usize, k1: usize) {
+        use crate::glint::kernels::prefetch::prefetch;
+        match self {
+            BinIndex::U16(v) => {
+                if let Some(s) = v.get(k0..k1) {
+                    prefetch(s);
+                }
+            }
+            BinIndex::U32(v) => {
+                if let Some(s) = v.get(k0..k1) {
+                    prefetch(s);
+                }
+            }
         }
     }
 
@@ -301,7 +321,11 @@ impl BinMap {
                 );
             }
         }
-        let (facets, center_slope) = bin_tables(&bins, &offsets);
+        let BinTables {
+            facets,
+            center_slope,
+            corners,
+        } = bin_tables(&bins, &offsets);
         let table = Table::new(params.lookup, offsets, roots);
         // The masking lobe's moments: the bins' own, only the levels it reads (from
         // MASKING_FIRST_LEVEL).
@@ -320,6 +344,7 @@ impl BinMap {
             table,
             center_slope,
             facets,
+            corners,
             moments,
             moment_masking_error: Vec::new(),
         }
@@ -412,7 +437,8 @@ impl BinMap {
             forest: 4 * self.nodes.len(),
             lookup: self.table.bytes(),
             bin_tables: 8 * self.center_slope.len()
-                + std::mem::size_of::<BinFacet>() * self.facets.len(),
+                + std::mem::size_of::<BinFacet>() * self.facets.len()
+                + std::mem::size_of::<Vec3>() * self.corners.len(),
             moments: self.moments.bytes(),
         }
     }

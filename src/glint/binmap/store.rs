@@ -230,7 +230,11 @@ impl BinMap {
         if lists != assigned? {
             return Err(disagreement(&inverse, &offsets, &bin_map));
         }
-        let (facets, center_slope) = tables.expect("the tables task ran");
+        let super::facets::BinTables {
+            facets,
+            center_slope,
+            corners,
+        } = tables.expect("the tables task ran");
         let moments = if legacy {
             let pole = bins.bin_of(glam::Vec3::Z).unwrap_or(0);
             super::footprint_moments::chain(
@@ -256,6 +260,7 @@ impl BinMap {
             table: Table::new(params.lookup, offsets, roots),
             center_slope,
             facets,
+            corners,
             moments,
             moment_masking_error: Vec::new(),
         }

@@ -13,6 +13,7 @@
 //! - shared_lobes.rs: a weighted set of slope Gaussians of one shape held inline, a procedural
 //!   Beckmann patch's P-NDF.
 //! - mip.rs: trilinear addressing of mip chains over a lobe grid.
+//! - prefetch.rs: prefetch hints for the memory a footprint's query reads next.
 //! - prepared_view.rs: a value a patch computes once for the view it is prepared for (V(wo)).
 //! - slope_tree.rs: the implicit quadtree of slope boxes over a regular grid of elements (the
 //!   mixture's lobes, the position-normal elements).
@@ -28,6 +29,7 @@ pub(crate) mod gmm_store;
 pub(crate) mod lanes;
 pub(crate) mod lobe_set;
 pub(crate) mod mip;
+pub(crate) mod prefetch;
 pub(crate) mod prepared_view;
 pub(crate) mod shared_lobes;
 pub(crate) mod slope_tree;

@@ -52,21 +52,10 @@ pub(super) struct LobeBlock {
 const _: () = assert!(std::mem::size_of::<LobeBlock>() == 512);
 
 impl LobeBlock {
-    /// Asks the CPU to bring the block's eight cache lines into its caches (a hint: no effect on
-    /// any value; nothing on targets other than x86-64).
+    /// Asks the CPU to bring the block's eight cache lines into its caches (a hint).
     #[inline(always)]
     pub(super) fn prefetch(&self) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            let p = (self as *const LobeBlock).cast::<i8>();
-            for line in 0..std::mem::size_of::<LobeBlock>() / 64 {
-                // SAFETY: a prefetch is a hint that never faults and reads nothing into the
-                // program; `p + 64 line` stays inside `self` (512 bytes); SSE, which it needs, is
-                // part of the x86-64 baseline.
-                unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(64 * line)) };
-            }
-        }
+        crate::glint::kernels::prefetch::prefetch(self);
     }
 
     /// Whether slope `s` lies in lane `lane`'s slope box (`k2` = k²): where [`p22_lanes`] counts
