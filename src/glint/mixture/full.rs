@@ -248,10 +248,10 @@ impl LevelView for FullLevel<'_> {
         self.data.blocks.block(bx, by).prefetch();
     }
 
-    /// The stored block lane's mean.
+    /// The stored block.
     #[inline(always)]
-    fn lane_mean(&self, _: usize, bx: usize, by: usize, lane: usize) -> [f64; 2] {
-        self.data.blocks.block(bx, by).mean(lane)
+    fn stored_block(&self, bx: usize, by: usize) -> Option<&super::blocks::LobeBlock> {
+        Some(self.data.blocks.block(bx, by))
     }
 
     #[inline]

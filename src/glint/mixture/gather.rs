@@ -143,18 +143,26 @@ impl Effective {
     /// so e(i + 1) = e(i) r(i) and r(i + 1) = r(i) e^{−Σ⁻¹ₓₓ}: three `exp` per row, two
     /// multiplications per lobe (relative drift ~1e-16 per step, negligible over a footprint).
     fn row_weights(&self, i0: i64, j: i64) -> impl Iterator<Item = f64> {
-        let [a, b, _] = self.inv;
-        let dx = i0 as f64 + 0.5 - self.c[0];
-        let dy = j as f64 + 0.5 - self.c[1];
-        let mut e = self.weight(i0, j);
-        let mut r = (-0.5 * (a * (2.0 * dx + 1.0) + 2.0 * b * dy)).exp();
-        let s = (-a).exp();
+        let (mut e, mut r, s) = self.row_recurrence(i0, j);
         std::iter::repeat_with(move || {
             let out = e;
             e *= r;
             r *= s;
             out
         })
+    }
+
+    /// The state (e, r, s) of [`Effective::row_weights`]'s recurrence at lobe (i0, j): the weight
+    /// e of (i0, j), the ratio r to the next lobe's and the ratio s of consecutive ratios; each step
+    /// returns e, then e ← e r, r ← r s.
+    #[inline]
+    fn row_recurrence(&self, i0: i64, j: i64) -> (f64, f64, f64) {
+        let [a, b, _] = self.inv;
+        let dx = i0 as f64 + 0.5 - self.c[0];
+        let dy = j as f64 + 0.5 - self.c[1];
+        let e = self.weight(i0, j);
+        let r = (-0.5 * (a * (2.0 * dx + 1.0) + 2.0 * b * dy)).exp();
+        (e, r, (-a).exp())
     }
 
     #[inline]
@@ -344,55 +352,60 @@ pub(super) fn gather<'b, L: LevelView>(
     let merged = lv.level() > 0;
     let sx0 = axes[0].slot_of_unwrapped(i0);
     let x0 = axes[0].lobe_of_slot(sx0);
+    let n_x = axes[0].n;
     for j in j0..=j1 {
         let sy = axes[1].slot_of_unwrapped(j);
         let y = axes[1].lobe_of_slot(sy);
         let ry = usize::from(sy >= run[1]);
+        let (by, lane_row) = (y / SIDE, (y % SIDE) * SIDE);
         if y.is_multiple_of(SIDE) {
-            prefetch_row(y / SIDE + 1);
+            prefetch_row(by + 1);
         }
         let row_k = y * nx;
-        // The lane of node (x, y) in rectangle r: base(r) + (x / 4) · 16 + x mod 4, with base(r)
-        // = r's offset + its block row's offset + the row's lanes − r.bx0 · 16 (never negative at a
-        // node of r, so the sum is formed in wrapping arithmetic).
-        let base = |r: &BlockRect| {
-            (r.offset + (y / SIDE - r.by0) * r.bw * LANES + (y % SIDE) * SIDE)
-                .wrapping_sub(r.bx0 * LANES)
-        };
-        let mut sx = sx0;
-        let mut x = x0;
-        let mut row = base(&rects[usize::from(sx >= run[0]) * n_ys + ry]);
-        for w in eff.row_weights(i0, j).take(count_x) {
-            let k = row_k + x;
-            total += w;
-            if second_moments {
-                let (mu, cov) = lv.mean_cov(k);
-                m1[0] += w * mu[0];
-                m1[1] += w * mu[1];
-                m2[0] += w * (cov[0] + mu[0] * mu[0]);
-                m2[1] += w * (cov[1] + mu[0] * mu[1]);
-                m2[2] += w * (cov[2] + mu[1] * mu[1]);
-            } else {
-                let mu = lv.lane_mean(k, x / SIDE, y / SIDE, (y % SIDE) * SIDE + x % SIDE);
-                m1[0] += w * mu[0];
-                m1[1] += w * mu[1];
-            }
-            if merged {
-                lod_error += w * lv.error(k, res) as f64;
-            }
-            block_weights[row.wrapping_add((x / SIDE) * LANES + x % SIDE)] += w as f32;
-            // The next unwrapped node: its slot and node wrap at the grid's edge, where an
-            // unfolded axis enters its second segment.
-            sx += 1;
-            x += 1;
-            if x == axes[0].n {
-                x = 0;
-                if axes[0].folded {
-                    sx = 0;
-                } else if sx < axes[0].len {
-                    row = base(&rects[n_ys + ry]);
+        let (mut e, mut r, s) = eff.row_recurrence(i0, j);
+        let (mut sx, mut x, mut left) = (sx0, x0, count_x);
+        // Runs of consecutive nodes up to the grid's edge, where the nodes wrap (into the second
+        // segment of an unfolded axis, or onto the same lanes of a folded one).
+        while left > 0 {
+            let len = left.min(n_x - x);
+            let rect = &rects[usize::from(sx >= run[0]) * n_ys + ry];
+            let rect_row = rect.offset + (by - rect.by0) * rect.bw * LANES;
+            // Each run in chunks of one block: its lanes and stored means read from one place.
+            let (mut xx, end) = (x, x + len);
+            while xx < end {
+                let bx = xx / SIDE;
+                let chunk_end = ((bx + 1) * SIDE).min(end);
+                let lanes = rect_row + (bx - rect.bx0) * LANES + lane_row;
+                let block = lv.stored_block(bx, by);
+                for xi in xx..chunk_end {
+                    let (w, k, lane) = (e, row_k + xi, lane_row + xi % SIDE);
+                    e *= r;
+                    r *= s;
+                    total += w;
+                    if second_moments {
+                        let (mu, cov) = lv.mean_cov(k);
+                        m1[0] += w * mu[0];
+                        m1[1] += w * mu[1];
+                        m2[0] += w * (cov[0] + mu[0] * mu[0]);
+                        m2[1] += w * (cov[1] + mu[0] * mu[1]);
+                        m2[2] += w * (cov[2] + mu[1] * mu[1]);
+                    } else {
+                        let mu = match block {
+                            Some(b) => b.mean(lane),
+                            None => lv.mean(k),
+                        };
+                        m1[0] += w * mu[0];
+                        m1[1] += w * mu[1];
+                    }
+                    if merged {
+                        lod_error += w * lv.error(k, res) as f64;
+                    }
+                    block_weights[lanes + xi % SIDE] += w as f32;
                 }
+                xx = chunk_end;
             }
+            left -= len;
+            (sx, x) = (if axes[0].folded { 0 } else { sx + len }, 0);
         }
     }
     // total ≥ the nearest node's weight ≥ exp(−½ · 2 · 0.5²/v) with v the smallest variance of

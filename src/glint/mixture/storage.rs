@@ -56,14 +56,13 @@ pub(super) trait LevelView: Copy + std::fmt::Debug {
         self.mean_cov(k).0
     }
 
-    /// Node k's mean slope as the gather reads it, k being lane `lane` of block (bx, by): the
-    /// block lane's (the mean D and the exact masking evaluate, in `f32`) where the blocks are
-    /// stored, so that the gather reads the memory the passes read next; [`LevelView::mean`]
-    /// otherwise.
+    /// Block (bx, by) where the blocks are stored in the kernels' form (`None` where a block must
+    /// be decoded): the gather reads the lobes' means from its lanes (the means D and the exact
+    /// masking evaluate, in `f32`), the memory the passes read next.
     #[inline(always)]
-    fn lane_mean(&self, k: usize, bx: usize, by: usize, lane: usize) -> [f64; 2] {
-        let _ = (bx, by, lane);
-        self.mean(k)
+    fn stored_block(&self, bx: usize, by: usize) -> Option<&LobeBlock> {
+        let _ = (bx, by);
+        None
     }
 
     /// Asks the CPU to load block (bx, by) where the blocks are stored (a hint, no effect on
