@@ -107,7 +107,7 @@ impl PatchLevel<'_> {
 ///   ([`Ndf::pdf_visible_given_d`]). A renderer's `eval_pdf` at k directions and one `sample` at the
 ///   prepared wo then cost k + 1 D_P walks, one V_P(wo) pass, the sampler's pick pass and, with
 ///   exact masking, k + 1 V_P(wi) passes (the pdfs read D_P from the walk: the samplers draw each
-///   lobe within its slope box, [`MixturePatch::sample_lobe_in_box`]); every value is the one an
+///   lobe within its slope box); every value is the one an
 ///   unprepared patch returns.
 /// - What approximate masking cannot make O(1): the sampler. `sample_visible` picks a lobe
 ///   ∝ W_i V_i(wo), which needs the exact V_P(wo) (one pass per view, shared with the pdfs) and a
