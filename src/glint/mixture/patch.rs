@@ -20,7 +20,7 @@ use crate::frame::normal_to_slope;
 use crate::glint::Footprint;
 use crate::glint::GlintScratch;
 use crate::glint::kernels::albedo::Lobe;
-use crate::glint::kernels::cdf::{invert_cdf, pick_streaming, rehash};
+use crate::glint::kernels::cdf::{invert_cdf, pick_streaming};
 use crate::glint::kernels::cut::CutStats;
 use crate::glint::kernels::lobe_set::{Few, LobeSet};
 use crate::glint::kernels::prepared_view::PreparedView;
@@ -484,42 +484,6 @@ impl<'a> MixturePatch<'a> {
         self.sample_lobe_in_box(k, Some(wo), Vec2::new(r, u.y))
     }
 
-    /// Lobe k's visible normal for `wo` (its normal if `None`) **within its slope box**, the box
-    /// D_P counts it in ([`blocks::p22_lanes`]): a draw outside the box (probability ≤ ~10⁻⁶, the
-    /// lobe's truncated tail) is redrawn with numbers derived from u ([`rehash`]), up to
-    /// [`MAX_REDRAWS`] times, then replaced by the lobe's mean normal, which lies in the box. So the
-    /// samplers' densities are those of D_P's own truncated lobes, renormalised by each lobe's mass
-    /// in its box (1 − ≤ ~10⁻⁶), and the pdfs read them from D_P.
-    fn sample_lobe_in_box(&self, k: usize, wo: Option<Vec3>, u: Vec2) -> Vec3 {
-        let lobe = self.level.lobe(k);
-        let draw = |u: Vec2| match wo {
-            Some(wo) => lobe.sample_visible(wo, u),
-            None => lobe.sample_normal(u),
-        };
-        let mut m = draw(u);
-        for round in 0..MAX_REDRAWS {
-            if self.in_lobe_box(k, m) {
-                return m;
-            }
-            m = draw(rehash(u, round));
-        }
-        if self.in_lobe_box(k, m) {
-            m
-        } else {
-            let mu = lobe.mean();
-            Vec3::new(-mu.x, -mu.y, 1.0).normalize()
-        }
-    }
-
-    /// Whether normal m's slope lies in lobe k's slope box (the test of [`blocks::p22_lanes`]).
-    fn in_lobe_box(&self, k: usize, m: Vec3) -> bool {
-        let Some(s) = normal_to_slope(m) else {
-            return false;
-        };
-        let k2 = self.box_k * self.box_k;
-        with_level!(self.level, |lv| lane_in_box(&lv, k, s, k2))
-    }
-
     /// This patch running its block loops in the baseline copy (`baseline`) or in the copy the CPU
     /// supports (AVX2 where detected): results are bit-identical either way (dispatch_tests.rs).
     #[cfg(test)]
@@ -641,18 +605,4 @@ impl Ndf for MixturePatch<'_> {
             (None, _) => self.few_view_visible_area(wo),
         }
     }
-}
-
-/// Redraws of a lobe's sample that fell outside its slope box before the lobe's mean stands in
-/// ([`MixturePatch::sample_lobe_in_box`]): each redraw fails with probability ≤ ~10⁻⁶.
-const MAX_REDRAWS: u64 = 8;
-
-/// Whether slope `s` lies in node k's slope box on level `lv` (its block lane's test).
-fn lane_in_box<L: LevelView>(lv: &L, k: usize, s: Vec2, k2: f32) -> bool {
-    use super::blocks::SIDE;
-    let nx = lv.grid()[0];
-    let (x, y) = (k % nx, k / nx);
-    let mut scratch = L::scratch();
-    lv.block(x / SIDE, y / SIDE, &mut scratch)
-        .in_box((y % SIDE) * SIDE + x % SIDE, s, k2)
 }
